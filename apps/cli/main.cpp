@@ -1,0 +1,473 @@
+// subvec: the command-line front end. It only translates: options -> parameter structs -> library
+// calls -> files and text (docs/cli.md). Error policy: a subvec::Error or any other exception
+// becomes one line "subvec: <message>" on stderr and exit status 1; a command-line mistake found by
+// CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
+// status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
+// partial file and never clobbers an existing one.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <new>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "subvec/core/error.h"
+#include "subvec/core/metrics.h"
+#include "subvec/io/image_io.h"
+#include "subvec/io/svec.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/render/renderer.h"
+
+#ifndef SUBVEC_VERSION
+#define SUBVEC_VERSION "unknown"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using subvec::Error;
+using subvec::ErrorCode;
+
+// Output images over this many pixels are refused (about 1 GiB of RGBA).
+constexpr int64_t kMaxOutputPixels = int64_t{1} << 28;
+
+std::string in_quotes(const fs::path& p) { return "'" + p.string() + "'"; }
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+// Messages are printed on one line whatever they contain.
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+// ---- --window X0,Y0,X1,Y1 --------------------------------------------------------------------
+
+// Parses "X0,Y0,X1,Y1"; returns an error message, or "" and fills `w`.
+std::string parse_window(const std::string& text, subvec::Window& w) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const char* begin = item.c_str();
+    char* end = nullptr;
+    const double x = std::strtod(begin, &end);
+    while (end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (item.empty() || end == begin || *end != '\0' || !std::isfinite(x)) {
+      return "expected four numbers X0,Y0,X1,Y1, got '" + text + "'";
+    }
+    v.push_back(x);
+  }
+  if (v.size() != 4 || (!text.empty() && text.back() == ',')) {
+    return "expected four numbers X0,Y0,X1,Y1, got '" + text + "'";
+  }
+  if (!(v[0] < v[2]) || !(v[1] < v[3])) {
+    return "the window must have X0 < X1 and Y0 < Y1, got '" + text + "'";
+  }
+  w = {v[0], v[1], v[2], v[3]};
+  return "";
+}
+
+// ---- render ----------------------------------------------------------------------------------
+
+struct RenderArgs {
+  std::string input, output;
+  int width = 0;
+  double scale = 1;
+  std::string window;
+  int level = 0;
+  std::string overlay = "none";  // none, mesh or features (checked by CLI11)
+  bool no_aa = false;
+  int threads = 0;
+  int depth = -1;
+};
+
+// Output formats by extension; later issues add .pdf and .svg here.
+void check_image_output(const fs::path& out) {
+  const std::string ext = lower(out.extension().string());
+  if (ext == ".png") return;
+  if (ext.empty()) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "output " + in_quotes(out) + " has no extension (supported: .png)");
+  }
+  throw Error(ErrorCode::kInvalidArgument, "unsupported output format '" + ext + "' for " +
+                                               in_quotes(out) + " (supported: .png)");
+}
+
+void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
+  check_image_output(a.output);
+  const subvec::VectorImage image = subvec::read_svec(a.input);
+
+  const int num_levels = static_cast<int>(image.levels.size());
+  if (a.level >= num_levels) {
+    throw Error(ErrorCode::kInvalidArgument, "--level " + std::to_string(a.level) +
+                                                 " is out of range: " + in_quotes(a.input) +
+                                                 " has " + std::to_string(num_levels) +
+                                                 (num_levels == 1 ? " level" : " levels") +
+                                                 " (0 to " + std::to_string(num_levels - 1) + ")");
+  }
+
+  subvec::RenderOptions options;
+  subvec::Window window{0, 0, double(image.width), double(image.height)};
+  if (!a.window.empty()) {
+    parse_window(a.window, window);  // already validated by CLI11
+    options.window = window;
+  }
+  // Output size: explicit width (height keeps the window's aspect), or the window's size times
+  // the scale (1 by default).
+  const double ww = window.x1 - window.x0, wh = window.y1 - window.y0;
+  double out_w, out_h;
+  if (width_given) {
+    out_w = a.width;
+    out_h = std::max(1.0, std::round(a.width * wh / ww));
+  } else {
+    const double s = scale_given ? a.scale : 1.0;
+    out_w = std::max(1.0, std::round(ww * s));
+    out_h = std::max(1.0, std::round(wh * s));
+  }
+  const double max_side = subvec::Limits::kMaxDimension;
+  if (!(out_w <= max_side && out_h <= max_side && out_w * out_h <= double(kMaxOutputPixels))) {
+    const auto pixels = [](double v) {
+      std::ostringstream o;
+      if (v < 1e15) o << std::fixed << std::setprecision(0);
+      o << v;
+      return o.str();
+    };
+    std::ostringstream msg;
+    msg << "output size " << pixels(out_w) << "x" << pixels(out_h) << " is too large (at most "
+        << subvec::Limits::kMaxDimension << " pixels a side and " << kMaxOutputPixels
+        << " pixels in all)";
+    throw Error(ErrorCode::kLimit, msg.str());
+  }
+  options.width = static_cast<int>(out_w);
+  options.height = static_cast<int>(out_h);
+  options.level = a.level;
+  const std::string overlay = lower(a.overlay);
+  options.overlay = overlay == "mesh"       ? subvec::Overlay::kMesh
+                    : overlay == "features" ? subvec::Overlay::kFeatures
+                                            : subvec::Overlay::kNone;
+  options.antialias = !a.no_aa;
+  options.threads = a.threads;
+  options.depth = a.depth;
+
+  const subvec::Image8 raster = subvec::render(image, options);
+  subvec::write_png(a.output, raster);
+}
+
+// ---- info ------------------------------------------------------------------------------------
+
+struct LevelInfo {
+  int vertices, triangles, colors, features, tear_edges, crease_edges, border_edges, edges, corners;
+};
+
+LevelInfo level_info(const subvec::ControlMesh& mesh, int width, int height) {
+  const subvec::MeshTopology topo = subvec::MeshTopology::build(mesh, width, height);
+  LevelInfo info{mesh.num_vertices(),
+                 mesh.num_triangles(),
+                 mesh.num_colors(),
+                 static_cast<int>(mesh.features.size()),
+                 0,
+                 0,
+                 0,
+                 topo.num_edges(),
+                 0};
+  for (subvec::EdgeTag t : topo.edge_tags) {
+    info.tear_edges += t == subvec::EdgeTag::kTear;
+    info.crease_edges += t == subvec::EdgeTag::kCrease;
+    info.border_edges += t == subvec::EdgeTag::kBorder;
+  }
+  for (subvec::VertexTag t : topo.vertex_tags) info.corners += t == subvec::VertexTag::kCorner;
+  return info;
+}
+
+void run_info(const std::string& input, bool json) {
+  const subvec::VectorImage image = subvec::read_svec(input);
+  std::error_code ec;
+  const auto bytes = fs::file_size(input, ec);
+  std::vector<LevelInfo> levels;
+  for (const subvec::ControlMesh& mesh : image.levels) {
+    levels.push_back(level_info(mesh, image.width, image.height));
+  }
+
+  if (json) {
+    nlohmann::ordered_json j;
+    j["width"] = image.width;
+    j["height"] = image.height;
+    j["bytes"] = ec ? 0 : bytes;
+    j["levels"] = nlohmann::ordered_json::array();
+    for (const LevelInfo& l : levels) {
+      j["levels"].push_back({{"vertices", l.vertices},
+                             {"triangles", l.triangles},
+                             {"features", l.features},
+                             {"tear_edges", l.tear_edges},
+                             {"colors", l.colors},
+                             {"creases", l.crease_edges},
+                             {"border_edges", l.border_edges},
+                             {"edges", l.edges},
+                             {"corners", l.corners}});
+    }
+    j["strokes"] = image.strokes.size();
+    j["metadata"] = nlohmann::ordered_json::object();
+    for (const auto& [key, value] : image.metadata) j["metadata"][key] = value;
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+
+  std::printf("%s\n", input.c_str());
+  std::printf("  size       %d x %d pixels\n", image.width, image.height);
+  std::printf("  file       %llu bytes\n", static_cast<unsigned long long>(ec ? 0 : bytes));
+  std::printf("  levels     %zu (0 is the finest)\n", levels.size());
+  std::printf("  strokes    %zu\n", image.strokes.size());
+  const char* label = "metadata";
+  for (const auto& [key, value] : image.metadata) {
+    std::printf("  %-10s %s: %s\n", label, key.c_str(), one_line(value).c_str());
+    label = "";
+  }
+  std::printf(
+      "\n  level  vertices  triangles    colors  features  tear edges  crease edges  corners\n");
+  for (size_t i = 0; i < levels.size(); ++i) {
+    const LevelInfo& l = levels[i];
+    std::printf("  %5zu  %8d  %9d  %8d  %8d  %10d  %12d  %7d\n", i, l.vertices, l.triangles,
+                l.colors, l.features, l.tear_edges, l.crease_edges, l.corners);
+  }
+}
+
+// ---- convert ---------------------------------------------------------------------------------
+
+void run_convert(const std::string& input, const std::string& output) {
+  subvec::svec_format_for(output);  // rejects an unknown extension before any work
+  subvec::write_svec(output, subvec::read_svec(input));
+}
+
+// ---- compare ---------------------------------------------------------------------------------
+
+void run_compare(const std::string& reference, const std::string& test, bool json) {
+  const subvec::Image8 a = subvec::read_image(reference);
+  const subvec::Image8 b = subvec::read_image(test);
+  if (a.width != b.width || a.height != b.height) {
+    throw Error(ErrorCode::kInvalidArgument, "images differ in size: " + in_quotes(reference) +
+                                                 " is " + std::to_string(a.width) + "x" +
+                                                 std::to_string(a.height) + ", " + in_quotes(test) +
+                                                 " is " + std::to_string(b.width) + "x" +
+                                                 std::to_string(b.height));
+  }
+  const subvec::ImageDifference d = subvec::compare(a, b);
+  if (json) {
+    nlohmann::ordered_json j;
+    j["width"] = a.width;
+    j["height"] = a.height;
+    j["mae"] = {{"r", d.mae[0]}, {"g", d.mae[1]}, {"b", d.mae[2]}};
+    j["mae_mean"] = d.mae_mean;
+    j["psnr"] =
+        std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
+    j["ssim"] = d.ssim;
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::printf("size  %d x %d pixels\n", a.width, a.height);
+  std::printf("MAE   %.4f  (R %.4f  G %.4f  B %.4f; 0-255 scale)\n", d.mae_mean, d.mae[0], d.mae[1],
+              d.mae[2]);
+  if (std::isinf(d.psnr)) {
+    std::printf("PSNR  inf dB (identical)\n");
+  } else {
+    std::printf("PSNR  %.3f dB\n", d.psnr);
+  }
+  std::printf("SSIM  %.6f\n", d.ssim);
+}
+
+// ---- command line ----------------------------------------------------------------------------
+
+// The name of the deepest subcommand CLI11 got to, for the hint after a usage error.
+std::string command_path(const CLI::App& app) {
+  std::string path = "subvec";
+  const CLI::App* at = &app;
+  while (true) {
+    const auto subs = at->get_subcommands();
+    if (subs.empty()) break;
+    at = subs.front();
+    path += " " + at->get_name();
+  }
+  return path;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app(
+      "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
+      "Renders, inspects and converts .svec / .svec.json files and compares raster images.",
+      "subvec");
+  app.footer(
+      "Examples:\n"
+      "  subvec render examples/01-disk.svec.json -o disk.png --scale 4\n"
+      "  subvec info examples/01-disk.svec.json --json\n"
+      "  subvec convert examples/01-disk.svec.json -o disk.svec\n"
+      "  subvec compare photo.png disk.png\n"
+      "\n"
+      "Run 'subvec <command> --help' for the options of one command; docs/cli.md has them all.");
+  app.set_version_flag("--version", std::string("subvec ") + SUBVEC_VERSION);
+  app.require_subcommand(1);
+
+  // render
+  RenderArgs ra;
+  CLI::App* render = app.add_subcommand("render", "Rasterize a vector image to PNG");
+  render->add_option("input", ra.input, "Vector image (.svec or .svec.json)")->required();
+  render
+      ->add_option("-o,--output", ra.output,
+                   "Output image; the format follows the extension (.png)")
+      ->required();
+  CLI::Option* width_opt =
+      render
+          ->add_option("--width", ra.width,
+                       "Output width in pixels; the height keeps the window's aspect ratio")
+          ->check(CLI::Range(1, subvec::Limits::kMaxDimension));
+  CLI::Option* scale_opt =
+      render
+          ->add_option("--scale", ra.scale,
+                       "Output size as a multiple of the window's size (default 1)")
+          ->check(CLI::Validator(
+              [](std::string& text) {
+                double v = 0;
+                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0;
+                return ok ? std::string() : "expected a positive number, got '" + text + "'";
+              },
+              "POSITIVE", "positive"));
+  width_opt->excludes(scale_opt);
+  render
+      ->add_option("--window", ra.window,
+                   "View window X0,Y0,X1,Y1 in image pixels (default: the whole image); may extend "
+                   "past the image, where the output is transparent")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            subvec::Window w;
+            return parse_window(text, w);
+          },
+          "X0,Y0,X1,Y1", "window"));
+  render->add_option("--level", ra.level, "Level of detail, 0 (the finest) by default")
+      ->check(CLI::Range(0, subvec::Limits::kMaxLevels - 1));
+  render
+      ->add_option("--overlay", ra.overlay,
+                   "Draw the control mesh or the feature curves over the image")
+      ->check(CLI::IsMember({"none", "mesh", "features"}, CLI::ignore_case))
+      ->default_str("none");
+  render->add_flag("--no-aa", ra.no_aa, "Disable anti-aliasing of tears and the image border");
+  render->add_option("--threads", ra.threads, "Worker threads; 0 (default) uses all cores")
+      ->check(CLI::Range(0, 1024));
+  render
+      ->add_option("--depth", ra.depth,
+                   "Subdivision depth; by default chosen from the output scale")
+      ->check(CLI::Range(0, 10));
+  render->footer(
+      "Examples:\n"
+      "  subvec render in.svec.json -o out.png                  # the image's own size\n"
+      "  subvec render in.svec.json -o out.png --scale 4        # 4x larger\n"
+      "  subvec render in.svec -o out.png --width 1920          # 1920 wide, aspect kept\n"
+      "  subvec render in.svec -o zoom.png --window 10,10,42,34 --scale 16\n"
+      "  subvec render in.svec -o mesh.png --overlay mesh --scale 4");
+
+  // info
+  std::string info_input;
+  bool info_json = false;
+  CLI::App* info =
+      app.add_subcommand("info", "Print the size and per-level statistics of a vector image");
+  info->add_option("input", info_input, "Vector image (.svec or .svec.json)")->required();
+  info->add_flag("--json", info_json, "Print a JSON object instead of text");
+  info->footer(
+      "Examples:\n"
+      "  subvec info in.svec\n"
+      "  subvec info in.svec.json --json    # {\"width\":..., \"height\":..., \"bytes\":..., "
+      "\"levels\":[...]}");
+
+  // convert
+  std::string convert_input, convert_output;
+  CLI::App* convert =
+      app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
+  convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
+  convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
+      ->required();
+  convert->footer(
+      "Examples:\n"
+      "  subvec convert in.svec.json -o in.svec     # compact binary\n"
+      "  subvec convert in.svec -o in.svec.json     # readable JSON");
+
+  // compare
+  std::string compare_ref, compare_test;
+  bool compare_json = false;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "Compare two raster images: mean absolute error per channel, PSNR and SSIM");
+  compare->add_option("reference", compare_ref, "Reference image (PNG, JPEG, WebP, TIFF, BMP)")
+      ->required();
+  compare->add_option("test", compare_test, "Image to compare, of the same size")->required();
+  compare->add_flag("--json", compare_json, "Print a JSON object instead of text");
+  compare->footer(
+      "Examples:\n"
+      "  subvec compare photo.png render.png\n"
+      "  subvec compare photo.png render.png --json   # psnr is null for identical images");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string message = e.what();
+    int status = e.get_exit_code();
+    if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
+      // No command: either none was given or the first word is not one.
+      const std::vector<std::string> extra = app.remaining();
+      if (extra.empty()) {
+        message = "a command is required: render, info, convert or compare";
+      } else {
+        message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
+                  extra.front() + "' (expected a command: render, info, convert or compare)";
+        status = int(CLI::ExitCodes::ExtrasError);
+      }
+    }
+    std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
+    return status;
+  }
+
+  if (render->parsed()) {
+    run_render(ra, width_opt->count() > 0, scale_opt->count() > 0);
+  } else if (info->parsed()) {
+    run_info(info_input, info_json);
+  } else if (convert->parsed()) {
+    run_convert(convert_input, convert_output);
+  } else if (compare->parsed()) {
+    run_compare(compare_ref, compare_test, compare_json);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "subvec: out of memory\n";
+  } catch (const std::exception& e) {  // subvec::Error and everything else
+    std::cerr << "subvec: " << one_line(e.what()) << "\n";
+  } catch (...) {
+    std::cerr << "subvec: unknown error\n";
+  }
+  return 1;
+}

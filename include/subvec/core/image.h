@@ -1,0 +1,21 @@
+// 8-bit raster images: what the renderer produces and the metrics compare.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace subvec {
+
+// Interleaved 8-bit pixels, rows top to bottom, channels 3 (RGB) or 4 (RGBA, straight alpha).
+struct Image8 {
+  int width = 0, height = 0, channels = 3;
+  std::vector<uint8_t> pixels;  // height * width * channels
+
+  Image8() = default;
+  Image8(int w, int h, int c) : width(w), height(h), channels(c), pixels(size_t(w) * h * c) {}
+  uint8_t* row(int y) { return pixels.data() + size_t(y) * width * channels; }
+  const uint8_t* row(int y) const { return pixels.data() + size_t(y) * width * channels; }
+};
+
+}  // namespace subvec

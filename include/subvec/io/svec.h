@@ -1,0 +1,33 @@
+// Native files: `.svec.json` (documented JSON, writable by hand) and `.svec` (binary: magic,
+// version, little-endian, zstd-compressed payload). docs/format.md is the contract for both.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+enum class SvecFormat { kJson, kBinary };
+
+// `.svec.json` or `.json` -> kJson, `.svec` -> kBinary; anything else throws kInvalidArgument.
+SvecFormat svec_format_for(const std::filesystem::path& path);
+
+// Parse and validate (mesh/validate.h). Throw Error(kBadFile) naming the field and index, or
+// Error(kInvalidMesh) from validation; never read out of bounds.
+VectorImage parse_svec_json(std::string_view text);
+VectorImage parse_svec_binary(std::span<const uint8_t> bytes);
+
+std::string to_svec_json(const VectorImage& image);
+std::vector<uint8_t> to_svec_binary(const VectorImage& image);
+
+// Read by content (binary magic, else JSON); write by extension, atomically.
+VectorImage read_svec(const std::filesystem::path& path);
+void write_svec(const std::filesystem::path& path, const VectorImage& image);
+
+}  // namespace subvec

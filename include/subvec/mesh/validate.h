@@ -1,0 +1,31 @@
+// Validation of a vector image: everything a reader, an editor or a renderer relies on.
+#pragma once
+
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+// Hard limits on what subvec accepts from a file (docs/format.md lists them).
+struct Limits {
+  static constexpr int32_t kMaxDimension = 1 << 16;         // width or height, pixels
+  static constexpr int64_t kMaxPixels = int64_t{1} << 30;   // width * height
+  static constexpr int32_t kMaxLevels = 64;
+  static constexpr int64_t kMaxElements = int64_t{1} << 26; // vertices, colors, triangles per level
+};
+
+// Checks one level against the image size and returns its topology. Throws Error(kInvalidMesh)
+// with a one-line message naming the level, the element and its index:
+//  - sizes within Limits; positions and colors finite; positions inside the domain;
+//  - triangles with valid, distinct indices and positive signed area (not flipped or degenerate);
+//  - an edge-manifold mesh with no unused vertex, whose boundary lies on the image border and
+//    whose triangles tile the domain exactly (no gap, no overlap; the 4 image corners are vertices);
+//  - creases and features are chains of interior mesh edges, each edge in at most one of them;
+//  - colors: each color value belongs to one vertex and is used; corners across a non-tear edge
+//    use the same color values.
+MeshTopology validate_level(const ControlMesh& mesh, int width, int height, int level_index = 0);
+
+// Checks the whole image: size, levels (at least one), every level, and strokes.
+void validate(const VectorImage& image);
+
+}  // namespace subvec

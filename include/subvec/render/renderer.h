@@ -1,0 +1,63 @@
+// Rasterization of a vector image (paper §7.1) on the CPU.
+//
+// The renderer refines only the control faces whose limit surface touches the view window, to a
+// depth chosen from the output scale, pushes the refined vertices to the limit and draws the
+// triangles with Gouraud interpolation under a top-left fill rule. Tears and the image border are
+// anti-aliased by supersampling the pixels they cross. Work is split over horizontal bands, one
+// writer per pixel, so the output is byte-identical whatever the thread count.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <span>
+
+#include "subvec/core/image.h"
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+// A view window in image coordinates (x0 < x1, y0 < y1); may extend past the image, where the
+// output is transparent.
+struct Window {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+enum class Overlay { kNone, kMesh, kFeatures };
+
+struct RenderOptions {
+  int width = 0;                  // output width; 0: the window's width in image pixels
+  int height = 0;                 // output height; 0: keep the window's aspect ratio
+  std::optional<Window> window;   // default: the whole image
+  int level = 0;                  // level of detail
+  Overlay overlay = Overlay::kNone;
+  bool antialias = true;          // supersample pixels crossed by tears and the border
+  int threads = 0;                // <= 0: all cores
+  int depth = -1;                 // subdivision depth; -1: from the output scale
+  double max_edge_pixels = 2.5;   // depth rule: refine until refined edges average at most this
+};
+
+// Draws the image as described by `options`; RGB, or RGBA when the window leaves the image.
+// Throws Error(kInvalidArgument) for a bad level, size or window.
+Image8 render(const VectorImage& image, const RenderOptions& options);
+
+// A renderer that keeps the refined topology of the last view, so that redrawing the same view or
+// drawing after an edit of positions or colors (set_positions / set_colors) skips refinement.
+class Renderer {
+ public:
+  explicit Renderer(VectorImage image);
+  ~Renderer();
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+
+  const VectorImage& image() const;
+  Image8 render(const RenderOptions& options);
+  // Edits that keep topology: the cached refinement is kept and only re-evaluated.
+  void set_positions(int level, std::span<const Vec2> positions);
+  void set_colors(int level, std::span<const Color> colors);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace subvec

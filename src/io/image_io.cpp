@@ -1,0 +1,266 @@
+// Raster image files through OpenCV (io/image_io.h).
+//
+// Reading: the whole file is read into memory (io/file.h), its size checked against `max_pixels`
+// from the header where we can parse it cheaply (PNG IHDR, JPEG SOFn) before anything is decoded,
+// and otherwise right after decoding. Everything becomes 8-bit RGB:
+//  - gray (and gray + alpha) is replicated to R = G = B;
+//  - 16-bit samples are scaled by 255/65535 with rounding, float samples are taken as 0-1;
+//  - alpha is composited over black (c * a / 255), so a transparent pixel reads as black; this
+//    matches the renderer, whose transparent pixels outside the image are (0, 0, 0, 0);
+//  - JPEG is decoded with OpenCV's colour path, which converts CMYK/YCCK and applies the EXIF
+//    orientation; other formats are decoded as stored (IMREAD_UNCHANGED keeps alpha and depth).
+// A PNG whose chunks are cut short or fail their CRC, and a JPEG whose entropy-coded data has no
+// end-of-image marker, are reported as truncated before decoding (libpng would print to stderr,
+// libjpeg would fill the missing rows with grey). Decoders may still print warnings about
+// unusual but readable files (libpng's "iCCP: known incorrect sRGB profile").
+//
+// Writing: encoded to memory, then written atomically.
+#include "subvec/io/image_io.h"
+
+#include <array>
+#include <cstring>
+#include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "subvec/core/error.h"
+#include "subvec/io/file.h"
+
+namespace subvec {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string in_quotes(const fs::path& path) { return "'" + path.string() + "'"; }
+
+[[noreturn]] void fail(ErrorCode code, const fs::path& path, const std::string& why) {
+  throw Error(code, "cannot read image " + in_quotes(path) + ": " + why);
+}
+
+// OpenCV logs decoder warnings to stderr; the library reports through exceptions instead.
+void silence_opencv() {
+  static const bool once = [] {
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    return true;
+  }();
+  (void)once;
+}
+
+uint32_t big_endian_u32(const uint8_t* p) {
+  return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
+}
+uint32_t big_endian_u16(const uint8_t* p) { return uint32_t(p[0]) << 8 | uint32_t(p[1]); }
+
+bool is_png(const std::vector<uint8_t>& b) {
+  static constexpr uint8_t kMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return b.size() >= 8 && std::memcmp(b.data(), kMagic, 8) == 0;
+}
+bool is_jpeg(const std::vector<uint8_t>& b) {
+  return b.size() >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff;
+}
+
+struct HeaderSize {
+  int64_t width = -1, height = -1;  // -1: not known from the header
+};
+
+// PNG: signature, then the IHDR chunk (length, "IHDR", width, height as big-endian u32).
+HeaderSize png_size(const std::vector<uint8_t>& b) {
+  if (b.size() < 24 || std::memcmp(b.data() + 12, "IHDR", 4) != 0) return {};
+  return {big_endian_u32(b.data() + 16), big_endian_u32(b.data() + 20)};
+}
+
+// libpng reports a broken stream on stderr before OpenCV sees the failure, so the chunk structure
+// is checked here first: every chunk inside the file with a correct CRC-32, up to IEND.
+uint32_t crc32(const uint8_t* data, size_t n) {
+  static const std::array<uint32_t, 256> table = [] {
+    std::array<uint32_t, 256> t{};
+    for (uint32_t i = 0; i < 256; ++i) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xedb88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  uint32_t crc = 0xffffffffu;
+  for (size_t i = 0; i < n; ++i) crc = table[(crc ^ data[i]) & 0xff] ^ (crc >> 8);
+  return crc ^ 0xffffffffu;
+}
+
+bool png_complete(const std::vector<uint8_t>& b) {
+  size_t pos = 8;
+  while (pos + 12 <= b.size()) {
+    const size_t length = big_endian_u32(b.data() + pos);
+    if (length > b.size() - pos - 12) return false;
+    const uint8_t* type = b.data() + pos + 4;
+    if (crc32(type, length + 4) != big_endian_u32(type + 4 + length)) return false;
+    if (std::memcmp(type, "IEND", 4) == 0) return true;
+    pos += 12 + length;
+  }
+  return false;
+}
+
+// JPEG: walk the marker segments up to the first start-of-frame (SOF0-SOF15 except DHT C4, JPG
+// C8 and DAC CC), whose payload is precision (1 byte), height, width (big-endian u16). Also reports
+// whether an end-of-image marker follows the start of scan: inside entropy-coded data 0xFF is
+// always followed by 0x00 or a restart marker, so 0xFF 0xD9 after SOS is the real EOI.
+struct JpegScan {
+  HeaderSize size;
+  bool complete = false;
+};
+JpegScan scan_jpeg(const std::vector<uint8_t>& b) {
+  JpegScan scan;
+  size_t i = 2;
+  while (i + 4 <= b.size()) {
+    if (b[i] != 0xff) return scan;  // not a marker: malformed, let the decoder complain
+    const uint8_t marker = b[i + 1];
+    if (marker == 0xff) {  // fill byte
+      ++i;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) {  // markers without a length
+      i += 2;
+      continue;
+    }
+    const size_t length = big_endian_u16(b.data() + i + 2);
+    const bool sof =
+        marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (sof && i + 9 <= b.size() && scan.size.width < 0) {
+      scan.size = {big_endian_u16(b.data() + i + 7), big_endian_u16(b.data() + i + 5)};
+    }
+    if (marker == 0xda) {  // start of scan: look for EOI in the rest
+      for (size_t j = i + 2 + length; j + 1 < b.size(); ++j) {
+        if (b[j] == 0xff && b[j + 1] == 0xd9) {
+          scan.complete = true;
+          break;
+        }
+      }
+      return scan;
+    }
+    i += 2 + length;
+  }
+  return scan;
+}
+
+void check_pixels(const fs::path& path, int64_t width, int64_t height, int64_t max_pixels) {
+  // width * height > max_pixels, without overflow for 32-bit header fields.
+  if (width > 0 && height > max_pixels / width) {
+    throw Error(ErrorCode::kLimit, "cannot read image " + in_quotes(path) + ": " +
+                                       std::to_string(width) + "x" + std::to_string(height) +
+                                       " pixels is over the limit of " +
+                                       std::to_string(max_pixels) + " pixels");
+  }
+}
+
+// Any decoded depth to 8 bits per sample.
+cv::Mat to_8bit(const cv::Mat& m, const fs::path& path) {
+  cv::Mat out;
+  switch (m.depth()) {
+    case CV_8U:
+      return m;
+    case CV_16U:
+      m.convertTo(out, CV_8U, 255.0 / 65535.0);
+      return out;
+    case CV_32F:
+    case CV_64F:
+      m.convertTo(out, CV_8U, 255.0);
+      return out;
+    default:
+      fail(ErrorCode::kBadFile, path, "unsupported sample type (signed integers)");
+  }
+}
+
+}  // namespace
+
+Image8 read_image(const fs::path& path, int64_t max_pixels) {
+  silence_opencv();
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) fail(ErrorCode::kIo, path, "no such file");
+  if (fs::is_directory(status)) fail(ErrorCode::kIo, path, "is a directory");
+
+  const std::vector<uint8_t> bytes = read_file(path);
+  if (bytes.empty()) fail(ErrorCode::kBadFile, path, "file is empty");
+
+  int flags = cv::IMREAD_UNCHANGED;
+  if (is_png(bytes)) {
+    const HeaderSize size = png_size(bytes);
+    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+    if (!png_complete(bytes)) fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+  } else if (is_jpeg(bytes)) {
+    const JpegScan scan = scan_jpeg(bytes);
+    if (scan.size.width >= 0) check_pixels(path, scan.size.width, scan.size.height, max_pixels);
+    if (!scan.complete) fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+    flags = cv::IMREAD_COLOR;  // CMYK conversion and EXIF orientation; JPEG has no alpha
+  }
+
+  cv::Mat decoded;
+  try {
+    // cv::imdecode takes a non-const Mat header over the buffer but does not write to it.
+    const cv::Mat buffer(1, int(bytes.size()), CV_8U, const_cast<uint8_t*>(bytes.data()));
+    decoded = cv::imdecode(buffer, flags);
+  } catch (const cv::Exception&) {
+    decoded.release();
+  }
+  if (decoded.empty() || decoded.dims != 2) {
+    fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+  }
+  check_pixels(path, decoded.cols, decoded.rows, max_pixels);
+
+  const cv::Mat m = to_8bit(decoded, path);
+  const int channels = m.channels();
+  if (channels < 1 || channels > 4) {
+    fail(ErrorCode::kBadFile, path, "unsupported channel count " + std::to_string(channels));
+  }
+
+  Image8 image(m.cols, m.rows, 3);
+  for (int y = 0; y < m.rows; ++y) {
+    const uint8_t* src = m.ptr<uint8_t>(y);
+    uint8_t* dst = image.row(y);
+    for (int x = 0; x < m.cols; ++x, src += channels, dst += 3) {
+      // OpenCV orders colour samples B, G, R; gray is one sample, gray + alpha two.
+      int r, g, b, a = 255;
+      if (channels <= 2) {
+        r = g = b = src[0];
+        if (channels == 2) a = src[1];
+      } else {
+        b = src[0];
+        g = src[1];
+        r = src[2];
+        if (channels == 4) a = src[3];
+      }
+      // Over black: c * a / 255, rounded.
+      dst[0] = uint8_t((r * a + 127) / 255);
+      dst[1] = uint8_t((g * a + 127) / 255);
+      dst[2] = uint8_t((b * a + 127) / 255);
+    }
+  }
+  return image;
+}
+
+void write_png(const fs::path& path, const Image8& image) {
+  silence_opencv();
+  if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
+      image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "cannot write " + in_quotes(path) + ": the image is empty or malformed");
+  }
+  // A header over the caller's pixels (not written to), then RGB(A) -> BGR(A) for OpenCV.
+  const cv::Mat rgb(image.height, image.width, CV_8UC(image.channels),
+                    const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, image.channels == 4 ? cv::COLOR_RGBA2BGRA : cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> encoded;
+  bool ok = false;
+  try {
+    ok = cv::imencode(".png", bgr, encoded);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": PNG encoding failed");
+  write_file_atomic(path, encoded);
+}
+
+}  // namespace subvec

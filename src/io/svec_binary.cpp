@@ -1,0 +1,387 @@
+// The `.svec` binary form (docs/format.md): a fixed header and one zstd frame holding a
+// little-endian payload.
+//
+// Reading never trusts a declared size: the header's payload size is capped before anything is
+// allocated, the output buffer grows only as zstd produces bytes, every count in the payload is
+// capped and checked against the bytes that remain before a vector is sized, and the cursor
+// throws "truncated payload while reading <what>" instead of reading past the end. The image is
+// then validated like a JSON one. Writing is deterministic (single-threaded zstd, fixed level).
+#include <zstd.h>
+
+#include <bit>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "io/svec_p.h"
+#include "subvec/core/error.h"
+#include "subvec/io/svec.h"
+#include "subvec/mesh/validate.h"
+
+namespace subvec {
+namespace {
+
+using namespace svec_detail;
+
+[[noreturn]] void fail(const std::string& message, ErrorCode code = ErrorCode::kBadFile) {
+  throw Error(code, message);
+}
+
+std::string str(uint64_t v) { return std::to_string(v); }
+
+// ---------------------------------------------------------------------------------------------
+// Little-endian encoding.
+
+class ByteWriter {
+ public:
+  std::vector<uint8_t> bytes;
+
+  void u32(uint32_t v) {
+    for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<uint8_t>(v >> (8 * k)));
+  }
+  void u64(uint64_t v) {
+    for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<uint8_t>(v >> (8 * k)));
+  }
+  void i32(int32_t v) { u32(static_cast<uint32_t>(v)); }
+  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+  void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
+  void count(size_t n, const char* what) {
+    if (n > UINT32_MAX)
+      fail(std::string("too many ") + what + " for a .svec file", ErrorCode::kLimit);
+    u32(static_cast<uint32_t>(n));
+  }
+  void string(const std::string& s) {
+    count(s.size(), "bytes in a metadata string");
+    bytes.insert(bytes.end(), s.begin(), s.end());
+  }
+};
+
+class Cursor {
+ public:
+  explicit Cursor(std::span<const uint8_t> bytes) : bytes_(bytes) {}
+
+  // What is being read, for messages: "level 0 triangles".
+  void set_context(std::string what) { context_ = std::move(what); }
+  size_t remaining() const { return bytes_.size() - pos_; }
+
+  const uint8_t* take(size_t n) {
+    if (n > remaining()) {
+      fail("truncated payload while reading " + context_ + " (needs " + str(n) +
+           " bytes at offset " + str(pos_) + ", " + str(remaining()) + " left)");
+    }
+    const uint8_t* p = bytes_.data() + pos_;
+    pos_ += n;
+    return p;
+  }
+  uint32_t u32() {
+    const uint8_t* p = take(4);
+    uint32_t v = 0;
+    for (int k = 0; k < 4; ++k) v |= uint32_t{p[k]} << (8 * k);
+    return v;
+  }
+  uint64_t u64() {
+    const uint8_t* p = take(8);
+    uint64_t v = 0;
+    for (int k = 0; k < 8; ++k) v |= uint64_t{p[k]} << (8 * k);
+    return v;
+  }
+  int32_t i32() { return static_cast<int32_t>(u32()); }
+  float f32() { return std::bit_cast<float>(u32()); }
+  double f64() { return std::bit_cast<double>(u64()); }
+
+  // An element count, capped by `max` and by the bytes left (each element takes at least
+  // `min_bytes`), so that no vector is sized from an unchecked number.
+  size_t count(const std::string& what, size_t min_bytes, int64_t max = Limits::kMaxElements) {
+    set_context(what + " count");
+    const uint32_t n = u32();
+    if (n > max) {
+      fail(what + ": count " + str(n) + " is over the limit of " + str(uint64_t(max)),
+           ErrorCode::kLimit);
+    }
+    set_context(what);
+    if (uint64_t{n} * min_bytes > remaining()) {
+      fail("truncated payload while reading " + what + " (" + str(n) + " declared, needing " +
+           str(uint64_t{n} * min_bytes) + " bytes at offset " + str(pos_) + ", " +
+           str(remaining()) + " left)");
+    }
+    return n;
+  }
+
+  std::string string(const std::string& what) {
+    const size_t n = count(what, 1);
+    const uint8_t* p = take(n);
+    return std::string(reinterpret_cast<const char*>(p), n);
+  }
+
+ private:
+  std::span<const uint8_t> bytes_;
+  size_t pos_ = 0;
+  std::string context_ = "the payload";
+};
+
+// ---------------------------------------------------------------------------------------------
+// Payload.
+
+std::vector<uint8_t> encode_payload(const VectorImage& image) {
+  ByteWriter w;
+  w.i32(image.width);
+  w.i32(image.height);
+  w.count(image.levels.size(), "levels");
+  for (const ControlMesh& m : image.levels) {
+    if (m.triangle_colors.size() != m.triangles.size()) {
+      fail("cannot write a level whose triangle_colors and triangles differ in length",
+           ErrorCode::kInvalidMesh);
+    }
+    w.count(m.positions.size(), "vertices");
+    w.count(m.colors.size(), "colors");
+    w.count(m.triangles.size(), "triangles");
+    w.count(m.creases.size(), "creases");
+    w.count(m.features.size(), "features");
+    for (const Vec2& p : m.positions) w.f64(p.x), w.f64(p.y);
+    for (const Color& c : m.colors) w.f32(c.r), w.f32(c.g), w.f32(c.b);
+    for (const Tri& t : m.triangles)
+      for (int32_t v : t) w.i32(v);
+    for (const Tri& t : m.triangle_colors)
+      for (int32_t c : t) w.i32(c);
+    for (const EdgeVerts& e : m.creases) w.i32(e[0]), w.i32(e[1]);
+    for (const Feature& f : m.features) {
+      w.i32(f.id);
+      w.f64(f.saliency);
+      w.count(f.vertices.size(), "feature vertices");
+      for (int32_t v : f.vertices) w.i32(v);
+    }
+  }
+  w.count(image.strokes.size(), "strokes");
+  for (const Stroke& s : image.strokes) {
+    w.i32(s.level);
+    w.f32(s.width);
+    w.f32(s.color.r), w.f32(s.color.g), w.f32(s.color.b);
+    w.f32(s.taper);
+    w.count(s.points.size(), "stroke points");
+    for (const Vec2& p : s.points) w.f64(p.x), w.f64(p.y);
+  }
+  w.count(image.metadata.size(), "metadata entries");
+  for (const auto& [key, value] : image.metadata) {
+    w.string(key);
+    w.string(value);
+  }
+  return std::move(w.bytes);
+}
+
+VectorImage decode_payload(std::span<const uint8_t> payload) {
+  Cursor in(payload);
+  VectorImage image;
+  in.set_context("image size");
+  image.width = in.i32();
+  image.height = in.i32();
+  const size_t num_levels = in.count("levels", 20, Limits::kMaxLevels);
+  image.levels.resize(num_levels);
+  for (size_t l = 0; l < num_levels; ++l) {
+    ControlMesh& m = image.levels[l];
+    const std::string level = "level " + str(l) + " ";
+    in.set_context(level + "counts");
+    const size_t counts[5] = {in.count(level + "vertices", 16), in.count(level + "colors", 12),
+                              in.count(level + "triangles", 24), in.count(level + "creases", 8),
+                              in.count(level + "features", 16)};
+    in.set_context(level + "vertices");
+    m.positions.resize(counts[0]);
+    for (Vec2& p : m.positions) p.x = in.f64(), p.y = in.f64();
+    in.set_context(level + "colors");
+    m.colors.resize(counts[1]);
+    for (Color& c : m.colors) c.r = in.f32(), c.g = in.f32(), c.b = in.f32();
+    in.set_context(level + "triangles");
+    m.triangles.resize(counts[2]);
+    for (Tri& t : m.triangles)
+      for (int32_t& v : t) v = in.i32();
+    in.set_context(level + "triangle colors");
+    m.triangle_colors.resize(counts[2]);
+    for (Tri& t : m.triangle_colors)
+      for (int32_t& c : t) c = in.i32();
+    in.set_context(level + "creases");
+    m.creases.resize(counts[3]);
+    for (EdgeVerts& e : m.creases) e[0] = in.i32(), e[1] = in.i32();
+    m.features.resize(counts[4]);
+    for (size_t i = 0; i < counts[4]; ++i) {
+      Feature& f = m.features[i];
+      const std::string what = level + "feature " + str(i);
+      in.set_context(what);
+      f.id = in.i32();
+      f.saliency = in.f64();
+      f.vertices.resize(in.count(what + " vertices", 4));
+      for (int32_t& v : f.vertices) v = in.i32();
+    }
+  }
+  image.strokes.resize(in.count("strokes", 28));
+  for (size_t i = 0; i < image.strokes.size(); ++i) {
+    Stroke& s = image.strokes[i];
+    const std::string what = "stroke " + str(i);
+    in.set_context(what);
+    s.level = in.i32();
+    s.width = in.f32();
+    s.color.r = in.f32(), s.color.g = in.f32(), s.color.b = in.f32();
+    s.taper = in.f32();
+    s.points.resize(in.count(what + " points", 16));
+    for (Vec2& p : s.points) p.x = in.f64(), p.y = in.f64();
+  }
+  image.metadata.resize(in.count("metadata entries", 8));
+  for (size_t i = 0; i < image.metadata.size(); ++i) {
+    const std::string what = "metadata entry " + str(i);
+    image.metadata[i].first = in.string(what + " key");
+    image.metadata[i].second = in.string(what + " value");
+  }
+  if (in.remaining() != 0)
+    fail(str(in.remaining()) + " unexpected bytes after the payload's metadata");
+  return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// zstd.
+
+struct DctxDeleter {
+  void operator()(ZSTD_DCtx* d) const { ZSTD_freeDCtx(d); }
+};
+struct CctxDeleter {
+  void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
+};
+
+// Decompresses one frame that must produce exactly `expected` bytes. The buffer grows as output
+// arrives, so a header that lies about the size costs no memory up front.
+std::vector<uint8_t> decompress(std::span<const uint8_t> frame, uint64_t expected) {
+  const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
+  if (content == ZSTD_CONTENTSIZE_ERROR) fail("corrupt zstd frame: bad frame header");
+  if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != expected) {
+    fail("zstd frame holds " + str(content) + " bytes but the header declares " + str(expected));
+  }
+  std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx(ZSTD_createDCtx());
+  if (!dctx) fail("out of memory for zstd", ErrorCode::kIo);
+  std::vector<uint8_t> out(std::min<uint64_t>(expected, uint64_t{1} << 24));
+  ZSTD_inBuffer input{frame.data(), frame.size(), 0};
+  size_t produced = 0;
+  for (;;) {
+    if (produced == out.size() && out.size() < expected) {
+      out.resize(std::min<uint64_t>(expected, uint64_t{out.size()} * 2));
+    }
+    // Once the buffer holds the declared size, zstd gets one spare byte: any output there means
+    // the frame holds more than declared.
+    uint8_t spare = 0;
+    const bool full = produced == out.size();
+    ZSTD_outBuffer output =
+        full ? ZSTD_outBuffer{&spare, 1, 0} : ZSTD_outBuffer{out.data(), out.size(), produced};
+    const size_t consumed_before = input.pos;
+    const size_t ret = ZSTD_decompressStream(dctx.get(), &output, &input);
+    if (ZSTD_isError(ret)) fail(std::string("corrupt zstd frame: ") + ZSTD_getErrorName(ret));
+    if (full && output.pos > 0) {
+      fail("zstd frame decompresses to more than the " + str(expected) +
+           " bytes the header declares");
+    }
+    const bool progress = input.pos != consumed_before || (!full && output.pos != produced);
+    if (!full) produced = output.pos;
+    if (ret == 0) break;  // frame complete, checksum verified
+    if (input.pos == input.size && (full || produced < out.size())) {
+      fail("truncated zstd frame: it ends after " + str(produced) + " of " + str(expected) +
+           " payload bytes");
+    }
+    if (!progress) fail("corrupt zstd frame: the decoder makes no progress");
+  }
+  if (produced != expected) {
+    fail("zstd frame decompresses to " + str(produced) + " bytes but the header declares " +
+         str(expected));
+  }
+  if (input.pos != input.size) {
+    fail(str(input.size - input.pos) + " unexpected bytes after the zstd frame");
+  }
+  out.resize(produced);
+  return out;
+}
+
+std::vector<uint8_t> compress(std::span<const uint8_t> payload) {
+  std::unique_ptr<ZSTD_CCtx, CctxDeleter> cctx(ZSTD_createCCtx());
+  if (!cctx) fail("out of memory for zstd", ErrorCode::kIo);
+  ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, kZstdLevel);
+  ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_checksumFlag, 1);
+  ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1);
+  std::vector<uint8_t> frame(ZSTD_compressBound(payload.size()));
+  const size_t n =
+      ZSTD_compress2(cctx.get(), frame.data(), frame.size(), payload.data(), payload.size());
+  if (ZSTD_isError(n))
+    fail(std::string("zstd compression failed: ") + ZSTD_getErrorName(n), ErrorCode::kIo);
+  frame.resize(n);
+  return frame;
+}
+
+std::string hex_bytes(std::span<const uint8_t> bytes) {
+  static const char* digits = "0123456789abcdef";
+  std::string s;
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    if (i) s += ' ';
+    s += digits[bytes[i] >> 4];
+    s += digits[bytes[i] & 15];
+  }
+  return s;
+}
+
+}  // namespace
+
+VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
+  if (!has_magic(bytes)) {
+    const size_t n = std::min(bytes.size(), kMagic.size());
+    if (n > 0 && n < kMagic.size() && std::memcmp(bytes.data(), kMagic.data(), n) == 0) {
+      fail("truncated .svec header: " + str(bytes.size()) + " bytes, the header needs " +
+           str(kHeaderBytes));
+    }
+    fail("not a .svec file: wrong magic bytes (" + hex_bytes(bytes.first(n)) + ", expected " +
+         hex_bytes(kMagic) + ")");
+  }
+  if (bytes.size() < kHeaderBytes) {
+    fail("truncated .svec header: " + str(bytes.size()) + " bytes, the header needs " +
+         str(kHeaderBytes));
+  }
+  Cursor header(bytes.subspan(kMagic.size(), kHeaderBytes - kMagic.size()));
+  header.set_context("the header");
+  const uint32_t version = header.u32();
+  const uint32_t flags = header.u32();
+  const uint64_t payload_size = header.u64();
+  const uint64_t frame_size = header.u64();
+  if (version != kBinaryVersion) {
+    fail("unsupported .svec version " + str(version) + " (this build reads " + str(kBinaryVersion) +
+         ")");
+  }
+  if (flags != 0) fail("unsupported .svec flags " + str(flags) + " (this build knows none)");
+  if (payload_size > kMaxPayloadBytes) {
+    fail("declared payload of " + str(payload_size) + " bytes is over the limit of " +
+             str(kMaxPayloadBytes),
+         ErrorCode::kLimit);
+  }
+  const uint64_t available = bytes.size() - kHeaderBytes;
+  if (frame_size > available) {
+    fail("truncated .svec file: the header declares a " + str(frame_size) +
+         "-byte zstd frame but only " + str(available) + " bytes follow");
+  }
+  if (frame_size < available) {
+    fail(str(available - frame_size) + " unexpected bytes after the zstd frame");
+  }
+  const std::vector<uint8_t> payload = decompress(bytes.subspan(kHeaderBytes), payload_size);
+  VectorImage image = decode_payload(payload);
+  validate(image);
+  return image;
+}
+
+std::vector<uint8_t> to_svec_binary(const VectorImage& image) {
+  const std::vector<uint8_t> payload = encode_payload(image);
+  if (payload.size() > kMaxPayloadBytes) {
+    fail("image too large for a .svec file (" + str(payload.size()) + " bytes of payload, limit " +
+             str(kMaxPayloadBytes) + ")",
+         ErrorCode::kLimit);
+  }
+  const std::vector<uint8_t> frame = compress(payload);
+  ByteWriter w;
+  w.bytes.assign(kMagic.begin(), kMagic.end());
+  w.u32(kBinaryVersion);
+  w.u32(0);  // flags
+  w.u64(payload.size());
+  w.u64(frame.size());
+  w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());
+  return std::move(w.bytes);
+}
+
+}  // namespace subvec

@@ -1,0 +1,731 @@
+// Triangle rasterization with a top-left fill rule, Gouraud shading, tear anti-aliasing and overlays.
+// See raster_p.h for the design; this file is organised as
+//   fixed point and the triangle setup (edge functions, fill rule),
+//   coverage traversal: which samples a triangle owns (shared with the sample_coverage test hook),
+//   shading, the marks of pixels to supersample, the two passes of a band, overlays, rasterize().
+#include "render/raster_p.h"
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "render/parallel_p.h"
+
+namespace subvec::detail {
+namespace {
+
+// 24.8 fixed point: 8 subpixel bits. Coordinates are clamped to a guard band of +-2^21 output
+// pixels, so edge-function products stay below 2^61 in int64.
+constexpr int kSubpixelBits = 8;
+constexpr int64_t kOne = int64_t{1} << kSubpixelBits;
+constexpr int64_t kHalf = kOne / 2;
+constexpr double kGuard = double(int64_t{1} << (21 + kSubpixelBits));
+
+// 4x4 subsamples per marked pixel at offsets (k + 0.5) / 4: 32 + 64 k in fixed point.
+constexpr int kSubGrid = 4;
+constexpr int kSubsamples = kSubGrid * kSubGrid;
+constexpr int64_t kSubStep = kOne / kSubGrid;
+constexpr int64_t kSubOffset = kSubStep / 2;
+
+// Marks live in 8x8-pixel tiles; bands are a power of two of at least the tile height.
+constexpr int kTileBits = 3;
+constexpr int kTile = 1 << kTileBits;
+
+int32_t to_fixed(double v) {
+  v *= double(kOne);
+  v = v > -kGuard ? v : -kGuard;  // also maps NaN to the guard band
+  v = v < kGuard ? v : kGuard;
+  // Round half up: floor(v + 0.5), as a truncation of a non-negative value.
+  return static_cast<int32_t>(static_cast<int64_t>(v + (kGuard + 0.5)) - static_cast<int64_t>(kGuard));
+}
+
+// Floor division of a fixed-point value by one pixel (arithmetic shift floors negatives).
+int pixel_floor(int32_t v) { return v >> kSubpixelBits; }
+// First pixel index whose centre is >= v, and last whose centre is <= v.
+int first_centre(int32_t v) { return (v + int32_t{kHalf} - 1) >> kSubpixelBits; }
+int last_centre(int32_t v) { return (v - int32_t{kHalf}) >> kSubpixelBits; }
+
+// Edge k runs from corner k+1 to corner k+2 (opposite corner k). Its function
+//   E_k(P) = dx_k (P.y - y_{k+1}) - dy_k (P.x - x_{k+1})
+// equals cross(v_{k+2} - v_{k+1}, P - v_{k+1}): positive inside a triangle of positive signed area
+// (cross(b - a, c - a) > 0), and E_0 + E_1 + E_2 = twice the area, so E_k / area2 are the
+// barycentric weights. Fill rule: a sample with E_k == 0 belongs to the triangle iff
+// dy_k > 0, or dy_k == 0 and dx_k > 0. This is the sign of E_k at the sample nudged by (-e, e^2),
+// the same nudge for every triangle, so the two triangles sharing an edge (which run it in
+// opposite directions) split its samples exactly, and a vertex sample goes to exactly one
+// triangle of its fan. The rule is folded in as a bias of 0 or -1 on the integer E_k.
+struct TriangleSetup {
+  Fixed v0, v1, v2;
+  int64_t dx0, dy0, dx1, dy1, dx2, dy2;
+  int64_t b0, b1, b2;  // fill-rule biases
+  int64_t area2 = 0;
+  int32_t min_x = 0, max_x = 0, min_y = 0, max_y = 0;
+
+  static int32_t min3(int32_t a, int32_t b, int32_t c) { return std::min(std::min(a, b), c); }
+  static int32_t max3(int32_t a, int32_t b, int32_t c) { return std::max(std::max(a, b), c); }
+  // 0 when dy > 0 or (dy == 0 and dx > 0), else -1: the sign of the lexicographic key
+  // dy 2^32 + dx (|dx|, |dy| < 2^31), minus one, shifted down.
+  static int64_t bias(int64_t dx, int64_t dy) { return (dy * (int64_t{1} << 32) + dx - 1) >> 63; }
+
+  // Corners and bounding box.
+  void init(Fixed a, Fixed b, Fixed c) {
+    v0 = a, v1 = b, v2 = c;
+    min_x = min3(a.x, b.x, c.x), max_x = max3(a.x, b.x, c.x);
+    min_y = min3(a.y, b.y, c.y), max_y = max3(a.y, b.y, c.y);
+  }
+  // Edges and area; returns false for a degenerate or back-facing triangle (drawn by no one).
+  bool init_edges() {
+    dx0 = int64_t(v2.x) - v1.x, dy0 = int64_t(v2.y) - v1.y;
+    dx1 = int64_t(v0.x) - v2.x, dy1 = int64_t(v0.y) - v2.y;
+    dx2 = int64_t(v1.x) - v0.x, dy2 = int64_t(v1.y) - v0.y;
+    area2 = dx2 * (int64_t(v2.y) - v0.y) - dy2 * (int64_t(v2.x) - v0.x);
+    b0 = bias(dx0, dy0), b1 = bias(dx1, dy1), b2 = bias(dx2, dy2);
+    return area2 > 0;
+  }
+  // Biased edge functions at (x, y): the sample is inside iff all three are >= 0.
+  int64_t edge0(int64_t x, int64_t y) const { return dx0 * (y - v1.y) - dy0 * (x - v1.x) + b0; }
+  int64_t edge1(int64_t x, int64_t y) const { return dx1 * (y - v2.y) - dy1 * (x - v2.x) + b1; }
+  int64_t edge2(int64_t x, int64_t y) const { return dx2 * (y - v0.y) - dy2 * (x - v0.x) + b2; }
+};
+
+// ---- Coverage traversal ------------------------------------------------------------------------
+// Every path below decides coverage exactly by the fill rule above; they differ only in speed.
+// Visitors get the unbiased edge functions 1 and 2 as floats (enough for the barycentrics).
+
+#if defined(__SSE2__)
+// Triangles less than 8 pixels across are tested with SSE2 float lanes, 4 samples at a time. The
+// edge functions at samples within a few pixels of such a triangle are integers below 2^24 in
+// magnitude, which floats hold exactly, so the float tests are the integer tests.
+constexpr int32_t kSmall = 8 << kSubpixelBits;
+
+bool is_small(const TriangleSetup& t) { return (t.max_x - t.min_x < kSmall) & (t.max_y - t.min_y < kSmall); }
+
+// Tests `rows` rows of 4 samples starting at (x, y) (fixed point), sample pitch `step`; returns a
+// mask with bit 4 j + i set for covered sample (i, j) and fills e1, e2 (unbiased) for all lanes.
+[[gnu::always_inline]] inline unsigned test_rows(const TriangleSetup& t, int64_t x, int64_t y, int64_t step, int rows, float* e1s, float* e2s) {
+  const __m128 lane = _mm_setr_ps(0.f, 1.f, 2.f, 3.f), zero = _mm_setzero_ps();
+  __m128 e0 = _mm_add_ps(_mm_set1_ps(float(t.edge0(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy0 * step))));
+  __m128 e1 = _mm_add_ps(_mm_set1_ps(float(t.edge1(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy1 * step))));
+  __m128 e2 = _mm_add_ps(_mm_set1_ps(float(t.edge2(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy2 * step))));
+  const __m128 s0 = _mm_set1_ps(float(t.dx0 * step)), s1 = _mm_set1_ps(float(t.dx1 * step));
+  const __m128 s2 = _mm_set1_ps(float(t.dx2 * step));
+  const __m128 b1 = _mm_set1_ps(float(t.b1)), b2 = _mm_set1_ps(float(t.b2));
+  unsigned mask = 0;
+  for (int j = 0; j < rows; ++j) {
+    const __m128 outside = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
+    mask |= (~unsigned(_mm_movemask_ps(outside)) & 0xfu) << (4 * j);
+    _mm_store_ps(e1s + 4 * j, _mm_sub_ps(e1, b1));
+    _mm_store_ps(e2s + 4 * j, _mm_sub_ps(e2, b2));
+    e0 = _mm_add_ps(e0, s0);
+    e1 = _mm_add_ps(e1, s1);
+    e2 = _mm_add_ps(e2, s2);
+  }
+  return mask;
+}
+#endif
+
+// The pixel centres of rows [py0, py1] x columns [px0, px1] (a non-empty range inside the
+// triangle's bounding box) that the triangle owns: visit(px, py, e1, e2). Sets t.area2.
+template <class Visit>
+void for_each_centre(TriangleSetup& t, int px0, int px1, int py0, int py1, Visit&& visit) {
+  if ((px0 == px1) & (py0 == py1)) {
+    // A single candidate (most refined triangles): the biases only matter for a sample on an
+    // edge, so test without them first. A sample inside all three edges implies a positive area
+    // (the E_k sum to it), so back-facing and degenerate triangles fall out here too.
+    const int64_t x = int64_t(px0) * kOne + kHalf, y = int64_t(py0) * kOne + kHalf;
+    const Fixed a = t.v0, b = t.v1, c = t.v2;
+    const int64_t e0 = (int64_t(c.x) - b.x) * (y - b.y) - (int64_t(c.y) - b.y) * (x - b.x);
+    const int64_t e1 = (int64_t(a.x) - c.x) * (y - c.y) - (int64_t(a.y) - c.y) * (x - c.x);
+    const int64_t e2 = (int64_t(b.x) - a.x) * (y - a.y) - (int64_t(b.y) - a.y) * (x - a.x);
+    if ((e0 | e1 | e2) < 0) return;
+    if ((e0 == 0) | (e1 == 0) | (e2 == 0)) {
+      t.init_edges();
+      if (((e0 + t.b0) | (e1 + t.b1) | (e2 + t.b2)) < 0) return;
+    }
+    t.area2 = e0 + e1 + e2;
+    visit(px0, py0, float(e1), float(e2));
+    return;
+  }
+  if (!t.init_edges()) return;
+  const int64_t x = int64_t(px0) * kOne + kHalf, y = int64_t(py0) * kOne + kHalf;
+#if defined(__SSE2__)
+  if ((px1 - px0 < 4) & (py1 - py0 < 4) & is_small(t)) {
+    alignas(16) float e1s[16], e2s[16];
+    unsigned mask = test_rows(t, x, y, kOne, py1 - py0 + 1, e1s, e2s);
+    const unsigned columns = (1u << (px1 - px0 + 1)) - 1;
+    mask &= columns * 0x1111u;  // lanes beyond px1
+    while (mask) {
+      const int k = std::countr_zero(mask);
+      mask &= mask - 1;
+      visit(px0 + (k & 3), py0 + (k >> 2), e1s[k], e2s[k]);
+    }
+    return;
+  }
+#endif
+  // General case: int64 edge functions stepped across the box.
+  int64_t r0 = t.edge0(x, y), r1 = t.edge1(x, y), r2 = t.edge2(x, y);
+  const int64_t sx0 = -t.dy0 * kOne, sx1 = -t.dy1 * kOne, sx2 = -t.dy2 * kOne;
+  const int64_t sy0 = t.dx0 * kOne, sy1 = t.dx1 * kOne, sy2 = t.dx2 * kOne;
+  for (int py = py0; py <= py1; ++py) {
+    int64_t e0 = r0, e1 = r1, e2 = r2;
+    for (int px = px0; px <= px1; ++px) {
+      if ((e0 | e1 | e2) >= 0) visit(px, py, float(e1 - t.b1), float(e2 - t.b2));
+      e0 += sx0;
+      e1 += sx1;
+      e2 += sx2;
+    }
+    r0 += sy0;
+    r1 += sy1;
+    r2 += sy2;
+  }
+}
+
+// The 4x4 subsamples of pixel (px, py) that the triangle owns: visit(k, e1, e2), k = 4 row +
+// column. Needs t.init_edges() done (and true).
+template <class Visit>
+void for_each_subsample(const TriangleSetup& t, int px, int py, Visit&& visit) {
+  const int64_t x = int64_t(px) * kOne + kSubOffset, y = int64_t(py) * kOne + kSubOffset;
+#if defined(__SSE2__)
+  if (is_small(t)) {
+    alignas(16) float e1s[16], e2s[16];
+    unsigned mask = test_rows(t, x, y, kSubStep, kSubGrid, e1s, e2s);
+    while (mask) {
+      const int k = std::countr_zero(mask);
+      mask &= mask - 1;
+      visit(k, e1s[k], e2s[k]);
+    }
+    return;
+  }
+#endif
+  int64_t r0 = t.edge0(x, y), r1 = t.edge1(x, y), r2 = t.edge2(x, y);
+  for (int j = 0; j < kSubGrid; ++j) {
+    int64_t e0 = r0, e1 = r1, e2 = r2;
+    for (int i = 0; i < kSubGrid; ++i) {
+      if ((e0 | e1 | e2) >= 0) visit(j * kSubGrid + i, float(e1 - t.b1), float(e2 - t.b2));
+      e0 -= t.dy0 * kSubStep;
+      e1 -= t.dy1 * kSubStep;
+      e2 -= t.dy2 * kSubStep;
+    }
+    r0 += t.dx0 * kSubStep;
+    r1 += t.dx1 * kSubStep;
+    r2 += t.dx2 * kSubStep;
+  }
+}
+
+// ---- Shading -----------------------------------------------------------------------------------
+
+uint8_t to_u8(float v) {
+  v = v > 0.f ? v : 0.f;  // NaN -> 0
+  v = v < 255.f ? v : 255.f;
+  return static_cast<uint8_t>(static_cast<int>(v + 0.5f));
+}
+
+// Gouraud color of a sample from its edge functions: c0 + (w1 (c1 - c0) + w2 (c2 - c0)) with the
+// barycentric weights w_k = E_k / area2, rounded and clamped to 0..255 (NaN -> 0). Returns the
+// color packed as r | g << 8 | b << 16.
+struct Shader {
+#if defined(__SSE2__)
+  __m128 base = _mm_setzero_ps(), d1 = base, d2 = base;  // c0 + 0.5 (rounding), c1 - c0, c2 - c0
+  float inv_area = 0;
+
+  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
+    const __m128 a = _mm_setr_ps(c0[0], c0[1], c0[2], 0.f);
+    base = _mm_add_ps(a, _mm_set1_ps(0.5f));
+    d1 = _mm_sub_ps(_mm_setr_ps(c1[0], c1[1], c1[2], 0.f), a);
+    d2 = _mm_sub_ps(_mm_setr_ps(c2[0], c2[1], c2[2], 0.f), a);
+    inv_area = 1.f / float(area2);
+  }
+  uint32_t shade(float e1, float e2) const {
+    const __m128 w1 = _mm_set1_ps(e1 * inv_area), w2 = _mm_set1_ps(e2 * inv_area);
+    __m128 v = _mm_add_ps(base, _mm_add_ps(_mm_mul_ps(w1, d1), _mm_mul_ps(w2, d2)));
+    // max returns its second operand (0) for NaN; 255.25 truncates to 255.
+    v = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(255.25f));
+    __m128i i = _mm_cvttps_epi32(v);
+    i = _mm_packs_epi32(i, i);
+    i = _mm_packus_epi16(i, i);
+    return static_cast<uint32_t>(_mm_cvtsi128_si32(i)) & 0xffffffu;
+  }
+#else
+  float base[3] = {}, d1[3] = {}, d2[3] = {};
+  float inv_area = 0;
+
+  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
+    for (int c = 0; c < 3; ++c) {
+      base[c] = c0[c] + 0.5f;
+      d1[c] = c1[c] - c0[c];
+      d2[c] = c2[c] - c0[c];
+    }
+    inv_area = 1.f / float(area2);
+  }
+  uint32_t shade(float e1, float e2) const {
+    const float w1 = e1 * inv_area, w2 = e2 * inv_area;
+    uint32_t rgb = 0;
+    for (int c = 0; c < 3; ++c) {
+      float v = base[c] + (w1 * d1[c] + w2 * d2[c]);
+      v = v > 0.f ? v : 0.f;
+      v = v < 255.25f ? v : 255.25f;
+      rgb |= static_cast<uint32_t>(v) << (8 * c);
+    }
+    return rgb;
+  }
+#endif
+};
+
+// Sets up `shader` for triangle ti (at its first covered sample: many tiny triangles cover none).
+void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, int64_t area2) {
+  const Tri& tc = mesh.triangle_colors[ti];
+  const float* colors = mesh.colors.data();
+  shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3, area2);
+}
+
+// ---- Pixels marked for supersampling ----------------------------------------------------------
+
+// Marked pixels in 8x8 tiles: a tile holds a 64-bit mask of its marked pixels and, per pixel, the
+// slot of its 16 subsamples (RGBA8 words, alpha 255 once written).
+class MarkTiles {
+ public:
+  MarkTiles(int width, int height)
+      : width_(width),
+        height_(height),
+        tiles_x_((width + kTile - 1) / kTile),
+        tile_(size_t(tiles_x_) * ((height + kTile - 1) / kTile), -1) {}
+
+  bool empty() const { return masks_.empty(); }
+
+  void mark(int x, int y) {
+    int32_t& t = tile_[size_t(y >> kTileBits) * tiles_x_ + (x >> kTileBits)];
+    if (t < 0) {
+      t = static_cast<int32_t>(masks_.size());
+      masks_.push_back(0);
+    }
+    masks_[t] |= uint64_t{1} << bit(x, y);
+  }
+
+  // Marks every pixel that the segment a-b touches (conservatively, a little more).
+  void mark_segment(Fixed a, Fixed b) {
+    if (a.y > b.y) std::swap(a, b);
+    const int r0 = std::max(pixel_floor(a.y), 0), r1 = std::min(pixel_floor(b.y), height_ - 1);
+    if (std::max(a.x, b.x) < 0 || pixel_floor(std::min(a.x, b.x)) >= width_) return;
+    const double dy = double(b.y) - a.y;
+    for (int r = r0; r <= r1; ++r) {
+      // The part of the segment inside row r, widened by one subpixel unit for rounding.
+      const double ya = std::max<double>(a.y, double(r) * kOne);
+      const double yb = std::min<double>(b.y, double(r + 1) * kOne);
+      double xa = a.x, xb = b.x;
+      if (dy > 0) {
+        xa = a.x + (double(b.x) - a.x) * (ya - a.y) / dy;
+        xb = a.x + (double(b.x) - a.x) * (yb - a.y) / dy;
+      }
+      const int c0 = std::max(static_cast<int>(std::floor((std::min(xa, xb) - 1) / kOne)), 0);
+      const int c1 = std::min(static_cast<int>(std::floor((std::max(xa, xb) + 1) / kOne)), width_ - 1);
+      for (int c = c0; c <= c1; ++c) mark(c, r);
+    }
+  }
+
+  // Numbers the marked pixels and allocates their subsamples once marking is complete.
+  void finish_marking() {
+    slots_.assign(masks_.size() * kTile * kTile, -1);
+    int32_t total = 0;
+    for (size_t t = 0; t < masks_.size(); ++t) {
+      for (int b = 0; b < kTile * kTile; ++b) {
+        if ((masks_[t] >> b) & 1) slots_[t * kTile * kTile + b] = total++;
+      }
+    }
+    samples_.assign(size_t(total) * kSubsamples, 0);
+  }
+
+  // Whether any pixel in [x0, x1] x [y0, y1] (clipped to the output) may be marked: a tile test.
+  bool any_tile(int x0, int x1, int y0, int y1) const {
+    x0 = std::max(x0, 0) >> kTileBits;
+    x1 = std::min(x1, width_ - 1) >> kTileBits;
+    y0 = std::max(y0, 0) >> kTileBits;
+    y1 = std::min(y1, height_ - 1) >> kTileBits;
+    if (x0 > x1 || y0 > y1) return false;
+    if (x1 - x0 <= 1 && y1 - y0 <= 1) {  // small boxes: the (at most) four tiles at the corners
+      const int32_t* r0 = tile_.data() + size_t(y0) * tiles_x_;
+      const int32_t* r1 = tile_.data() + size_t(y1) * tiles_x_;
+      return (r0[x0] & r0[x1] & r1[x0] & r1[x1]) >= 0;  // unmarked tiles hold -1
+    }
+    for (int ty = y0; ty <= y1; ++ty) {
+      for (int tx = x0; tx <= x1; ++tx) {
+        if (tile_[size_t(ty) * tiles_x_ + tx] >= 0) return true;
+      }
+    }
+    return false;
+  }
+
+  // Calls visit(x, y, samples) for each marked pixel in [x0, x1] x [y0, y1] (clipped), walking
+  // the set bits of the tile masks.
+  template <class Visit>
+  void for_each_marked(int x0, int x1, int y0, int y1, Visit&& visit) {
+    x0 = std::max(x0, 0), x1 = std::min(x1, width_ - 1), y0 = std::max(y0, 0), y1 = std::min(y1, height_ - 1);
+    for (int ty = y0 >> kTileBits; ty <= y1 >> kTileBits; ++ty) {
+      // Rows of this tile inside [y0, y1], as a byte selector.
+      const int ly0 = std::max(y0 - (ty << kTileBits), 0), ly1 = std::min(y1 - (ty << kTileBits), kTile - 1);
+      const uint64_t rows = (~uint64_t{0} >> (8 * (kTile - 1 - ly1))) & (~uint64_t{0} << (8 * ly0));
+      for (int tx = x0 >> kTileBits; tx <= x1 >> kTileBits; ++tx) {
+        const int32_t t = tile_[size_t(ty) * tiles_x_ + tx];
+        if (t < 0) continue;
+        const int lx0 = std::max(x0 - (tx << kTileBits), 0), lx1 = std::min(x1 - (tx << kTileBits), kTile - 1);
+        const uint64_t columns = ((uint64_t{2} << lx1) - (uint64_t{1} << lx0)) * 0x0101010101010101ull;
+        uint64_t mask = masks_[t] & rows & columns;
+        while (mask) {
+          const int b = std::countr_zero(mask);
+          mask &= mask - 1;
+          visit((tx << kTileBits) + (b & (kTile - 1)), (ty << kTileBits) + (b >> kTileBits),
+                samples_.data() + size_t(slots_[size_t(t) * kTile * kTile + b]) * kSubsamples);
+        }
+      }
+    }
+  }
+
+  // Replaces each marked pixel of rows [y0, y1) by the mean of its written subsamples; alpha is
+  // the covered fraction.
+  void resolve(Image8& out, int y0, int y1) {
+    for_each_marked(0, width_ - 1, y0, y1 - 1, [&](int x, int y, const uint32_t* s) {
+      uint32_t sum[3] = {0, 0, 0}, count = 0;
+      for (int i = 0; i < kSubsamples; ++i) {
+        if ((s[i] >> 24) == 0) continue;
+        sum[0] += s[i] & 0xff;
+        sum[1] += (s[i] >> 8) & 0xff;
+        sum[2] += (s[i] >> 16) & 0xff;
+        ++count;
+      }
+      uint8_t* p = out.row(y) + size_t(x) * out.channels;
+      if (count == 0) {
+        if (out.channels == 4) std::memset(p, 0, 4);
+        return;
+      }
+      for (int c = 0; c < 3; ++c) p[c] = static_cast<uint8_t>((sum[c] + count / 2) / count);
+      if (out.channels == 4) p[3] = static_cast<uint8_t>((count * 255 + kSubsamples / 2) / kSubsamples);
+    });
+  }
+
+ private:
+  static int bit(int x, int y) { return ((y & (kTile - 1)) << kTileBits) | (x & (kTile - 1)); }
+
+  int width_, height_, tiles_x_;
+  std::vector<int32_t> tile_;      // per tile: index into masks_, or -1
+  std::vector<uint64_t> masks_;    // per marked tile
+  std::vector<int32_t> slots_;     // per marked tile, 64 pixels: slot in samples_, or -1
+  std::vector<uint32_t> samples_;  // 16 RGBA8 words per marked pixel
+};
+
+// ---- The passes of a band ----------------------------------------------------------------------
+
+struct Frame {
+  const RefinedMesh* mesh;
+  const Fixed* fixed;  // #N output positions
+  int width, height;
+  MarkTiles* marks;  // nullptr without marked pixels
+};
+
+// Pass 1: the pixel-centre samples of the band's blocks, rows [band_y0, band_y1). The triangles
+// whose bounding box meets a marked tile are collected for pass 2 into `near` (when not null).
+template <int kChannels>
+void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* unit_data, Image8& out,
+                  int band_y0, int band_y1, std::vector<int32_t>* near) {
+  const RefinedMesh& mesh = *f.mesh;
+  const Tri* tris = mesh.triangles.data();
+  const int last_x = f.width - 1, last_y = band_y1 - 1;
+  uint8_t* const pixels = out.pixels.data();
+  const size_t stride = size_t(out.width) * kChannels;
+  TriangleSetup t;
+  Shader shader;
+  for (const int32_t u : units) {
+    const Unit& unit = unit_data[u];
+    const bool near_unit = near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0), std::min(unit.y1, last_y));
+    for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
+      const Tri& tri = tris[ti];
+      t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+      if (near_unit && f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x), std::max(pixel_floor(t.min_y), band_y0),
+                                         std::min(pixel_floor(t.max_y), last_y))) {
+        near->push_back(ti);
+      }
+      const int px0 = std::max(first_centre(t.min_x), 0), px1 = std::min(last_centre(t.max_x), last_x);
+      const int py0 = std::max(first_centre(t.min_y), band_y0), py1 = std::min(last_centre(t.max_y), last_y);
+      if ((px0 > px1) | (py0 > py1)) continue;
+      bool shaded = false;
+      for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
+        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
+        const uint32_t rgb = shader.shade(e1, e2);
+        uint8_t* p = pixels + size_t(py) * stride + size_t(px) * kChannels;
+        p[0] = static_cast<uint8_t>(rgb);
+        p[1] = static_cast<uint8_t>(rgb >> 8);
+        p[2] = static_cast<uint8_t>(rgb >> 16);
+        if constexpr (kChannels == 4) p[3] = 255;
+      });
+    }
+  }
+}
+
+// Pass 2: the subsamples of the marked pixels in rows [band_y0, band_y1) that the given
+// triangles own.
+void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int band_y0, int band_y1) {
+  const RefinedMesh& mesh = *f.mesh;
+  MarkTiles& marks = *f.marks;
+  const int last_x = f.width - 1, last_y = band_y1 - 1;
+  TriangleSetup t;
+  Shader shader;
+  for (const int32_t ti : triangles) {
+    const Tri& tri = mesh.triangles[ti];
+    t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+    const int ax0 = std::max(pixel_floor(t.min_x), 0), ax1 = std::min(pixel_floor(t.max_x), last_x);
+    const int ay0 = std::max(pixel_floor(t.min_y), band_y0), ay1 = std::min(pixel_floor(t.max_y), last_y);
+    if (!t.init_edges()) continue;
+    bool shaded = false;
+    marks.for_each_marked(ax0, ax1, ay0, ay1, [&](int px, int py, uint32_t* samples) {
+      for_each_subsample(t, px, py, [&](int k, float e1, float e2) {
+        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
+        samples[k] = shader.shade(e1, e2) | 0xff000000u;
+      });
+    });
+  }
+}
+
+// ---- Overlays ----------------------------------------------------------------------------------
+
+// Anti-aliased overlay primitives: coverage of a pixel centre at distance d from a primitive of
+// half width w is clamp(w + 0.5 - d, 0, 1), a box-filtered edge. Rows [y0, y1) only.
+void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer> layers,
+                       std::vector<float>& coverage) {
+  const int w = out.width;
+  coverage.assign(size_t(y1 - y0) * w, 0.f);
+  auto pixel = [](float v, int lo, int hi) {  // floor, clamped (also for huge or NaN values)
+    const float f = std::floor(v);
+    return f > float(lo) ? (f < float(hi) ? static_cast<int>(f) : hi) : lo;
+  };
+  for (const OverlayLayer& layer : layers) {
+    int bx0 = w, bx1 = -1, by0 = y1, by1 = y0 - 1;  // touched region
+    auto splat = [&](float minx, float maxx, float miny, float maxy, auto&& cov) {
+      const int px0 = pixel(minx, 0, w), px1 = pixel(maxx, -1, w - 1);
+      const int py0 = pixel(miny, y0, y1), py1 = pixel(maxy, y0 - 1, y1 - 1);
+      if (px0 > px1 || py0 > py1) return;
+      bx0 = std::min(bx0, px0), bx1 = std::max(bx1, px1), by0 = std::min(by0, py0), by1 = std::max(by1, py1);
+      for (int py = py0; py <= py1; ++py) {
+        float* row = coverage.data() + size_t(py - y0) * w;
+        for (int px = px0; px <= px1; ++px) row[px] = std::max(row[px], cov(float(px) + 0.5f, float(py) + 0.5f));
+      }
+    };
+    const float reach = layer.half_width + 1.f;
+    for (const auto& s : layer.segments) {
+      const float ax = s[0], ay = s[1], dx = s[2] - s[0], dy = s[3] - s[1];
+      const float len2 = dx * dx + dy * dy;
+      splat(std::min(s[0], s[2]) - reach, std::max(s[0], s[2]) + reach, std::min(s[1], s[3]) - reach,
+            std::max(s[1], s[3]) + reach, [&](float x, float y) {
+              float u = len2 > 0 ? ((x - ax) * dx + (y - ay) * dy) / len2 : 0.f;
+              u = std::clamp(u, 0.f, 1.f);
+              const float ex = x - (ax + u * dx), ey = y - (ay + u * dy);
+              return std::clamp(layer.half_width + 0.5f - std::sqrt(ex * ex + ey * ey), 0.f, 1.f);
+            });
+    }
+    for (const auto& d : layer.dots) {
+      const float r = d[2] + 1.f;
+      splat(d[0] - r, d[0] + r, d[1] - r, d[1] + r, [&](float x, float y) {
+        const float ex = x - d[0], ey = y - d[1];
+        return std::clamp(d[2] + 0.5f - std::sqrt(ex * ex + ey * ey), 0.f, 1.f);
+      });
+    }
+    // Source-over compositing with straight alpha.
+    for (int py = by0; py <= by1; ++py) {
+      float* row = coverage.data() + size_t(py - y0) * w;
+      uint8_t* dst = out.row(py);
+      for (int px = bx0; px <= bx1; ++px) {
+        const float a = row[px] * layer.opacity;
+        row[px] = 0.f;
+        if (a <= 0.f) continue;
+        uint8_t* p = dst + size_t(px) * out.channels;
+        const float da = out.channels == 4 ? p[3] / 255.f : 1.f;
+        const float oa = a + da * (1.f - a);
+        for (int c = 0; c < 3; ++c) p[c] = to_u8((layer.color[c] * a + p[c] * da * (1.f - a)) / oa);
+        if (out.channels == 4) p[3] = to_u8(oa * 255.f);
+      }
+    }
+  }
+}
+
+// ---- Frame setup -------------------------------------------------------------------------------
+
+void snap_vertices(const RefinedMesh& mesh, const ViewTransform& view, int threads, std::vector<Fixed>& fixed) {
+  const int n = mesh.num_vertices();
+  fixed.resize(n);
+  constexpr int kChunk = 1 << 16;
+  parallel_for((n + kChunk - 1) / kChunk, threads, [&](int chunk) {
+    const int end = std::min(n, (chunk + 1) * kChunk);
+    for (int i = chunk * kChunk; i < end; ++i) {
+      const auto o = view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
+      fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
+    }
+  });
+}
+
+// Band height: a power of two, at least the tile height, several bands per thread for load balance.
+int band_shift(int height, int threads) {
+  const int target = height / std::max(1, 4 * threads);
+  int shift = kTileBits;
+  while (shift < 6 && (2 << shift) <= target) ++shift;
+  return shift;
+}
+
+// Bounds unit u for the frame: the pixel columns and rows of its bounding box.
+void bound_unit(const RefinedMesh& mesh, const Frame& f, const ViewTransform& view,
+                std::span<const TriangleBlock> blocks, int u, Unit& unit) {
+  constexpr int kBlock = 64;
+  int x0, x1, y0, y1;
+  if (!blocks.empty()) {
+    const TriangleBlock& b = blocks[u];
+    unit.begin = b.begin;
+    unit.end = b.end;
+    // Snapping moves a vertex by at most half a subpixel unit: widen the box by one unit.
+    constexpr double kMargin = 1.0 / kOne;
+    const auto lo = view.to_output(b.x0, b.y0), hi = view.to_output(b.x1, b.y1);
+    auto floor_px = [](double v) { return static_cast<int>(std::floor(std::clamp(v, -1e9, 1e9))); };
+    x0 = floor_px(lo[0] - kMargin), x1 = floor_px(hi[0] + kMargin);
+    y0 = floor_px(lo[1] - kMargin), y1 = floor_px(hi[1] + kMargin);
+  } else {
+    unit.begin = u * kBlock;
+    unit.end = std::min(mesh.num_triangles(), unit.begin + kBlock);
+    int32_t bx0 = INT32_MAX, bx1 = INT32_MIN, by0 = INT32_MAX, by1 = INT32_MIN;
+    for (int32_t i = unit.begin; i < unit.end; ++i) {
+      const Tri& tri = mesh.triangles[i];
+      const Fixed a = f.fixed[tri[0]], b = f.fixed[tri[1]], c = f.fixed[tri[2]];
+      bx0 = std::min(bx0, TriangleSetup::min3(a.x, b.x, c.x));
+      bx1 = std::max(bx1, TriangleSetup::max3(a.x, b.x, c.x));
+      by0 = std::min(by0, TriangleSetup::min3(a.y, b.y, c.y));
+      by1 = std::max(by1, TriangleSetup::max3(a.y, b.y, c.y));
+    }
+    x0 = pixel_floor(bx0), x1 = pixel_floor(bx1), y0 = pixel_floor(by0), y1 = pixel_floor(by1);
+  }
+  unit.x0 = x0, unit.x1 = x1;
+  unit.y0 = std::max(y0, 0);
+  unit.y1 = std::min(y1, f.height - 1);
+  if (x1 < 0 || x0 >= f.width || unit.begin >= unit.end) unit.y1 = unit.y0 - 1;  // culled
+}
+
+}  // namespace
+
+Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
+                 std::span<const OverlayLayer> overlay, RasterScratch* scratch) {
+  const int width = view.width, height = view.height, threads = std::max(options.threads, 1);
+  Image8 out(width, height, options.channels);
+  RasterScratch local;
+  RasterScratch& work = scratch ? *scratch : local;
+  Frame f{&mesh, nullptr, width, height, nullptr};
+
+  // Snap the vertices and bound the blocks of triangles. Blocks come from the caller with
+  // image-space boxes (then both run as one parallel loop), or are cut here, 64 triangles each,
+  // and bounded from the snapped vertices afterwards.
+  const int num_vertices = mesh.num_vertices();
+  work.fixed.resize(num_vertices);
+  f.fixed = work.fixed.data();
+  const bool given = !options.blocks.empty();
+  const int num_units = given ? static_cast<int>(options.blocks.size()) : (mesh.num_triangles() + 63) / 64;
+  work.units.resize(num_units);
+  constexpr int kVerticesPerJob = 1 << 16, kUnitsPerJob = 1024;
+  const int vertex_jobs = (num_vertices + kVerticesPerJob - 1) / kVerticesPerJob;
+  const int unit_jobs = (num_units + kUnitsPerJob - 1) / kUnitsPerJob;
+  auto bound_units = [&](int job) {
+    const int end = std::min(num_units, (job + 1) * kUnitsPerJob);
+    for (int u = job * kUnitsPerJob; u < end; ++u) bound_unit(mesh, f, view, options.blocks, u, work.units[u]);
+  };
+  parallel_for(vertex_jobs + (given ? unit_jobs : 0), threads, [&](int job) {
+    if (job >= vertex_jobs) return bound_units(job - vertex_jobs);
+    const int end = std::min(num_vertices, (job + 1) * kVerticesPerJob);
+    for (int i = job * kVerticesPerJob; i < end; ++i) {
+      const auto o = view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
+      work.fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
+    }
+  });
+  if (!given) parallel_for(unit_jobs, threads, bound_units);
+
+  // Mark the pixels crossed by discontinuities (serial: cheap, and keeps the tile order fixed).
+  MarkTiles marks(width, height);
+  if (options.antialias) {
+    for (const EdgeVerts& e : mesh.tear_edges) marks.mark_segment(f.fixed[e[0]], f.fixed[e[1]]);
+    if (options.antialias_border) {
+      for (const EdgeVerts& e : mesh.border_edges) marks.mark_segment(f.fixed[e[0]], f.fixed[e[1]]);
+    }
+    marks.finish_marking();
+    if (!marks.empty()) f.marks = &marks;
+  }
+
+  // Bin the blocks by band: a block goes to every band that its bounding box's pixel rows meet
+  // (the band pass culls each triangle further). Serial and in block order, so each band's list
+  // is in triangle order whatever the thread count.
+  const int shift = band_shift(height, threads), band_h = 1 << shift;
+  const int num_bands = (height + band_h - 1) / band_h;
+  work.band_begin.assign(num_bands + 2, 0);
+  int64_t* begin = work.band_begin.data() + 1;  // count into begin[band + 1], then prefix
+  for (const Unit& unit : work.units) {
+    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band) ++begin[band + 1];
+  }
+  for (int band = 0; band < num_bands; ++band) begin[band + 1] += begin[band];
+  work.binned.resize(begin[num_bands]);
+  for (int u = 0; u < num_units; ++u) {
+    const Unit& unit = work.units[u];
+    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band) {
+      work.binned[begin[band]++] = u;
+    }
+  }
+  // begin[band] now ends band `band`, i.e. band_begin[band + 1]: the lists start at band_begin.
+
+  // Each band: centres, then subsamples and their resolve, then overlays; one writer per pixel.
+  parallel_for(num_bands, threads, [&](int band) {
+    const int y0 = band * band_h, y1 = std::min(height, y0 + band_h);
+    const std::span<const int32_t> list(work.binned.data() + work.band_begin[band],
+                                        work.binned.data() + work.band_begin[band + 1]);
+    thread_local std::vector<int32_t> near_list;
+    near_list.clear();
+    std::vector<int32_t>* near = f.marks && marks.any_tile(0, width - 1, y0, y1 - 1) ? &near_list : nullptr;
+    if (options.channels == 4) {
+      draw_centres<4>(f, list, work.units.data(), out, y0, y1, near);
+    } else {
+      draw_centres<3>(f, list, work.units.data(), out, y0, y1, near);
+    }
+    if (near) {
+      draw_subsamples(f, near_list, y0, y1);
+      marks.resolve(out, y0, y1);
+    }
+    if (!overlay.empty()) {
+      thread_local std::vector<float> coverage;
+      draw_overlay_band(out, y0, y1, overlay, coverage);
+    }
+  });
+  return out;
+}
+
+std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransform& view,
+                                     bool subsamples) {
+  const int width = view.width, height = view.height;
+  std::vector<Fixed> fixed;
+  snap_vertices(mesh, view, 1, fixed);
+  std::vector<int32_t> counts(size_t(width) * height * (subsamples ? kSubsamples : 1), 0);
+  TriangleSetup t;
+  for (const Tri& tri : mesh.triangles) {
+    t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
+    if (!subsamples) {
+      const int px0 = std::max(first_centre(t.min_x), 0), px1 = std::min(last_centre(t.max_x), width - 1);
+      const int py0 = std::max(first_centre(t.min_y), 0), py1 = std::min(last_centre(t.max_y), height - 1);
+      if (px0 > px1 || py0 > py1) continue;
+      for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
+      continue;
+    }
+    if (!t.init_edges()) continue;
+    const int ax0 = std::max(pixel_floor(t.min_x), 0), ax1 = std::min(pixel_floor(t.max_x), width - 1);
+    const int ay0 = std::max(pixel_floor(t.min_y), 0), ay1 = std::min(pixel_floor(t.max_y), height - 1);
+    for (int py = ay0; py <= ay1; ++py) {
+      for (int px = ax0; px <= ax1; ++px) {
+        for_each_subsample(t, px, py, [&](int k, float, float) { ++counts[(size_t(py) * width + px) * kSubsamples + k]; });
+      }
+    }
+  }
+  return counts;
+}
+
+}  // namespace subvec::detail

@@ -1,0 +1,391 @@
+// The renderer (paper §7.1 on the CPU): plans a view, keeps the refinement of the last view, and
+// hands the limit mesh to the rasterizer (raster.cpp).
+//
+// Depth rule. The paper refines uniformly until the refined triangles outnumber the pixels of the
+// window. We state the same idea per edge, in output pixels: refine until the mean refined edge of
+// the visible faces is at most `max_edge_pixels` (2.5 by default). Each level halves edges, so with
+// L the mean control edge length of the visible faces in output pixels the depth is the smallest k
+// with L / 2^k <= max_edge_pixels. Edge length is what bounds the error of drawing the limit
+// surface as flat triangles (a chord of length h deviates from a curve of bounded curvature by
+// O(h^2), and colors are interpolated linearly over the same chords), and since it is measured in
+// output pixels, a window zoomed by 2^z refines z more levels but only over the faces it sees: its
+// cost is that of a full view of the same output size.
+//
+// Visible faces. The limit patch of a control face lies in the convex hull of the control vertices
+// of the faces sharing a vertex with it (Loop masks, crease and corner rules are all convex
+// combinations over that ring), so a face is refined when the bounding box of that ring meets the
+// window. Subdivision refines the selected faces plus the ring they need and returns only their
+// children.
+#include "subvec/render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "render/parallel_p.h"
+#include "render/raster_p.h"
+#include "render/renderer_p.h"
+#include "subvec/core/error.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/subdiv/subdivision.h"
+
+namespace subvec {
+namespace detail {
+
+std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh, const MeshTopology& topology) {
+  // Bounding box of each vertex's star (the vertices of its incident faces), then per face the
+  // union over its three corners.
+  const int nv = mesh.num_vertices();
+  std::vector<std::array<double, 4>> star(nv);
+  for (int v = 0; v < nv; ++v) {
+    std::array<double, 4> b{mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].x,
+                            mesh.positions[v].y};
+    auto [begin, end] = topology.faces_of(v);
+    for (const int32_t* f = begin; f != end; ++f) {
+      for (const int32_t u : mesh.triangles[*f]) {
+        const Vec2& p = mesh.positions[u];
+        b = {std::min(b[0], p.x), std::min(b[1], p.y), std::max(b[2], p.x), std::max(b[3], p.y)};
+      }
+    }
+    star[v] = b;
+  }
+  std::vector<std::array<double, 4>> boxes(mesh.num_triangles());
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const Tri& t = mesh.triangles[f];
+    const auto &a = star[t[0]], &b = star[t[1]], &c = star[t[2]];
+    boxes[f] = {std::min({a[0], b[0], c[0]}), std::min({a[1], b[1], c[1]}),
+                std::max({a[2], b[2], c[2]}), std::max({a[3], b[3], c[3]})};
+  }
+  return boxes;
+}
+
+int choose_depth(double mean_edge_pixels, double max_edge_pixels, int64_t num_faces) {
+  int k = 0;
+  while (k < kMaxAutoDepth && mean_edge_pixels / std::ldexp(1.0, k) > max_edge_pixels) ++k;
+  while (k > 0 && num_faces * (int64_t{1} << (2 * k)) > kMaxAutoTriangles) --k;
+  return k;
+}
+
+namespace {
+
+[[noreturn]] void invalid(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// Output size for a window of ww x wh image pixels.
+std::array<int, 2> output_size(const RenderOptions& options, double ww, double wh) {
+  if (options.width < 0 || options.height < 0) {
+    invalid("output size " + std::to_string(options.width) + " x " + std::to_string(options.height) +
+            " is negative");
+  }
+  double w = options.width, h = options.height;
+  if (w == 0 && h == 0) {
+    w = ww;
+    h = wh;
+  } else if (h == 0) {
+    h = w * wh / ww;
+  } else if (w == 0) {
+    w = h * ww / wh;
+  }
+  w = std::max(1.0, std::round(w));
+  h = std::max(1.0, std::round(h));
+  if (w > Limits::kMaxDimension || h > Limits::kMaxDimension || w * h > double(Limits::kMaxPixels)) {
+    throw Error(ErrorCode::kLimit, "output size " + num(w) + " x " + num(h) + " is over the limit of " +
+                                       std::to_string(Limits::kMaxDimension) + " per side and " +
+                                       std::to_string(Limits::kMaxPixels) + " pixels");
+  }
+  return {static_cast<int>(w), static_cast<int>(h)};
+}
+
+}  // namespace
+
+ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
+                   std::span<const std::array<double, 4>> boxes, const RenderOptions& options) {
+  ViewPlan p;
+  const Window w = options.window.value_or(Window{0, 0, double(image.width), double(image.height)});
+  if (!std::isfinite(w.x0) || !std::isfinite(w.y0) || !std::isfinite(w.x1) || !std::isfinite(w.y1) ||
+      !(w.x0 < w.x1) || !(w.y0 < w.y1)) {
+    invalid("window " + num(w.x0) + "," + num(w.y0) + "," + num(w.x1) + "," + num(w.y1) +
+            " is empty or not finite (want x0 < x1, y0 < y1)");
+  }
+  if (!(options.max_edge_pixels > 0) || !std::isfinite(options.max_edge_pixels)) {
+    invalid("max_edge_pixels " + num(options.max_edge_pixels) + " is not a positive number");
+  }
+  if (options.depth > 10) invalid("depth " + std::to_string(options.depth) + " is over 10");
+  const double ww = w.x1 - w.x0, wh = w.y1 - w.y0;
+  const auto [width, height] = output_size(options, ww, wh);
+  p.window = w;
+  p.view = {w.x0, w.y0, width / ww, height / wh, width, height};
+  constexpr double kMaxZoom = 65536;
+  if (p.view.sx > kMaxZoom || p.view.sy > kMaxZoom) {
+    invalid("window " + num(ww) + " x " + num(wh) + " is too small for a " + std::to_string(width) +
+            " x " + std::to_string(height) + " output (zoom over 65536x)");
+  }
+  p.channels = (w.x0 < 0 || w.y0 < 0 || w.x1 > image.width || w.y1 > image.height) ? 4 : 3;
+
+  // Visible faces and their mean edge length in output pixels.
+  double edge_sum = 0;
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const auto& b = boxes[f];
+    if (b[2] < w.x0 || b[0] > w.x1 || b[3] < w.y0 || b[1] > w.y1) continue;
+    p.faces.push_back(f);
+    const Tri& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      const Vec2& a = mesh.positions[t[k]];
+      const Vec2& c = mesh.positions[t[(k + 1) % 3]];
+      edge_sum += std::hypot((c.x - a.x) * p.view.sx, (c.y - a.y) * p.view.sy);
+    }
+  }
+  p.all_faces = static_cast<int>(p.faces.size()) == mesh.num_triangles();
+  const auto count = static_cast<int64_t>(p.faces.size());
+  p.mean_edge_pixels = count ? edge_sum / double(3 * count) : 0;
+  if (options.depth >= 0) {
+    p.depth = options.depth;
+    if (count * (int64_t{1} << (2 * p.depth)) > int64_t{1} << 26) {
+      throw Error(ErrorCode::kLimit, "depth " + std::to_string(p.depth) + " over " +
+                                         std::to_string(count) + " faces would refine more than 2^26 triangles");
+    }
+  } else {
+    p.depth = choose_depth(p.mean_edge_pixels, options.max_edge_pixels, count);
+  }
+  return p;
+}
+
+// Overlay of the control mesh: the control polygon as ~1 px white lines, tears and creases in
+// their own colors, control vertices as dots, all over a dark halo.
+std::vector<OverlayLayer> mesh_overlay(const ControlMesh& mesh, const MeshTopology& topology,
+                                       const ViewTransform& view) {
+  OverlayLayer halo{{0, 0, 0}, 0.55f, 1.5f, {}, {}};
+  OverlayLayer lines{{255, 255, 255}, 0.9f, 0.5f, {}, {}};
+  OverlayLayer tears{{255, 64, 32}, 1.f, 0.65f, {}, {}};
+  OverlayLayer creases{{255, 210, 0}, 1.f, 0.65f, {}, {}};
+  OverlayLayer dots{{255, 255, 255}, 1.f, 0.f, {}, {}};
+  auto out = [&](int v) {
+    const auto o = view.to_output(mesh.positions[v].x, mesh.positions[v].y);
+    return std::array<float, 2>{float(o[0]), float(o[1])};
+  };
+  auto visible = [&](float x0, float y0, float x1, float y1, float margin) {
+    return std::max(x0, x1) >= -margin && std::min(x0, x1) <= float(view.width) + margin &&
+           std::max(y0, y1) >= -margin && std::min(y0, y1) <= float(view.height) + margin;
+  };
+  for (int e = 0; e < topology.num_edges(); ++e) {
+    const auto a = out(topology.edges[e][0]), b = out(topology.edges[e][1]);
+    if (!visible(a[0], a[1], b[0], b[1], 4)) continue;
+    const std::array<float, 4> s{a[0], a[1], b[0], b[1]};
+    halo.segments.push_back(s);
+    const EdgeTag tag = topology.edge_tags[e];
+    (tag == EdgeTag::kTear ? tears : tag == EdgeTag::kCrease ? creases : lines).segments.push_back(s);
+  }
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    const auto a = out(v);
+    if (!visible(a[0], a[1], a[0], a[1], 4)) continue;
+    halo.dots.push_back({a[0], a[1], 2.2f});
+    dots.dots.push_back({a[0], a[1], 1.2f});
+  }
+  return {halo, lines, tears, creases, dots};
+}
+
+// Overlay of the refined limit feature curves: ~1.5 px vivid magenta over a dark halo.
+std::vector<OverlayLayer> feature_overlay(const RefinedMesh& refined, const ViewTransform& view) {
+  OverlayLayer halo{{0, 0, 0}, 0.5f, 1.75f, {}, {}};
+  OverlayLayer curves{{255, 0, 255}, 1.f, 0.75f, {}, {}};
+  for (const EdgeVerts& e : refined.tear_edges) {
+    const auto a = view.to_output(refined.positions[2 * size_t(e[0])], refined.positions[2 * size_t(e[0]) + 1]);
+    const auto b = view.to_output(refined.positions[2 * size_t(e[1])], refined.positions[2 * size_t(e[1]) + 1]);
+    const std::array<float, 4> s{float(a[0]), float(a[1]), float(b[0]), float(b[1])};
+    halo.segments.push_back(s);
+    curves.segments.push_back(s);
+  }
+  return {halo, curves};
+}
+
+}  // namespace detail
+
+namespace {
+
+// Everything derived from one level that survives between frames.
+struct LevelState {
+  std::optional<MeshTopology> topology;  // from validate_level: the level is valid
+  std::vector<std::array<double, 4>> boxes;  // ring boxes; empty when positions changed
+};
+
+// The refinement of the last view and its limit values.
+// The refinement of the last view and its limit values. A later view reuses it when it needs the
+// same level and depth and a subset of its faces (a pan or zoom within the refined region); the
+// rasterizer skips the blocks of refined triangles that the view does not meet.
+struct RefineCache {
+  int level = -1, depth = -1;
+  std::vector<int32_t> faces;  // ascending; empty: all faces
+  std::optional<Subdivision> subdivision;
+  RefinedMesh refined;
+  std::vector<detail::TriangleBlock> blocks;  // up to 64 triangles of one control face each
+  bool positions_stale = false, colors_stale = false;
+};
+
+// Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
+// bounds each block's vertices.
+void update_blocks(RefineCache& c, int threads) {
+  const RefinedMesh& r = c.refined;
+  constexpr int32_t kBlock = 64;
+  if (c.blocks.empty()) {
+    for (int32_t t = 0; t < r.num_triangles();) {
+      int32_t end = t + 1;
+      while (end < r.num_triangles() && end - t < kBlock && r.triangle_parent[end] == r.triangle_parent[t]) ++end;
+      c.blocks.push_back({t, end, 0, 0, 0, 0});
+      t = end;
+    }
+  }
+  constexpr int kBlocksPerJob = 1024;
+  const int jobs = (static_cast<int>(c.blocks.size()) + kBlocksPerJob - 1) / kBlocksPerJob;
+  detail::parallel_for(jobs, threads, [&](int job) {
+    const size_t end = std::min(c.blocks.size(), size_t(job + 1) * kBlocksPerJob);
+    for (size_t i = size_t(job) * kBlocksPerJob; i < end; ++i) {
+      detail::TriangleBlock& block = c.blocks[i];
+      float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+      for (int32_t t = block.begin; t < block.end; ++t) {
+        for (const int32_t v : r.triangles[t]) {
+          const float x = r.positions[2 * size_t(v)], y = r.positions[2 * size_t(v) + 1];
+          x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+      }
+      block.x0 = x0, block.y0 = y0, block.x1 = x1, block.y1 = y1;
+    }
+  });
+}
+
+struct State {
+  std::vector<LevelState> levels;
+  RefineCache cache;
+  detail::RasterScratch scratch;
+};
+
+LevelState& level_state(const VectorImage& image, State& state, int level) {
+  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+    throw Error(ErrorCode::kInvalidArgument, "level " + std::to_string(level) + " is out of range (" +
+                                                 std::to_string(image.levels.size()) + " levels)");
+  }
+  if (state.levels.size() != image.levels.size()) state.levels.resize(image.levels.size());
+  LevelState& s = state.levels[level];
+  const ControlMesh& mesh = image.levels[level];
+  if (!s.topology) s.topology = validate_level(mesh, image.width, image.height, level);
+  if (s.boxes.empty()) s.boxes = detail::ring_boxes(mesh, *s.topology);
+  return s;
+}
+
+Image8 render_with(const VectorImage& image, State& state, const RenderOptions& options) {
+  if (image.width < 1 || image.height < 1) {
+    throw Error(ErrorCode::kInvalidArgument, "the image has no pixels");
+  }
+  LevelState& ls = level_state(image, state, options.level);
+  const ControlMesh& mesh = image.levels[options.level];
+  detail::ViewPlan plan = detail::plan_view(image, mesh, ls.boxes, options);
+  const int threads = detail::resolve_threads(options.threads);
+  if (plan.faces.empty()) return Image8(plan.view.width, plan.view.height, plan.channels);
+  if (plan.all_faces) plan.faces.clear();
+
+  RefineCache& c = state.cache;
+  const bool reuse = c.subdivision && c.level == options.level && c.depth == plan.depth &&
+                     (c.faces.empty() || (!plan.all_faces && std::includes(c.faces.begin(), c.faces.end(),
+                                                                           plan.faces.begin(), plan.faces.end())));
+  if (!reuse) {
+    c.subdivision.reset();
+    c.refined = RefinedMesh{};
+    c.blocks.clear();
+    c.subdivision.emplace(mesh, *ls.topology, plan.depth, plan.faces);
+    c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
+    c.level = options.level;
+    c.depth = plan.depth;
+    c.faces = std::move(plan.faces);
+    update_blocks(c, threads);
+  } else if (c.positions_stale && c.colors_stale) {
+    c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
+    update_blocks(c, threads);
+  } else if (c.positions_stale) {
+    c.subdivision->evaluate_positions(mesh.positions, c.refined.positions, threads);
+    update_blocks(c, threads);
+  } else if (c.colors_stale) {
+    c.subdivision->evaluate_colors(mesh.colors, c.refined.colors, threads);
+  }
+  c.positions_stale = c.colors_stale = false;
+
+  detail::RasterOptions raster;
+  raster.channels = plan.channels;
+  raster.antialias = options.antialias;
+  raster.antialias_border = plan.channels == 4;
+  raster.threads = threads;
+  raster.blocks = c.blocks;
+  std::vector<detail::OverlayLayer> overlay;
+  if (options.overlay == Overlay::kMesh) overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
+  if (options.overlay == Overlay::kFeatures) overlay = detail::feature_overlay(c.refined, plan.view);
+  return detail::rasterize(c.refined, plan.view, raster, overlay, &state.scratch);
+}
+
+}  // namespace
+
+Image8 render(const VectorImage& image, const RenderOptions& options) {
+  State state;
+  return render_with(image, state, options);
+}
+
+struct Renderer::Impl {
+  VectorImage image;
+  State state;
+};
+
+Renderer::Renderer(VectorImage image) : impl_(std::make_unique<Impl>()) { impl_->image = std::move(image); }
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+const VectorImage& Renderer::image() const { return impl_->image; }
+
+Image8 Renderer::render(const RenderOptions& options) { return render_with(impl_->image, impl_->state, options); }
+
+void Renderer::set_positions(int level, std::span<const Vec2> positions) {
+  VectorImage& image = impl_->image;
+  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+    throw Error(ErrorCode::kInvalidArgument, "set_positions: level " + std::to_string(level) + " is out of range");
+  }
+  ControlMesh& mesh = image.levels[level];
+  if (static_cast<int>(positions.size()) != mesh.num_vertices()) {
+    throw Error(ErrorCode::kInvalidArgument, "set_positions: " + std::to_string(positions.size()) +
+                                                 " positions for " + std::to_string(mesh.num_vertices()) +
+                                                 " vertices");
+  }
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!std::isfinite(positions[i].x) || !std::isfinite(positions[i].y)) {
+      throw Error(ErrorCode::kInvalidArgument, "set_positions: position " + std::to_string(i) + " is not finite");
+    }
+  }
+  mesh.positions.assign(positions.begin(), positions.end());
+  State& s = impl_->state;
+  if (level < static_cast<int>(s.levels.size())) s.levels[level].boxes.clear();
+  if (s.cache.level == level) s.cache.positions_stale = true;
+}
+
+void Renderer::set_colors(int level, std::span<const Color> colors) {
+  VectorImage& image = impl_->image;
+  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+    throw Error(ErrorCode::kInvalidArgument, "set_colors: level " + std::to_string(level) + " is out of range");
+  }
+  ControlMesh& mesh = image.levels[level];
+  if (static_cast<int>(colors.size()) != mesh.num_colors()) {
+    throw Error(ErrorCode::kInvalidArgument, "set_colors: " + std::to_string(colors.size()) + " colors for " +
+                                                 std::to_string(mesh.num_colors()) + " color values");
+  }
+  for (size_t i = 0; i < colors.size(); ++i) {
+    if (!std::isfinite(colors[i].r) || !std::isfinite(colors[i].g) || !std::isfinite(colors[i].b)) {
+      throw Error(ErrorCode::kInvalidArgument, "set_colors: color " + std::to_string(i) + " is not finite");
+    }
+  }
+  mesh.colors.assign(colors.begin(), colors.end());
+  if (impl_->state.cache.level == level) impl_->state.cache.colors_stale = true;
+}
+
+}  // namespace subvec

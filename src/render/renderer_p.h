@@ -1,0 +1,41 @@
+// View planning for the renderer (exposed for tests): output size, view transform, visible control
+// faces and the subdivision depth.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "render/raster_p.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/render/renderer.h"
+
+namespace subvec::detail {
+
+// The depth rule refines at most this many triangles on its own (an explicit depth may go to 2^26).
+constexpr int64_t kMaxAutoTriangles = int64_t{1} << 24;
+constexpr int kMaxAutoDepth = 8;
+
+// Per control face, the bounding box (x0, y0, x1, y1) of the control vertices of every face that
+// shares a vertex with it: its limit patch lies in their convex hull, so inside this box.
+std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh, const MeshTopology& topology);
+
+struct ViewPlan {
+  ViewTransform view;
+  Window window;
+  int channels = 3;            // 4 when the window leaves the image
+  bool all_faces = false;      // every control face is visible (faces lists them all)
+  std::vector<int32_t> faces;  // visible control faces, ascending
+  double mean_edge_pixels = 0; // mean control edge length of the visible faces, output pixels
+  int depth = 0;
+};
+
+// Checks the options (Error(kInvalidArgument) / kLimit) and plans the view of one level.
+ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
+                   std::span<const std::array<double, 4>> boxes, const RenderOptions& options);
+
+// The depth rule: the smallest k in 0..8 with mean_edge_pixels / 2^k <= max_edge_pixels, lowered
+// until num_faces * 4^k <= kMaxAutoTriangles.
+int choose_depth(double mean_edge_pixels, double max_edge_pixels, int64_t num_faces);
+
+}  // namespace subvec::detail

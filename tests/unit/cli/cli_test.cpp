@@ -1,0 +1,370 @@
+// End-to-end tests of the `subvec` command-line tool: they run the built binary (SUBVEC_CLI) in a
+// shell and check exit statuses, stderr messages and the files left behind.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "subvec/io/image_io.h"
+#include "subvec/io/svec.h"
+
+namespace subvec {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kExamples[] = {"01-disk", "02-open-tear", "03-junction"};
+
+fs::path example(const std::string& name) {
+  return fs::path(SUBVEC_SOURCE_DIR) / "examples" / (name + ".svec.json");
+}
+
+// Single quotes for the shell.
+std::string q(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+std::string q(const fs::path& p) { return q(p.string()); }
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+struct CliResult {
+  int status = -1;  // exit status, or -1 when the process did not exit normally (a crash)
+  std::string out, err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("subvec_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `subvec <args>` with stdout and stderr captured in files of the test's directory.
+  CliResult subvec(const std::string& args) {
+    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
+    const std::string command =
+        q(std::string(SUBVEC_CLI)) + " " + args + " >" + q(out) + " 2>" + q(err);
+    const int raw = std::system(command.c_str());
+    CliResult r;
+    r.status = (raw != -1 && WIFEXITED(raw)) ? WEXITSTATUS(raw) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  // Expects a clean failure: a non-zero exit (not a crash), one line "subvec: ..." on stderr that
+  // contains `needle`, and nothing on stdout.
+  void expect_failure(const CliResult& r, const std::string& needle) {
+    EXPECT_GT(r.status, 0) << "stderr: " << r.err;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.rfind("subvec: ", 0), 0u) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "expected one line, got: " << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << "'" << needle << "' not in: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+
+  // Files the test's directory holds, temporary files included.
+  std::vector<std::string> files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_))
+      names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, RenderHasTheRequestedSize) {
+  const VectorImage img = read_svec(example("01-disk"));
+  const fs::path png = dir_ / "a.png";
+
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(png)).status, 0);
+  Image8 out = read_image(png);
+  EXPECT_EQ(out.width, img.width);
+  EXPECT_EQ(out.height, img.height);
+
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(png) + " --scale 4").status, 0);
+  out = read_image(png);
+  EXPECT_EQ(out.width, 4 * img.width);
+  EXPECT_EQ(out.height, 4 * img.height);
+
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(png) + " --width 100").status, 0);
+  out = read_image(png);
+  EXPECT_EQ(out.width, 100);
+  EXPECT_EQ(out.height, int(std::lround(100.0 * img.height / img.width)));
+
+  // A window of the top-left quarter at 2x: the image's own size again.
+  const std::string window =
+      "0,0," + std::to_string(img.width / 2.0) + "," + std::to_string(img.height / 2.0);
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(png) + " --window " + window +
+                   " --scale 2")
+                .status,
+            0);
+  out = read_image(png);
+  EXPECT_EQ(out.width, img.width);
+  EXPECT_EQ(out.height, img.height);
+  EXPECT_EQ(files(), std::vector<std::string>{"a.png"});  // no temporary left behind
+}
+
+TEST_F(Cli, RenderIsByteIdenticalAcrossRunsAndThreads) {
+  for (const char* name : kExamples) {
+    SCOPED_TRACE(name);
+    const std::string in = q(example(name));
+    const fs::path a = dir_ / "a.png", b = dir_ / "b.png", c = dir_ / "c.png";
+    ASSERT_EQ(subvec("render " + in + " -o " + q(a) + " --scale 4 --threads 1").status, 0);
+    ASSERT_EQ(subvec("render " + in + " -o " + q(b) + " --scale 4 --threads 1").status, 0);
+    ASSERT_EQ(subvec("render " + in + " -o " + q(c) + " --scale 4 --threads 2").status, 0);
+    const std::string bytes = read_text(a);
+    EXPECT_GT(bytes.size(), 8u);
+    EXPECT_EQ(bytes, read_text(b));
+    EXPECT_EQ(bytes, read_text(c));
+  }
+}
+
+TEST_F(Cli, RenderOptionsChangeTheImage) {
+  const std::string in = q(example("01-disk"));
+  const fs::path plain = dir_ / "plain.png", mesh = dir_ / "mesh.png", level = dir_ / "l.png";
+  ASSERT_EQ(subvec("render " + in + " -o " + q(plain) + " --scale 2").status, 0);
+  ASSERT_EQ(subvec("render " + in + " -o " + q(mesh) + " --scale 2 --overlay mesh").status, 0);
+  EXPECT_NE(read_text(plain), read_text(mesh));
+  ASSERT_EQ(subvec("render " + in + " -o " + q(level) +
+                   " --scale 2 --overlay Features --no-aa "
+                   "--depth 2 --level 0")
+                .status,
+            0);
+  EXPECT_TRUE(fs::exists(level));
+}
+
+TEST_F(Cli, InfoJson) {
+  for (const char* name : kExamples) {
+    SCOPED_TRACE(name);
+    const CliResult r = subvec("info " + q(example(name)) + " --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const VectorImage img = read_svec(example(name));
+    EXPECT_EQ(j.at("width").get<int>(), img.width);
+    EXPECT_EQ(j.at("height").get<int>(), img.height);
+    EXPECT_EQ(j.at("bytes").get<uint64_t>(), fs::file_size(example(name)));
+    ASSERT_EQ(j.at("levels").size(), img.levels.size());
+    for (size_t i = 0; i < img.levels.size(); ++i) {
+      const nlohmann::json& l = j["levels"][i];
+      const ControlMesh& m = img.levels[i];
+      EXPECT_EQ(l.at("vertices").get<int>(), m.num_vertices());
+      EXPECT_EQ(l.at("triangles").get<int>(), m.num_triangles());
+      EXPECT_EQ(l.at("features").get<size_t>(), m.features.size());
+      EXPECT_EQ(l.at("colors").get<int>(), m.num_colors());
+      EXPECT_EQ(l.at("creases").get<size_t>(), m.creases.size());
+      // Every feature edge is a tear edge and no edge belongs to two features.
+      size_t feature_edges = 0;
+      for (const Feature& f : m.features) feature_edges += f.vertices.size() - 1;
+      EXPECT_EQ(l.at("tear_edges").get<size_t>(), feature_edges);
+      EXPECT_GT(feature_edges, 0u) << "every example has a tear";
+    }
+  }
+}
+
+TEST_F(Cli, InfoText) {
+  const VectorImage img = read_svec(example("01-disk"));
+  const CliResult r = subvec("info " + q(example("01-disk")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(std::to_string(img.width) + " x " + std::to_string(img.height)),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("tear edges"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, ConvertRoundTrip) {
+  const fs::path bin = dir_ / "a.svec", json = dir_ / "b.svec.json", direct = dir_ / "c.svec.json",
+                 bin2 = dir_ / "d.svec";
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(bin) + " -o " + q(json)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(direct)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2)).status, 0);
+  // json -> svec -> json gives the text json -> json gives; svec -> json -> svec the same bytes.
+  EXPECT_EQ(read_text(json), read_text(direct));
+  EXPECT_EQ(read_text(bin), read_text(bin2));
+  EXPECT_NE(read_text(bin), read_text(json));  // really two formats
+  // And the binary file renders like the JSON one.
+  ASSERT_EQ(subvec("render " + q(bin) + " -o " + q(dir_ / "x.png")).status, 0);
+  ASSERT_EQ(subvec("render " + q(example("03-junction")) + " -o " + q(dir_ / "y.png")).status, 0);
+  EXPECT_EQ(read_text(dir_ / "x.png"), read_text(dir_ / "y.png"));
+}
+
+TEST_F(Cli, CompareIdenticalImages) {
+  const fs::path png = dir_ / "a.png";
+  ASSERT_EQ(subvec("render " + q(example("02-open-tear")) + " -o " + q(png)).status, 0);
+  CliResult r = subvec("compare " + q(png) + " " + q(png) + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("mae_mean").get<double>(), 0.0);
+  for (const char* c : {"r", "g", "b"}) EXPECT_EQ(j.at("mae").at(c).get<double>(), 0.0);
+  EXPECT_TRUE(j.at("psnr").is_null());
+  EXPECT_DOUBLE_EQ(j.at("ssim").get<double>(), 1.0);
+
+  r = subvec("compare " + q(png) + " " + q(png));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("MAE"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("inf"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, CompareDifferentImages) {
+  const fs::path a = dir_ / "a.png", b = dir_ / "b.png";
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(a)).status, 0);
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(b) + " --overlay mesh").status,
+            0);
+  const CliResult r = subvec("compare " + q(a) + " " + q(b) + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j.at("mae_mean").get<double>(), 0.0);
+  EXPECT_TRUE(j.at("psnr").is_number());
+  EXPECT_LT(j.at("ssim").get<double>(), 1.0);
+
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(b) + " --scale 2").status, 0);
+  expect_failure(subvec("compare " + q(a) + " " + q(b)), "differ in size");
+}
+
+// ---- failures --------------------------------------------------------------------------------
+
+TEST_F(Cli, MissingInputFile) {
+  const fs::path out = dir_ / "out.png";
+  expect_failure(subvec("render " + q(dir_ / "nope.svec.json") + " -o " + q(out)),
+                 "nope.svec.json");
+  expect_failure(subvec("info " + q(dir_ / "nope.svec")), "nope.svec");
+  expect_failure(subvec("compare " + q(dir_ / "nope.png") + " " + q(dir_ / "nope.png")),
+                 "nope.png");
+  EXPECT_TRUE(files().empty());
+}
+
+TEST_F(Cli, UnsupportedOutputExtension) {
+  expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "out.jpg")), ".jpg");
+  expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "out")),
+                 "no extension");
+  expect_failure(subvec("convert " + q(example("01-disk")) + " -o " + q(dir_ / "out.txt")),
+                 "out.txt");
+  EXPECT_TRUE(files().empty());
+}
+
+TEST_F(Cli, BadOptionValues) {
+  const std::string render = "render " + q(example("01-disk")) + " -o " + q(dir_ / "out.png");
+  expect_failure(subvec(render + " --width 0"), "--width");
+  expect_failure(subvec(render + " --width -3"), "--width");
+  expect_failure(subvec(render + " --scale 0"), "--scale");
+  expect_failure(subvec(render + " --width 10 --scale 2"), "--width");
+  expect_failure(subvec(render + " --window 10,0,5,20"), "X0 < X1");
+  expect_failure(subvec(render + " --window 0,20,10,5"), "Y0 < Y1");
+  expect_failure(subvec(render + " --window 1,2,3"), "four numbers");
+  expect_failure(subvec(render + " --window 0,0,nan,4"), "four numbers");
+  expect_failure(subvec(render + " --level 5"), "level 5");
+  expect_failure(subvec(render + " --overlay sparkles"), "--overlay");
+  expect_failure(subvec(render + " --threads -1"), "--threads");
+  expect_failure(subvec(render + " --depth 11"), "--depth");
+  expect_failure(subvec(render + " --scale 100000"), "too large");
+  expect_failure(subvec("render " + q(example("01-disk"))), "--output");
+  expect_failure(subvec("frobnicate"), "frobnicate");
+  EXPECT_TRUE(files().empty());
+}
+
+TEST_F(Cli, UsageErrorsUseCli11ExitCodes) {
+  EXPECT_EQ(subvec("").status, 106);  // RequiredError: no command
+  EXPECT_EQ(
+      subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "o.png") + " --width 0").status,
+      105);  // ValidationError
+  EXPECT_EQ(
+      subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "o.png") + " --level 5").status,
+      1);  // found only once the file is read
+}
+
+TEST_F(Cli, BadVectorFiles) {
+  const fs::path bad_bin = dir_ / "bad.svec", bad_json = dir_ / "bad.svec.json",
+                 empty = dir_ / "empty.svec";
+  write_text(bad_bin, "this is not a vector image at all");
+  write_text(bad_json, "{\"width\": 10, \"height\": ");
+  write_text(empty, "");
+  for (const fs::path& in : {bad_bin, bad_json, empty}) {
+    SCOPED_TRACE(in.string());
+    expect_failure(subvec("render " + q(in) + " -o " + q(dir_ / "out.png")), "");
+    expect_failure(subvec("info " + q(in)), "");
+    expect_failure(subvec("convert " + q(in) + " -o " + q(dir_ / "out.svec")), "");
+  }
+  // A truncated copy of a valid binary file.
+  ASSERT_EQ(subvec("convert " + q(example("01-disk")) + " -o " + q(dir_ / "good.svec")).status, 0);
+  std::string bytes = read_text(dir_ / "good.svec");
+  write_text(dir_ / "cut.svec", bytes.substr(0, bytes.size() / 2));
+  expect_failure(subvec("render " + q(dir_ / "cut.svec") + " -o " + q(dir_ / "out.png")), "");
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "out.svec"));
+  EXPECT_EQ(files(), (std::vector<std::string>{"bad.svec", "bad.svec.json", "cut.svec",
+                                               "empty.svec", "good.svec"}));
+}
+
+TEST_F(Cli, BadImagesForCompare) {
+  write_text(dir_ / "junk.png", "not a png");
+  const fs::path good = dir_ / "good.png";
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(good)).status, 0);
+  expect_failure(subvec("compare " + q(good) + " " + q(dir_ / "junk.png")),
+                 "file is truncated or not an image");
+}
+
+TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {
+  const fs::path out = dir_ / "out.png", svec = dir_ / "out.svec";
+  write_text(out, "precious");
+  write_text(svec, "precious too");
+  write_text(dir_ / "bad.svec", "garbage");
+  expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(out) + " --level 5"),
+                 "level");
+  expect_failure(subvec("render " + q(dir_ / "bad.svec") + " -o " + q(out)), "");
+  expect_failure(subvec("convert " + q(dir_ / "bad.svec") + " -o " + q(svec)), "");
+  EXPECT_EQ(read_text(out), "precious");
+  EXPECT_EQ(read_text(svec), "precious too");
+  EXPECT_EQ(files(), (std::vector<std::string>{"bad.svec", "out.png", "out.svec"}));
+  // A successful run replaces it.
+  ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(out)).status, 0);
+  EXPECT_NE(read_text(out), "precious");
+}
+
+TEST_F(Cli, HelpAndVersion) {
+  CliResult r = subvec("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out.rfind("subvec ", 0), 0u) << r.out;
+  r = subvec("--help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* word : {"render", "info", "convert", "compare", "Examples"}) {
+    EXPECT_NE(r.out.find(word), std::string::npos) << word;
+  }
+  r = subvec("render --help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* word : {"--width", "--scale", "--window", "--level", "--overlay", "--no-aa",
+                           "--threads", "--depth"}) {
+    EXPECT_NE(r.out.find(word), std::string::npos) << word;
+  }
+}
+
+}  // namespace
+}  // namespace subvec
