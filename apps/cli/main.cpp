@@ -28,6 +28,9 @@
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/render/renderer.h"
+#include "subvec/vectorize/vectorize.h"
+#include <chrono>
+#include <unistd.h>
 
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
@@ -292,6 +295,76 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
   std::printf("SSIM  %.6f\n", d.ssim);
 }
 
+// ---- vectorize -------------------------------------------------------------------------------
+
+struct VectorizeArgs {
+  std::string input, output;
+  double ratio = 0.01;
+  int vertices = 0;
+  int64_t max_pixels = int64_t{1} << 26;
+  std::string fit = "pixels";
+  bool json = false;
+};
+
+void run_vectorize(const VectorizeArgs& a) {
+  subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
+  const auto start = std::chrono::steady_clock::now();
+  const subvec::Image8 image = subvec::read_image(a.input, a.max_pixels);
+  subvec::VectorizeOptions options;
+  options.ratio = a.ratio;
+  options.vertices = a.vertices;
+  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices : subvec::ColorFitTarget::kPixels;
+  // Progress on a terminal, for runs past a second.
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  bool printed = false;
+  options.progress = [&](const std::string& stage, double fraction) {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!tty || elapsed < 1.0) return;
+    std::fprintf(stderr, "\rsubvec: vectorizing %s: %-9s %3d%%", a.input.c_str(), stage.c_str(),
+                 static_cast<int>(std::lround(100 * fraction)));
+    std::fflush(stderr);
+    printed = true;
+  };
+  subvec::VectorizeReport report;
+  const subvec::VectorImage v = subvec::vectorize(image, options, &report);
+  if (printed) std::fprintf(stderr, "\n");
+  const auto render_start = std::chrono::steady_clock::now();
+  const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
+  const double compare_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  subvec::write_svec(a.output, v);
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (a.json) {
+    nlohmann::ordered_json j;
+    j["input"] = a.input;
+    j["output"] = a.output;
+    j["width"] = image.width;
+    j["height"] = image.height;
+    j["vertices"] = report.vertices;
+    j["triangles"] = report.triangles;
+    j["features"] = report.features;
+    j["tear_vertices"] = report.tear_vertices;
+    j["mae"] = d.mae_mean;
+    j["psnr"] = std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
+    j["ssim"] = d.ssim;
+    nlohmann::ordered_json stages;
+    for (const auto& s : report.stages) stages[s.stage] = s.seconds;
+    stages["render_compare"] = compare_seconds;
+    j["seconds"] = stages;
+    j["total_seconds"] = total;
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::printf("%s -> %s\n", a.input.c_str(), a.output.c_str());
+  std::printf("size      %d x %d pixels\n", image.width, image.height);
+  std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n", report.vertices,
+              report.triangles, report.features, report.tear_vertices);
+  std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n", d.mae_mean,
+              d.psnr, d.ssim);
+  std::printf("seconds  ");
+  for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
+  std::printf(" total %.3f\n", total);
+}
+
 // ---- command line ----------------------------------------------------------------------------
 
 // The name of the deepest subcommand CLI11 got to, for the hint after a usage error.
@@ -310,10 +383,11 @@ std::string command_path(const CLI::App& app) {
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
-      "Renders, inspects and converts .svec / .svec.json files and compares raster images.",
+      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares raster images.",
       "subvec");
   app.footer(
       "Examples:\n"
+      "  subvec vectorize photo.png -o photo.svec\n"
       "  subvec render examples/01-disk.svec.json -o disk.png --scale 4\n"
       "  subvec info examples/01-disk.svec.json --json\n"
       "  subvec convert examples/01-disk.svec.json -o disk.svec\n"
@@ -419,6 +493,35 @@ int run(int argc, char** argv) {
       "  subvec compare photo.png render.png\n"
       "  subvec compare photo.png render.png --json   # psnr is null for identical images");
 
+  // vectorize
+  VectorizeArgs va;
+  CLI::App* vectorize = app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
+  vectorize->add_option("input", va.input, "Raster image")->required();
+  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")->required();
+  CLI::Option* ratio_opt =
+      vectorize->add_option("--ratio", va.ratio, "Control vertices as a fraction of the pixel count (default 0.01)")
+          ->check(CLI::Validator(
+              [](std::string& text) {
+                double v = 0;
+                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
+                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
+              },
+              "RATIO", "ratio"));
+  CLI::Option* vertices_opt = vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
+                                  ->check(CLI::Range(4, 1 << 26));
+  ratio_opt->excludes(vertices_opt);
+  vectorize->add_option("--max-pixels", va.max_pixels, "Refuse larger images (default 67108864)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  vectorize->add_option("--fit", va.fit, "Color fit: every pixel (default) or the paper's subdivided vertices")
+      ->check(CLI::IsMember({"pixels", "vertices"}))
+      ->default_str("pixels");
+  vectorize->add_flag("--json", va.json, "Print the summary as JSON");
+  vectorize->footer(
+      "Examples:\n"
+      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as vertices\n"
+      "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
+      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -434,10 +537,10 @@ int run(int argc, char** argv) {
       // No command: either none was given or the first word is not one.
       const std::vector<std::string> extra = app.remaining();
       if (extra.empty()) {
-        message = "a command is required: render, info, convert or compare";
+        message = "a command is required: vectorize, render, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: render, info, convert or compare)";
+                  extra.front() + "' (expected a command: vectorize, render, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }
@@ -453,6 +556,8 @@ int run(int argc, char** argv) {
     run_convert(convert_input, convert_output);
   } else if (compare->parsed()) {
     run_compare(compare_ref, compare_test, compare_json);
+  } else if (vectorize->parsed()) {
+    run_vectorize(va);
   }
   return 0;
 }

@@ -51,4 +51,9 @@ struct MeshTopology {
   std::vector<int64_t> edge_keys_;  // sorted (a << 32 | b), parallel to edges
 };
 
+// Face-varying color indices implied by the tears: the corners of a vertex share one color index
+// unless a tear separates them (a union over every non-tear interior edge). Returns #F index
+// triples numbered in order of first use, and sets `num_colors`.
+std::vector<Tri> face_varying_indices(const ControlMesh& mesh, const MeshTopology& topology, int& num_colors);
+
 }  // namespace subvec

@@ -1,0 +1,40 @@
+// Stage 4 of vectorization (paper §4, "Color optimization"): all control colors at once, each side
+// of a tear separately, by sparse least squares through the subdivision stencils.
+//
+// Beyond the paper, the default fits every pixel: a pixel centre lies in a refined triangle whose
+// color is a fixed sparse combination of control colors (limit stencils x barycentric weights), so
+// the fitted image is what the renderer draws. Pixels within `band` of a tear take target colors
+// filled in from their own side (the paper's hole filling), so color never bleeds across a tear.
+// The paper's fit at the subdivided vertices is kept as an option for comparison.
+#pragma once
+
+#include "subvec/core/image.h"
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+enum class ColorFitTarget { kPixels, kRefinedVertices };
+
+struct ColorFitOptions {
+  ColorFitTarget target = ColorFitTarget::kPixels;
+  int depth = -1;             // subdivision depth of the fit; -1: what the renderer uses at 1x
+  double band = 1.0;          // pixels this close to a tear get hole-filled targets
+  double fill_radius = 3.0;   // how far hole filling looks for same-side pixels
+  double regularization = 1e-6;  // relative Tikhonov weight toward the current colors
+};
+
+struct ColorFitStats {
+  int rows = 0;          // pixels or refined vertices fitted
+  int filled = 0;        // band pixels given hole-filled targets
+  double rms = 0;        // root-mean-square residual over the located pixels, 0-255 scale
+  double mae = 0;        // mean absolute error of the 8-bit prediction at pixel centres
+};
+
+// Refits mesh.colors in place against `image` (same size as the domain). Throws kInvalidArgument.
+ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8& image,
+                         const ColorFitOptions& options = {});
+
+// The renderer's depth rule at scale 1: smallest k whose refined edges average <= 2.5 px.
+int default_fit_depth(const ControlMesh& mesh);
+
+}  // namespace subvec

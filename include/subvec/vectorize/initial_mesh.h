@@ -1,0 +1,25 @@
+// Stage 2 of vectorization (paper §4): the dense feature-aligned control mesh. One vertex per
+// pixel centre, vertices along the image border, and the feature polylines at their subpixel
+// positions, as a constrained Delaunay triangulation whose constraints are the features. Feature
+// edges become tears, the border a crease, the 4 corners corners; every corner of every triangle
+// gets the image color sampled on its own side of any tear.
+#pragma once
+
+#include <vector>
+
+#include "subvec/core/image.h"
+#include "subvec/mesh/vector_image.h"
+#include "subvec/vectorize/features.h"
+
+namespace subvec {
+
+struct InitialMeshOptions {
+  double min_grid_distance = 0.5;  // grid vertices closer than this to a feature are dropped, px
+  double side_offset = 0.75;       // tear-side colors are sampled this far into each side, px
+};
+
+// Returns a valid single-level mesh (validate_level holds) over the image domain.
+ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
+                               const InitialMeshOptions& options = {});
+
+}  // namespace subvec

@@ -1,0 +1,316 @@
+// Global least-squares color fit through the limit stencils (paper §4, "Color optimization").
+//
+// With S the color limit stencils (refined color values = S * control colors) and B the sparse
+// matrix that interpolates refined values at the fitted points (barycentric weights of the refined
+// triangle containing each pixel centre), the fit solves
+//     min_c |B S c - t|^2 + lambda |c - c0|^2
+// through the normal equations S' (B'B) S c = S' B' t + lambda c0. B'B is assembled directly on the
+// refined values, so the large pixel matrix is never formed.
+#include "subvec/vectorize/fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/SparseCholesky>
+
+#include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/subdiv/subdivision.h"
+
+namespace subvec {
+namespace {
+
+struct Segment {
+  float ax, ay, bx, by;
+};
+
+double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+
+// Whether segments pq and ab intersect (touching counts).
+bool segments_cross(double px, double py, double qx, double qy, const Segment& s) {
+  const double d1 = cross(qx - px, qy - py, s.ax - px, s.ay - py);
+  const double d2 = cross(qx - px, qy - py, s.bx - px, s.by - py);
+  const double d3 = cross(s.bx - s.ax, s.by - s.ay, px - s.ax, py - s.ay);
+  const double d4 = cross(s.bx - s.ax, s.by - s.ay, qx - s.ax, qy - s.ay);
+  return ((d1 <= 0 && d2 >= 0) || (d1 >= 0 && d2 <= 0)) && ((d3 <= 0 && d4 >= 0) || (d3 >= 0 && d4 <= 0));
+}
+
+double point_segment_distance(double px, double py, const Segment& s) {
+  const double dx = s.bx - s.ax, dy = s.by - s.ay, len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? ((px - s.ax) * dx + (py - s.ay) * dy) / len2 : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(px - (s.ax + t * dx), py - (s.ay + t * dy));
+}
+
+// Tear segments bucketed on a coarse grid for neighbourhood queries.
+class SegmentGrid {
+ public:
+  SegmentGrid(std::vector<Segment> segments, int width, int height, int cell)
+      : segments_(std::move(segments)), cell_(cell), cols_(width / cell + 1), rows_(height / cell + 1),
+        buckets_(size_t(cols_) * rows_) {
+    for (size_t i = 0; i < segments_.size(); ++i) {
+      const Segment& s = segments_[i];
+      const int x0 = clamp_col(std::min(s.ax, s.bx)), x1 = clamp_col(std::max(s.ax, s.bx));
+      const int y0 = clamp_row(std::min(s.ay, s.by)), y1 = clamp_row(std::max(s.ay, s.by));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) buckets_[size_t(y) * cols_ + x].push_back(static_cast<int32_t>(i));
+    }
+  }
+  // Segment indices whose cells overlap the box (may repeat).
+  void query(double x0, double y0, double x1, double y1, std::vector<int32_t>& out) const {
+    out.clear();
+    for (int y = clamp_row(y0); y <= clamp_row(y1); ++y)
+      for (int x = clamp_col(x0); x <= clamp_col(x1); ++x)
+        for (int32_t i : buckets_[size_t(y) * cols_ + x]) out.push_back(i);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  const Segment& operator[](int32_t i) const { return segments_[i]; }
+  size_t size() const { return segments_.size(); }
+
+ private:
+  int clamp_col(double x) const { return std::clamp(static_cast<int>(x / cell_), 0, cols_ - 1); }
+  int clamp_row(double y) const { return std::clamp(static_cast<int>(y / cell_), 0, rows_ - 1); }
+  std::vector<Segment> segments_;
+  int cell_, cols_, rows_;
+  std::vector<std::vector<int32_t>> buckets_;
+};
+
+std::array<double, 3> pixel(const Image8& image, int x, int y) {
+  const uint8_t* p = image.row(y) + size_t(x) * image.channels;
+  return {double(p[0]), double(p[1]), double(p[2])};
+}
+
+std::array<double, 3> bilinear(const Image8& image, double x, double y) {
+  const double fx = std::clamp(x - 0.5, 0.0, double(image.width - 1));
+  const double fy = std::clamp(y - 0.5, 0.0, double(image.height - 1));
+  const int x0 = std::min(int(fx), image.width - 1), y0 = std::min(int(fy), image.height - 1);
+  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
+  const double ax = fx - x0, ay = fy - y0;
+  const auto a = pixel(image, x0, y0), b = pixel(image, x1, y0), c = pixel(image, x0, y1), d = pixel(image, x1, y1);
+  std::array<double, 3> out;
+  for (int k = 0; k < 3; ++k) out[k] = (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
+  return out;
+}
+
+}  // namespace
+
+int default_fit_depth(const ControlMesh& mesh) {
+  double total = 0;
+  int count = 0;
+  for (const Tri& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 a = mesh.positions[t[k]], b = mesh.positions[t[(k + 1) % 3]];
+      total += std::hypot(b.x - a.x, b.y - a.y);
+      ++count;
+    }
+  }
+  double mean = count ? total / count : 0;
+  int depth = 0;
+  while (mean > 2.5 && depth < 5) mean /= 2, ++depth;
+  return depth;
+}
+
+ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8& image,
+                         const ColorFitOptions& options) {
+  if (image.width != width || image.height != height) {
+    throw Error(ErrorCode::kInvalidArgument, "fit_colors: image is " + std::to_string(image.width) + "x" +
+                                                 std::to_string(image.height) + ", the mesh domain " +
+                                                 std::to_string(width) + "x" + std::to_string(height));
+  }
+  const MeshTopology topo = MeshTopology::build(mesh, width, height);
+  const int depth = options.depth >= 0 ? options.depth : default_fit_depth(mesh);
+  const Subdivision sub(mesh, topo, depth);
+  const RefinedMesh& refined = sub.topology();
+  int32_t num_refined = 0;  // every refined vertex belongs to a refined triangle
+  for (const Tri& t : refined.triangles) num_refined = std::max({num_refined, t[0] + 1, t[1] + 1, t[2] + 1});
+  std::vector<float> limit(size_t(num_refined) * 2);
+  sub.evaluate_positions(mesh.positions, limit);
+  const SparseMatrix& s = sub.color_stencils();
+  const int m = static_cast<int>(s.rows()), c = static_cast<int>(s.cols());
+
+  // Tear segments of the limit mesh, for the band and for same-side tests.
+  std::vector<Segment> segments;
+  for (const EdgeVerts& e : refined.tear_edges) {
+    segments.push_back({limit[2 * e[0]], limit[2 * e[0] + 1], limit[2 * e[1]], limit[2 * e[1] + 1]});
+  }
+  const SegmentGrid grid(std::move(segments), width, height, 4);
+
+  // Accumulate B'B (on refined values) and B't.
+  std::vector<Eigen::Triplet<double, int32_t>> btb;
+  Eigen::MatrixX3d btt = Eigen::MatrixX3d::Zero(m, 3);
+  ColorFitStats stats;
+  auto add_row = [&](const int32_t* values, const double* weights, int n, const std::array<double, 3>& target) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) btb.emplace_back(values[i], values[j], weights[i] * weights[j]);
+      for (int k = 0; k < 3; ++k) btt(values[i], k) += weights[i] * target[k];
+    }
+    ++stats.rows;
+  };
+
+  struct Location {
+    int32_t triangle = -1;
+    float b1 = 0, b2 = 0;
+  };
+  std::vector<Location> located;
+  if (options.target == ColorFitTarget::kPixels) {
+    // Locate every pixel centre in a refined triangle (first one wins on shared edges).
+    located.assign(size_t(width) * height, Location{});
+    for (int t = 0; t < refined.num_triangles(); ++t) {
+      const Tri& tri = refined.triangles[t];
+      const double x0 = limit[2 * tri[0]], y0 = limit[2 * tri[0] + 1];
+      const double x1 = limit[2 * tri[1]], y1 = limit[2 * tri[1] + 1];
+      const double x2 = limit[2 * tri[2]], y2 = limit[2 * tri[2] + 1];
+      const double area = cross(x1 - x0, y1 - y0, x2 - x0, y2 - y0);
+      if (area <= 0) continue;
+      const int px0 = std::max(0, int(std::ceil(std::min({x0, x1, x2}) - 0.5)));
+      const int px1 = std::min(width - 1, int(std::floor(std::max({x0, x1, x2}) - 0.5)));
+      const int py0 = std::max(0, int(std::ceil(std::min({y0, y1, y2}) - 0.5)));
+      const int py1 = std::min(height - 1, int(std::floor(std::max({y0, y1, y2}) - 0.5)));
+      constexpr double kEps = -1e-9;
+      for (int py = py0; py <= py1; ++py) {
+        for (int px = px0; px <= px1; ++px) {
+          Location& loc = located[size_t(py) * width + px];
+          if (loc.triangle >= 0) continue;
+          const double x = px + 0.5, y = py + 0.5;
+          const double b1 = cross(x - x0, y - y0, x2 - x0, y2 - y0) / area;
+          const double b2 = cross(x1 - x0, y1 - y0, x - x0, y - y0) / area;
+          if (b1 < kEps || b2 < kEps || 1 - b1 - b2 < kEps) continue;
+          loc = {t, static_cast<float>(b1), static_cast<float>(b2)};
+        }
+      }
+    }
+    // The band along tears: those pixels get targets filled from their own side.
+    std::vector<uint8_t> band(size_t(width) * height, 0);
+    for (size_t i = 0; i < grid.size(); ++i) {
+      const Segment& sg = grid[static_cast<int32_t>(i)];
+      const int x0 = std::max(0, int(std::floor(std::min(sg.ax, sg.bx) - options.band - 0.5)));
+      const int x1 = std::min(width - 1, int(std::ceil(std::max(sg.ax, sg.bx) + options.band - 0.5)));
+      const int y0 = std::max(0, int(std::floor(std::min(sg.ay, sg.by) - options.band - 0.5)));
+      const int y1 = std::min(height - 1, int(std::ceil(std::max(sg.ay, sg.by) + options.band - 0.5)));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+          if (point_segment_distance(x + 0.5, y + 0.5, sg) < options.band) band[size_t(y) * width + x] = 1;
+    }
+    std::vector<int32_t> nearby;
+    const int r = static_cast<int>(std::ceil(options.fill_radius));
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const Location& loc = located[size_t(y) * width + x];
+        if (loc.triangle < 0) continue;
+        std::array<double, 3> target = pixel(image, x, y);
+        if (band[size_t(y) * width + x]) {
+          // Hole filling: inverse-square-distance average of non-band pixels on the same side.
+          const double cx = x + 0.5, cy = y + 0.5;
+          grid.query(cx - r, cy - r, cx + r, cy + r, nearby);
+          std::array<double, 3> sum{0, 0, 0};
+          double wsum = 0;
+          for (int qy = std::max(0, y - r); qy <= std::min(height - 1, y + r); ++qy) {
+            for (int qx = std::max(0, x - r); qx <= std::min(width - 1, x + r); ++qx) {
+              if (band[size_t(qy) * width + qx]) continue;
+              const double d2 = double(qx - x) * (qx - x) + double(qy - y) * (qy - y);
+              if (d2 > options.fill_radius * options.fill_radius) continue;
+              bool blocked = false;
+              for (int32_t i : nearby) {
+                if (segments_cross(cx, cy, qx + 0.5, qy + 0.5, grid[i])) {
+                  blocked = true;
+                  break;
+                }
+              }
+              if (blocked) continue;
+              const auto q = pixel(image, qx, qy);
+              for (int k = 0; k < 3; ++k) sum[k] += q[k] / d2;
+              wsum += 1 / d2;
+            }
+          }
+          if (wsum == 0) continue;  // nothing on this side nearby: leave the pixel out
+          for (int k = 0; k < 3; ++k) target[k] = sum[k] / wsum;
+          ++stats.filled;
+        }
+        const Tri& values = refined.triangle_colors[loc.triangle];
+        const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
+        add_row(values.data(), w, 3, target);
+      }
+    }
+  } else {
+    // The paper's fit: one row per refined color value, its target sampled at its limit position
+    // (values on a tear sample slightly inside their own side).
+    std::vector<double> sx(m, 0), sy(m, 0), cnt(m, 0);
+    std::vector<int32_t> vertex_of(m, -1);
+    for (int t = 0; t < refined.num_triangles(); ++t) {
+      const Tri& tri = refined.triangles[t];
+      const double cx = (limit[2 * tri[0]] + limit[2 * tri[1]] + limit[2 * tri[2]]) / 3;
+      const double cy = (limit[2 * tri[0] + 1] + limit[2 * tri[1] + 1] + limit[2 * tri[2] + 1]) / 3;
+      for (int k = 0; k < 3; ++k) {
+        const int32_t value = refined.triangle_colors[t][k];
+        vertex_of[value] = tri[k];
+        sx[value] += cx, sy[value] += cy, cnt[value] += 1;
+      }
+    }
+    std::vector<int> values_at_vertex(num_refined, 0);
+    for (int v = 0; v < m; ++v)
+      if (vertex_of[v] >= 0) ++values_at_vertex[vertex_of[v]];
+    for (int v = 0; v < m; ++v) {
+      if (vertex_of[v] < 0) continue;
+      double x = limit[2 * vertex_of[v]], y = limit[2 * vertex_of[v] + 1];
+      if (values_at_vertex[vertex_of[v]] > 1) {
+        const double dx = sx[v] / cnt[v] - x, dy = sy[v] / cnt[v] - y, len = std::hypot(dx, dy);
+        if (len > 0) x += 0.75 * dx / len, y += 0.75 * dy / len;
+      }
+      const int32_t value = v;
+      const double one = 1.0;
+      add_row(&value, &one, 1, bilinear(image, x, y));
+    }
+  }
+
+  SparseMatrix nref(m, m);
+  nref.setFromTriplets(btb.begin(), btb.end());
+  btb.clear();
+  btb.shrink_to_fit();
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t> st = s.transpose();
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t> normal = st * (nref * s);
+  Eigen::MatrixX3d rhs = st * btt;
+
+  // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches.
+  const double scale = normal.diagonal().sum() / std::max(1, c);
+  const double lambda = options.regularization * std::max(scale, 1e-12);
+  for (int i = 0; i < c; ++i) {
+    normal.coeffRef(i, i) += lambda;
+    rhs(i, 0) += lambda * mesh.colors[i].r;
+    rhs(i, 1) += lambda * mesh.colors[i].g;
+    rhs(i, 2) += lambda * mesh.colors[i].b;
+  }
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> solver(normal);
+  if (solver.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, "color fit: normal equations are singular");
+  const Eigen::MatrixX3d x = solver.solve(rhs);
+  for (int i = 0; i < c; ++i) {
+    mesh.colors[i] = {static_cast<float>(x(i, 0)), static_cast<float>(x(i, 1)), static_cast<float>(x(i, 2))};
+  }
+
+  // Residual over the fitted pixels (the paper's error, before 8-bit rounding).
+  if (options.target == ColorFitTarget::kPixels) {
+    const Eigen::MatrixX3d values = s * x;
+    double sum = 0, abs_sum = 0;
+    long n = 0;
+    for (int y = 0; y < height; ++y) {
+      for (int px = 0; px < width; ++px) {
+        const Location& loc = located[size_t(y) * width + px];
+        if (loc.triangle < 0) continue;
+        const Tri& v = refined.triangle_colors[loc.triangle];
+        const auto target = pixel(image, px, y);
+        for (int k = 0; k < 3; ++k) {
+          const double pred = (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
+          sum += (pred - target[k]) * (pred - target[k]);
+          abs_sum += std::abs(std::clamp(std::round(pred), 0.0, 255.0) - target[k]);
+        }
+        n += 3;
+      }
+    }
+    stats.rms = n ? std::sqrt(sum / double(n)) : 0;
+    stats.mae = n ? abs_sum / double(n) : 0;
+  }
+  return stats;
+}
+
+}  // namespace subvec

@@ -1,0 +1,179 @@
+// The dense initial mesh. This is the only translation unit that includes CGAL (it compiles
+// slowly); everything CGAL-specific stays in this file.
+#include "subvec/vectorize/initial_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_plus_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+
+namespace subvec {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<int32_t, Kernel>;
+using FaceBase = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
+// Exact_predicates_tag: constraints may cross (features that touch after subpixel location);
+// CGAL then inserts their intersection point instead of throwing.
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
+using CdtPlus = CGAL::Constrained_triangulation_plus_2<Cdt>;
+using Point = Kernel::Point_2;
+
+double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+// Bilinear sample of the image at (x, y) in image coordinates (pixel centres at +0.5).
+Color sample(const Image8& image, double x, double y) {
+  const double fx = std::clamp(x - 0.5, 0.0, double(image.width - 1));
+  const double fy = std::clamp(y - 0.5, 0.0, double(image.height - 1));
+  const int x0 = std::min(int(fx), image.width - 1), y0 = std::min(int(fy), image.height - 1);
+  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
+  const double ax = fx - x0, ay = fy - y0;
+  float c[3];
+  for (int k = 0; k < 3; ++k) {
+    auto at = [&](int xx, int yy) { return double(image.row(yy)[xx * image.channels + k]); };
+    c[k] = static_cast<float>((1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
+                              ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1)));
+  }
+  return {c[0], c[1], c[2]};
+}
+
+}  // namespace
+
+ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
+                               const InitialMeshOptions& options) {
+  const int w = image.width, h = image.height;
+  if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
+
+  // Grid points closer than min_grid_distance to a feature would make slivers: drop them.
+  std::vector<uint8_t> dropped(size_t(w) * h, 0);
+  const double r = options.min_grid_distance;
+  for (const DetectedFeature& f : features) {
+    for (size_t i = 0; i + 1 < f.points.size(); ++i) {
+      const Vec2 a = f.points[i], b = f.points[i + 1];
+      const int x0 = std::max(0, int(std::floor(std::min(a.x, b.x) - r - 0.5)));
+      const int x1 = std::min(w - 1, int(std::ceil(std::max(a.x, b.x) + r - 0.5)));
+      const int y0 = std::max(0, int(std::floor(std::min(a.y, b.y) - r - 0.5)));
+      const int y1 = std::min(h - 1, int(std::ceil(std::max(a.y, b.y) + r - 0.5)));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+          if (segment_distance({x + 0.5, y + 0.5}, a, b) < r) dropped[size_t(y) * w + x] = 1;
+    }
+  }
+
+  std::vector<Point> points;
+  points.reserve(size_t(w) * h + 2 * size_t(w + h) + 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
+  // The border: corners and one vertex per pixel along each side.
+  points.emplace_back(0, 0), points.emplace_back(w, 0), points.emplace_back(w, h), points.emplace_back(0, h);
+  for (int x = 0; x < w; ++x) points.emplace_back(x + 0.5, 0), points.emplace_back(x + 0.5, h);
+  for (int y = 0; y < h; ++y) points.emplace_back(0, y + 0.5), points.emplace_back(w, y + 0.5);
+
+  CdtPlus cdt;
+  cdt.insert(points.begin(), points.end());
+  std::vector<CdtPlus::Constraint_id> ids;
+  for (const DetectedFeature& f : features) {
+    std::vector<Point> poly;
+    const size_t n = f.closed() ? f.points.size() - 1 : f.points.size();
+    for (size_t i = 0; i < n; ++i) {
+      const Vec2 p{std::clamp(f.points[i].x, 0.0, double(w)), std::clamp(f.points[i].y, 0.0, double(h))};
+      if (poly.empty() || poly.back() != Point(p.x, p.y)) poly.emplace_back(p.x, p.y);
+    }
+    if (poly.size() < 2) continue;
+    ids.push_back(cdt.insert_constraint(poly.begin(), poly.end(), f.closed()));
+  }
+
+  ControlMesh mesh;
+  int32_t next = 0;
+  for (auto v : cdt.finite_vertex_handles()) {
+    v->info() = next++;
+    mesh.positions.push_back({v->point().x(), v->point().y()});
+  }
+  for (auto f : cdt.finite_face_handles()) {
+    mesh.triangles.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()});
+  }
+
+  // Features: each constraint's vertex sequence (including any intersection vertices CGAL added),
+  // split where an edge is already claimed by an earlier feature or lies on the border.
+  std::set<std::pair<int32_t, int32_t>> claimed;
+  auto on_border = [&](int32_t a, int32_t b) {
+    const Vec2 p = mesh.positions[a], q = mesh.positions[b];
+    return (p.x == 0 && q.x == 0) || (p.y == 0 && q.y == 0) || (p.x == w && q.x == w) || (p.y == h && q.y == h);
+  };
+  int32_t feature_id = 0;
+  for (CdtPlus::Constraint_id cid : ids) {
+    std::vector<int32_t> chain;
+    for (auto it = cdt.vertices_in_constraint_begin(cid); it != cdt.vertices_in_constraint_end(cid); ++it) {
+      const int32_t v = (*it)->info();
+      if (chain.empty() || chain.back() != v) chain.push_back(v);
+    }
+    Feature current;
+    auto flush = [&] {
+      if (current.vertices.size() >= 2) {
+        current.id = feature_id++;
+        mesh.features.push_back(std::move(current));
+      }
+      current = Feature{};
+    };
+    for (size_t i = 0; i + 1 < chain.size(); ++i) {
+      const int32_t a = chain[i], b = chain[i + 1];
+      const auto key = std::minmax(a, b);
+      if (on_border(a, b) || !claimed.insert({key.first, key.second}).second) {
+        flush();
+        continue;
+      }
+      if (current.vertices.empty()) current.vertices.push_back(a);
+      current.vertices.push_back(b);
+    }
+    flush();
+  }
+
+  // Face-varying colors: one value per tear-bounded sector of each vertex, sampled on its side.
+  int num_colors = 0;
+  mesh.triangle_colors = face_varying_indices(mesh, MeshTopology::build(mesh, w, h), num_colors);
+  std::vector<Vec2> toward(num_colors, Vec2{0, 0});
+  std::vector<int32_t> owner(num_colors, -1);
+  std::vector<int> sectors(mesh.num_vertices(), 0);
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const Tri& t = mesh.triangles[f];
+    const Vec2 c{(mesh.positions[t[0]].x + mesh.positions[t[1]].x + mesh.positions[t[2]].x) / 3,
+                 (mesh.positions[t[0]].y + mesh.positions[t[1]].y + mesh.positions[t[2]].y) / 3};
+    for (int k = 0; k < 3; ++k) {
+      const int32_t ci = mesh.triangle_colors[f][k];
+      if (owner[ci] < 0) {
+        owner[ci] = t[k];
+        ++sectors[t[k]];
+      }
+      const Vec2 p = mesh.positions[t[k]];
+      const double len = std::hypot(c.x - p.x, c.y - p.y);
+      if (len > 0) toward[ci].x += (c.x - p.x) / len, toward[ci].y += (c.y - p.y) / len;
+    }
+  }
+  mesh.colors.resize(num_colors);
+  for (int ci = 0; ci < num_colors; ++ci) {
+    const int32_t v = owner[ci];
+    Vec2 p = mesh.positions[v];
+    if (sectors[v] > 1) {  // a vertex on a tear: sample inside this side
+      const double len = std::hypot(toward[ci].x, toward[ci].y);
+      if (len > 0) p.x += options.side_offset * toward[ci].x / len, p.y += options.side_offset * toward[ci].y / len;
+    }
+    mesh.colors[ci] = sample(image, p.x, p.y);
+  }
+  return mesh;
+}
+
+}  // namespace subvec

@@ -1,0 +1,805 @@
+// Constrained 5D QEM simplification with feature refitting (paper §4).
+//
+// Design note. The mesh is index-based: positions, triangles, per-corner color indices, and a
+// per-vertex list of incident faces that collapses keep current. Quadrics live on color indices,
+// not vertices: a vertex on a tear has one color per side, so each side accumulates its own 5D
+// quadric and a collapse along a tear merges the quadrics side by side. Colors are eliminated from
+// every quadric in closed form (Schur complement), leaving a 2D quadric in the position, so the
+// cost of a placement is cheap to evaluate and the best point on the edge has a closed form.
+//
+// Constraints (paper §4, and the model's invariants): corners never move; a border vertex
+// collapses only into a neighbour along the same border side; a tear vertex only into its
+// neighbour along the same feature, after which the feature's nearby control vertices are refitted
+// by least squares to the detected polyline (eq. 1) and the collapse is rolled back if the limit
+// curve (a uniform cubic B-spline of the chain, corners interpolated) leaves it by more than
+// max_feature_error. No collapse may break the link condition or flip or flatten a triangle.
+#include "subvec/vectorize/simplify.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <unordered_set>
+
+#include <Eigen/Dense>
+
+#include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+
+namespace subvec {
+namespace {
+
+using Mat5 = Eigen::Matrix<double, 5, 5>;
+using Vec5 = Eigen::Matrix<double, 5, 1>;
+
+// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b).
+struct Quadric {
+  Mat5 a = Mat5::Zero();
+  Vec5 b = Vec5::Zero();
+  double c = 0;
+  Quadric& operator+=(const Quadric& o) {
+    a += o.a, b += o.b, c += o.c;
+    return *this;
+  }
+};
+
+// Garland-Heckbert quadric of the plane through three 5D points, weighted by the xy area.
+Quadric triangle_quadric(const Vec5& p, const Vec5& q, const Vec5& r) {
+  Quadric out;
+  Vec5 e1 = q - p;
+  const double l1 = e1.norm();
+  if (l1 <= 0) return out;
+  e1 /= l1;
+  Vec5 e2 = r - p;
+  e2 -= e1.dot(e2) * e1;
+  const double l2 = e2.norm();
+  if (l2 <= 0) return out;
+  e2 /= l2;
+  const double area = 0.5 * std::abs((q(0) - p(0)) * (r(1) - p(1)) - (q(1) - p(1)) * (r(0) - p(0)));
+  const double pe1 = p.dot(e1), pe2 = p.dot(e2);
+  out.a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
+  out.b = area * (pe1 * e1 + pe2 * e2 - p);
+  out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
+  return out;
+}
+
+// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p.
+struct Quadric2 {
+  Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  double k = 0;
+  double operator()(const Eigen::Vector2d& p) const { return p.dot(m * p) + 2 * g.dot(p) + k; }
+  Quadric2& operator+=(const Quadric2& o) {
+    m += o.m, g += o.g, k += o.k;
+    return *this;
+  }
+};
+
+Quadric2 reduce(const Quadric& q) {
+  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix<double, 3, 2> acp = q.a.block<3, 2>(2, 0);
+  const Eigen::Matrix3d inv = acc.inverse();
+  Quadric2 r;
+  r.m = q.a.block<2, 2>(0, 0) - acp.transpose() * inv * acp;
+  r.g = q.b.head<2>() - acp.transpose() * inv * q.b.tail<3>();
+  r.k = q.c - q.b.tail<3>().dot(inv * q.b.tail<3>());
+  return r;
+}
+
+// Colors minimizing q at position p.
+Eigen::Vector3d best_color(const Quadric& q, const Eigen::Vector2d& p) {
+  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
+  return -acc.inverse() * (q.a.block<3, 2>(2, 0) * p + q.b.tail<3>());
+}
+
+int64_t edge_key(int32_t a, int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (int64_t{a} << 32) | static_cast<uint32_t>(b);
+}
+
+enum class Kind : uint8_t { kSmooth, kBorder, kFeature, kCorner };
+
+// Uniform cubic B-spline basis on a segment, s in [0, 1].
+std::array<double, 4> bspline(double s) {
+  const double t = 1 - s;
+  return {t * t * t / 6, (3 * s * s * s - 6 * s * s + 4) / 6, (-3 * s * s * s + 3 * s * s + 3 * s + 1) / 6,
+          s * s * s / 6};
+}
+
+// Feature chains are doubly linked lists of nodes, so that removing a vertex and visiting its
+// neighbourhood along the chain cost O(1) whatever the feature's length.
+struct Node {
+  int32_t vertex;
+  int32_t prev = -1, next = -1;  // -1 at the ends of an open chain
+  double param;                  // position along the detected polyline, in target indices
+  bool alive = true;
+};
+
+struct FeatureState {
+  int32_t head = -1;            // first node (any node of a closed chain)
+  int32_t size = 0;             // live nodes
+  std::vector<Vec2> target;     // the detected polyline (initial chain positions)
+  bool closed = false;
+  int32_t id = 0;
+  double saliency = 0;
+};
+
+// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries), which
+// halves the depth and the cache misses of a binary heap; the lazy collapse queue is dominated by
+// them.
+template <class T>
+class QuadHeap {
+ public:
+  bool empty() const { return v_.empty(); }
+  size_t size() const { return v_.size(); }
+  const T& top() const { return v_.front(); }
+  void clear() { v_.clear(); }
+  void push(const T& x) {
+    size_t i = v_.size();
+    v_.push_back(x);
+    while (i > 0) {
+      const size_t parent = (i - 1) / 4;
+      if (!(x < v_[parent])) break;
+      v_[i] = v_[parent];
+      i = parent;
+    }
+    v_[i] = x;
+  }
+  void pop() {
+    const T x = v_.back();
+    v_.pop_back();
+    if (v_.empty()) return;
+    const size_t n = v_.size();
+    size_t i = 0;
+    while (true) {
+      const size_t first = 4 * i + 1;
+      if (first >= n) break;
+      size_t best = first;
+      const size_t last = std::min(first + 4, n);
+      for (size_t c = first + 1; c < last; ++c)
+        if (v_[c] < v_[best]) best = c;
+      if (!(v_[best] < x)) break;
+      v_[i] = v_[best];
+      i = best;
+    }
+    v_[i] = x;
+  }
+
+ private:
+  std::vector<T> v_;
+};
+
+class Simplifier {
+ public:
+  Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options)
+      : mesh_(mesh), w_(width), h_(height), options_(options) {}
+
+  SimplifyStats run();
+
+ private:
+  struct Plan {
+    double cost = std::numeric_limits<double>::infinity();
+    int32_t remove = -1, keep = -1;
+    Vec2 position;
+  };
+  // A heap entry: 16 bytes, so that the lazy heap (stale entries are skipped when popped) stays
+  // cache friendly. Versions are truncated: an entry that survives a wrap-around is still fully
+  // re-planned and checked before it collapses anything.
+  struct Entry {
+    float cost;
+    int32_t remove, keep;
+    uint16_t version_remove, version_keep;
+    bool operator<(const Entry& o) const {  // cheaper first, ties by indices (determinism)
+      if (cost != o.cost) return cost < o.cost;
+      if (remove != o.remove) return remove < o.remove;
+      return keep < o.keep;
+    }
+  };
+
+  void setup();
+  Plan plan(int32_t a, int32_t b) const;
+  Plan plan_direction(int32_t u, int32_t v) const;
+  void push_edges(int32_t v);
+  bool try_collapse(const Plan& e);
+  void push(const Plan& p);
+  void rebuild_heap();
+  void neighbours(int32_t v, std::vector<int32_t>& out) const;
+  int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
+  bool link_condition(int32_t u, int32_t v) const;
+  bool feature_neighbour(int32_t u, int32_t v) const;
+  double signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved, int num_moved) const;
+  void write_back();
+
+  // Feature refit for the removal of node `removed`: fills moved vertices and returns the largest
+  // parametric error of the affected piece of curve.
+  double refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved, int& num_moved) const;
+
+  ControlMesh& mesh_;
+  int w_, h_;
+  SimplifyOptions options_;
+  SimplifyStats stats_;
+
+  std::vector<Vec2> pos_;
+  std::vector<Tri> tri_, tcol_;
+  std::vector<uint8_t> face_alive_, vertex_alive_;
+  std::vector<std::vector<int32_t>> vfaces_;
+  std::vector<Kind> kind_;
+  std::vector<uint8_t> sides_;     // bit mask: 1 x=0, 2 y=0, 4 x=W, 8 y=H
+  std::vector<int32_t> feature_;   // feature index of tear vertices, else -1
+  std::vector<int32_t> node_of_;   // node of tear vertices, else -1
+  std::vector<Node> nodes_;
+  std::unordered_set<int64_t> tear_edges_;  // (min << 32 | max) of every feature edge
+  std::vector<uint32_t> version_;
+  std::vector<Quadric> quadric_;   // per color index
+  std::vector<FeatureState> features_;
+  QuadHeap<Entry> heap_;
+  int alive_vertices_ = 0;
+};
+
+void Simplifier::setup() {
+  const MeshTopology topo = MeshTopology::build(mesh_, w_, h_);
+  const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
+  pos_ = mesh_.positions;
+  tri_ = mesh_.triangles;
+  tcol_ = mesh_.triangle_colors;
+  face_alive_.assign(nf, 1);
+  vertex_alive_.assign(nv, 1);
+  alive_vertices_ = nv;
+  vfaces_.assign(nv, {});
+  for (int f = 0; f < nf; ++f)
+    for (int v : tri_[f]) vfaces_[v].push_back(f);
+  version_.assign(nv, 0);
+
+  kind_.resize(nv);
+  sides_.assign(nv, 0);
+  for (int v = 0; v < nv; ++v) {
+    const Vec2 p = pos_[v];
+    sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == w_ ? 4 : 0) | (p.y == h_ ? 8 : 0));
+    switch (topo.vertex_tags[v]) {
+      case VertexTag::kSmooth: kind_[v] = Kind::kSmooth; break;
+      case VertexTag::kTear: kind_[v] = Kind::kFeature; break;
+      case VertexTag::kCrease: kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner; break;  // interior creases stay
+      case VertexTag::kCorner: kind_[v] = Kind::kCorner; break;
+    }
+  }
+
+  feature_.assign(nv, -1);
+  node_of_.assign(nv, -1);
+  for (const Feature& f : mesh_.features) {
+    FeatureState s;
+    s.id = f.id;
+    s.saliency = f.saliency;
+    s.closed = f.closed();
+    const size_t n = f.vertices.size() - (s.closed ? 1 : 0);
+    const int32_t first = static_cast<int32_t>(nodes_.size());
+    s.head = first;
+    s.size = static_cast<int32_t>(n);
+    for (size_t i = 0; i < n; ++i) {
+      const int32_t v = f.vertices[i];
+      Node node{v, -1, -1, 0.0, true};
+      node.param = static_cast<double>(i);
+      node.prev = i > 0 ? first + static_cast<int32_t>(i) - 1 : (s.closed ? first + static_cast<int32_t>(n) - 1 : -1);
+      node.next = i + 1 < n ? first + static_cast<int32_t>(i) + 1 : (s.closed ? first : -1);
+      s.target.push_back(pos_[v]);
+      if (kind_[v] == Kind::kFeature) {
+        feature_[v] = static_cast<int32_t>(features_.size());
+        node_of_[v] = static_cast<int32_t>(nodes_.size());
+      }
+      nodes_.push_back(node);
+    }
+    features_.push_back(std::move(s));
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) tear_edges_.insert(edge_key(f.vertices[i], f.vertices[i + 1]));
+  }
+
+  // Quadrics per color index from the corners' 5D points.
+  quadric_.assign(mesh_.num_colors(), Quadric{});
+  const double cs = options_.color_scale;
+  for (int f = 0; f < nf; ++f) {
+    Vec5 p[3];
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 x = pos_[tri_[f][k]];
+      const Color c = mesh_.colors[tcol_[f][k]];
+      p[k] << x.x, x.y, cs * c.r, cs * c.g, cs * c.b;
+    }
+    const Quadric q = triangle_quadric(p[0], p[1], p[2]);
+    for (int k = 0; k < 3; ++k) quadric_[tcol_[f][k]] += q;
+  }
+}
+
+void Simplifier::neighbours(int32_t v, std::vector<int32_t>& out) const {
+  out.clear();
+  for (int32_t f : vfaces_[v])
+    for (int32_t w : tri_[f])
+      if (w != v) out.push_back(w);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
+  int n = 0;
+  for (int32_t f : vfaces_[u]) {
+    const Tri& t = tri_[f];
+    if (t[0] == v || t[1] == v || t[2] == v) {
+      if (n < 2) out[n] = f;
+      ++n;
+    }
+  }
+  return n;
+}
+
+// Whether (u, v) is an edge of u's feature chain.
+bool Simplifier::feature_neighbour(int32_t u, int32_t v) const {
+  const int32_t n = node_of_[u];
+  if (n < 0) return false;
+  const Node& node = nodes_[n];
+  return (node.prev >= 0 && nodes_[node.prev].vertex == v) || (node.next >= 0 && nodes_[node.next].vertex == v);
+}
+
+Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
+  Plan p;
+  const Kind ku = kind_[u], kv = kind_[v];
+  if (ku == Kind::kCorner) return p;
+  int32_t faces[2];
+  const int nfaces = faces_with_edge(u, v, faces);
+  if (nfaces < 1 || nfaces > 2) return p;
+  switch (ku) {
+    case Kind::kSmooth:
+      break;
+    case Kind::kBorder:
+      if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
+      break;
+    case Kind::kFeature:
+      if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
+      if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
+      break;
+    case Kind::kCorner:
+      return p;
+  }
+  if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
+
+  // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
+  Quadric2 r;
+  int32_t pairs[2][2];
+  int npairs = 0;
+  for (int i = 0; i < nfaces; ++i) {
+    const Tri& t = tri_[faces[i]];
+    int32_t cu = -1, cv = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] == u) cu = tcol_[faces[i]][k];
+      if (t[k] == v) cv = tcol_[faces[i]][k];
+    }
+    if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
+    pairs[npairs][0] = cu, pairs[npairs][1] = cv;
+    ++npairs;
+  }
+  for (int i = 0; i < npairs; ++i) {
+    Quadric q = quadric_[pairs[i][0]];
+    q += quadric_[pairs[i][1]];
+    r += reduce(q);
+  }
+  const Eigen::Vector2d pu(pos_[u].x, pos_[u].y), pv(pos_[v].x, pos_[v].y);
+  Eigen::Vector2d best = pv;
+  if (ku == Kind::kSmooth && kv == Kind::kSmooth) {
+    // Best point on the segment: R(pu + t (pv - pu)) is quadratic in t.
+    const Eigen::Vector2d d = pv - pu;
+    const double a = d.dot(r.m * d), b = 2 * (d.dot(r.m * pu) + r.g.dot(d));
+    const double t = a > 1e-12 ? std::clamp(-b / (2 * a), 0.0, 1.0) : 0.5;
+    best = pu + t * d;
+  }
+  p.cost = std::max(0.0, r(best));
+  p.remove = u, p.keep = v;
+  p.position = {best.x(), best.y()};
+  return p;
+}
+
+Simplifier::Plan Simplifier::plan(int32_t a, int32_t b) const {
+  // Between two smooth vertices both directions give the same optimum on the segment.
+  if (kind_[a] == Kind::kSmooth && kind_[b] == Kind::kSmooth) return plan_direction(std::max(a, b), std::min(a, b));
+  Plan p = plan_direction(a, b), q = plan_direction(b, a);
+  return q.cost < p.cost ? q : p;
+}
+
+void Simplifier::push_edges(int32_t v) {
+  thread_local std::vector<int32_t> ring;
+  neighbours(v, ring);
+  for (int32_t w : ring) {
+    push(plan(v, w));
+  }
+}
+
+void Simplifier::push(const Plan& p) {
+  if (p.remove < 0 || !std::isfinite(p.cost)) return;
+  heap_.push({static_cast<float>(p.cost), p.remove, p.keep, static_cast<uint16_t>(version_[p.remove]),
+              static_cast<uint16_t>(version_[p.keep])});
+}
+
+// Re-plans every live edge into a fresh heap, dropping the stale entries that pile up.
+void Simplifier::rebuild_heap() {
+  heap_.clear();
+  thread_local std::vector<int32_t> ring;
+  for (int32_t v = 0; v < static_cast<int32_t>(pos_.size()); ++v) {
+    if (!vertex_alive_[v]) continue;
+    neighbours(v, ring);
+    for (int32_t w : ring)
+      if (w > v) push(plan(v, w));
+  }
+}
+
+bool Simplifier::link_condition(int32_t u, int32_t v) const {
+  thread_local std::vector<int32_t> ru, rv;
+  neighbours(u, ru);
+  neighbours(v, rv);
+  int common = 0;
+  for (size_t i = 0, j = 0; i < ru.size() && j < rv.size();) {
+    if (ru[i] < rv[j]) ++i;
+    else if (ru[i] > rv[j]) ++j;
+    else ++common, ++i, ++j;
+  }
+  int32_t faces[2];
+  return common == faces_with_edge(u, v, faces);
+}
+
+double Simplifier::signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved,
+                               int num_moved) const {
+  Vec2 p[3];
+  for (int k = 0; k < 3; ++k) {
+    p[k] = pos_[t[k]];
+    for (int i = 0; i < num_moved; ++i)
+      if (moved[i].first == t[k]) p[k] = moved[i].second;
+  }
+  return 0.5 * ((p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x));
+}
+
+double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved,
+                         int& num_moved) const {
+  // The limit curve of a chain is the uniform cubic B-spline of its control vertices; at a corner
+  // (feature end or junction) it ends with the phantom point 2 Q0 - Q1, which is what the crease
+  // masks with a fixed corner produce. The B-spline is local, so only a window of five nodes on
+  // each side of the removal matters: up to two free nodes per side, the segments they touch, and
+  // fixed context beyond. Windows stop early at corners ("hard" ends).
+  const Node& r = nodes_[removed];
+  const FeatureState& f = features_[feature_[r.vertex]];
+  const int total = static_cast<int>(f.target.size());
+  constexpr int kReach = 5;
+  std::array<int32_t, 2 * kReach + 1> back{}, fwd{};
+  int nb = 0, nf = 0;
+  bool hard_start = false, hard_end = false;
+  for (int32_t n = r.prev;; n = nodes_[n].prev) {
+    if (n < 0 || n == removed) { hard_start = true; break; }
+    back[nb++] = n;
+    if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_start = true; break; }
+    if (nb == kReach) break;
+  }
+  for (int32_t n = r.next;; n = nodes_[n].next) {
+    if (n < 0 || n == removed) { hard_end = true; break; }
+    if (nb > 0 && n == back[nb - 1] && !hard_start) break;  // a short loop met itself
+    fwd[nf++] = n;
+    if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_end = true; break; }
+    if (nf == kReach) break;
+  }
+  // Window w_0..w_K in chain order; `centre` is the index of the node after the removal.
+  std::array<int32_t, 2 * kReach + 2> win{};
+  int count = 0;
+  for (int i = nb - 1; i >= 0; --i) win[count++] = back[i];
+  const int centre = count;
+  for (int i = 0; i < nf; ++i) win[count++] = fwd[i];
+  // A short closed loop: the window wraps onto itself; treat the whole loop as periodic.
+  bool periodic = false;
+  if (f.closed && !hard_start && !hard_end && f.size - 1 <= 2 * kReach) {
+    std::vector<int32_t> loop;
+    for (int32_t n = r.next; n != removed && static_cast<int>(loop.size()) < f.size; n = nodes_[n].next) loop.push_back(n);
+    count = 0;
+    for (int32_t n : loop) win[count++] = n;
+    periodic = true;
+  }
+  const int K = count - 1;
+  if (K < 1) return 0;
+  auto slot_ok = [&](int k) { return periodic || (k >= 0 && k <= K); };
+  auto wrap = [&](int k) { return periodic ? ((k % count) + count) % count : k; };
+  // Free nodes: tear vertices among the two before and two after the removal.
+  std::array<int, 4> free_slots{};
+  int nfree = 0;
+  for (int k = periodic ? 0 : centre - 2; k <= (periodic ? K : centre + 1); ++k) {
+    if (!slot_ok(k)) continue;
+    if (periodic && nfree == 4) break;
+    if (kind_[nodes_[win[wrap(k)]].vertex] == Kind::kFeature) free_slots[nfree++] = wrap(k);
+  }
+  // Segments k (between w_k and w_{k+1}) that the removal or a free node can change, and that the
+  // window can evaluate (soft ends need one more node of context).
+  const int nseg = periodic ? count : K;
+  int seg_lo = periodic ? 0 : centre - 4, seg_hi = periodic ? nseg - 1 : centre + 2;
+  if (!periodic) {
+    seg_lo = std::max(seg_lo, hard_start ? 0 : 1);
+    seg_hi = std::min(seg_hi, hard_end ? K - 1 : K - 2);
+  }
+  if (seg_hi < seg_lo) return 0;
+
+  struct Row {
+    std::array<std::pair<int, double>, 6> w;
+    int nw = 0;
+    Vec2 target;
+  };
+  thread_local std::vector<Row> rows;
+  rows.clear();
+  for (int k = seg_lo; k <= seg_hi; ++k) {
+    const double p0 = nodes_[win[wrap(k)]].param;
+    double p1 = nodes_[win[wrap(k + 1)]].param;
+    if (p1 <= p0) p1 += total;  // wraps around a closed target
+    const int j_begin = static_cast<int>(std::ceil(p0));
+    const int j_end = static_cast<int>(std::floor(p1)) - (k < seg_hi && p1 == std::floor(p1) ? 1 : 0);
+    for (int j = j_begin; j <= j_end; ++j) {
+      const double s = (j - p0) / (p1 - p0);
+      const auto b = bspline(s);
+      Row row;
+      row.target = f.target[((j % total) + total) % total];
+      auto add = [&](int slot, double weight) {
+        for (int i = 0; i < row.nw; ++i) {
+          if (row.w[i].first == slot) {
+            row.w[i].second += weight;
+            return;
+          }
+        }
+        row.w[row.nw++] = {slot, weight};
+      };
+      for (int i = 0; i < 4; ++i) {
+        const int kk = k - 1 + i;
+        if (periodic || (kk >= 0 && kk <= K)) {
+          add(wrap(kk), b[i]);
+        } else if (kk < 0) {  // phantom 2 w0 - w1 at a hard start
+          add(0, 2 * b[i]), add(1, -b[i]);
+        } else {  // phantom 2 wK - w(K-1) at a hard end
+          add(K, 2 * b[i]), add(K - 1, -b[i]);
+        }
+      }
+      rows.push_back(row);
+    }
+  }
+
+  std::array<Vec2, 2 * kReach + 2> q;
+  for (int i = 0; i < count; ++i) q[i] = pos_[nodes_[win[i]].vertex];
+  if (nfree > 0 && !rows.empty()) {
+    // Normal equations of the small least-squares problem (eq. 1), x and y at once, with a light
+    // pull toward the current positions for free nodes that no target point constrains.
+    Eigen::Matrix4d ata = Eigen::Matrix4d::Zero();
+    Eigen::Matrix<double, 4, 2> atb = Eigen::Matrix<double, 4, 2>::Zero();
+    for (const Row& row : rows) {
+      double coef[4] = {0, 0, 0, 0};
+      double bx = row.target.x, by = row.target.y;
+      for (int i = 0; i < row.nw; ++i) {
+        const auto [slot, weight] = row.w[i];
+        int fi = -1;
+        for (int j = 0; j < nfree; ++j)
+          if (free_slots[j] == slot) fi = j;
+        if (fi >= 0) {
+          coef[fi] += weight;
+        } else {
+          bx -= weight * q[slot].x, by -= weight * q[slot].y;
+        }
+      }
+      for (int a = 0; a < nfree; ++a) {
+        for (int b = 0; b < nfree; ++b) ata(a, b) += coef[a] * coef[b];
+        atb(a, 0) += coef[a] * bx, atb(a, 1) += coef[a] * by;
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      const double reg = i < nfree ? 1e-3 : 1.0;
+      ata(i, i) += reg;
+      if (i < nfree) atb(i, 0) += reg * q[free_slots[i]].x, atb(i, 1) += reg * q[free_slots[i]].y;
+    }
+    const Eigen::Matrix<double, 4, 2> x = ata.ldlt().solve(atb);
+    for (int i = 0; i < nfree && num_moved < 8; ++i) {
+      q[free_slots[i]] = {x(i, 0), x(i, 1)};
+      moved[num_moved++] = {nodes_[win[free_slots[i]]].vertex, q[free_slots[i]]};
+    }
+  }
+  double worst = 0;
+  for (const Row& row : rows) {
+    double x = 0, y = 0;
+    for (int i = 0; i < row.nw; ++i) x += row.w[i].second * q[row.w[i].first].x, y += row.w[i].second * q[row.w[i].first].y;
+    worst = std::max(worst, std::hypot(x - row.target.x, y - row.target.y));
+  }
+  return worst;
+}
+
+bool Simplifier::try_collapse(const Plan& e) {
+  const int32_t u = e.remove, v = e.keep;
+  if (!link_condition(u, v)) {
+    ++stats_.rejected_topology;
+    return false;
+  }
+  // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
+  {
+    int32_t faces[2];
+    const int nfaces = faces_with_edge(u, v, faces);
+    for (int i = 0; i < std::min(nfaces, 2); ++i) {
+      for (int32_t w : tri_[faces[i]]) {
+        if (w != u && w != v && tear_edges_.count(edge_key(u, w)) && tear_edges_.count(edge_key(v, w))) {
+          ++stats_.rejected_topology;
+          return false;
+        }
+      }
+    }
+  }
+  std::array<std::pair<int32_t, Vec2>, 8> moved;
+  int num_moved = 0;
+  moved[num_moved++] = {u, e.position};  // u takes v's place (its faces get v)
+  moved[num_moved++] = {v, e.position};
+
+  // A collapse along a feature: the chain loses u, then its neighbourhood is refitted.
+  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
+  if (removed_node >= 0) {
+    const double error = refit(removed_node, moved, num_moved);
+    if (error > options_.max_feature_error) {
+      ++stats_.rejected_feature;
+      return false;
+    }
+    stats_.max_feature_error = std::max(stats_.max_feature_error, error);
+  }
+
+  // No flipped or degenerate triangle among everything that moves.
+  constexpr double kMinArea = 1e-4;
+  auto faces_ok = [&](int32_t x) {
+    for (int32_t f : vfaces_[x]) {
+      Tri t = tri_[f];
+      bool has_u = false, has_v = false;
+      for (int32_t& w : t) {
+        has_u |= w == u;
+        has_v |= w == v;
+      }
+      if (has_u && has_v) continue;  // dies
+      for (int32_t& w : t)
+        if (w == u) w = v;
+      if (signed_area(t, moved, num_moved) <= kMinArea) return false;
+    }
+    return true;
+  };
+  for (int i = 0; i < num_moved; ++i) {
+    if (!faces_ok(moved[i].first)) {
+      ++stats_.rejected_topology;
+      return false;
+    }
+  }
+
+  // Apply: colors of v per side, faces of u handed to v, quadrics merged, chain updated.
+  int32_t faces[2];
+  const int nfaces = faces_with_edge(u, v, faces);
+  std::array<std::pair<int32_t, int32_t>, 2> side;  // (color of u, color of v) per edge face
+  for (int i = 0; i < nfaces; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (tri_[faces[i]][k] == u) side[i].first = tcol_[faces[i]][k];
+      if (tri_[faces[i]][k] == v) side[i].second = tcol_[faces[i]][k];
+    }
+  }
+  for (int i = 0; i < nfaces; ++i) {
+    if (i == 1 && side[1] == side[0]) break;
+    quadric_[side[i].second] += quadric_[side[i].first];
+  }
+  for (int32_t f : vfaces_[u]) {
+    Tri& t = tri_[f];
+    const bool dies = t[0] == v || t[1] == v || t[2] == v;
+    if (dies) {
+      face_alive_[f] = 0;
+      for (int32_t w : t) {
+        if (w == u) continue;
+        auto& list = vfaces_[w];
+        list.erase(std::find(list.begin(), list.end(), f));
+      }
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] != u) continue;
+      t[k] = v;
+      const int32_t cu = tcol_[f][k];
+      tcol_[f][k] = nfaces == 2 && side[1].first == cu ? side[1].second : side[0].second;
+    }
+    vfaces_[v].push_back(f);
+  }
+  vfaces_[u].clear();
+  vertex_alive_[u] = 0;
+  --alive_vertices_;
+  for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
+  if (removed_node >= 0) {  // unlink the node; its two chain edges become one
+    Node& n = nodes_[removed_node];
+    if (n.prev >= 0) tear_edges_.erase(edge_key(u, nodes_[n.prev].vertex));
+    if (n.next >= 0) tear_edges_.erase(edge_key(u, nodes_[n.next].vertex));
+    if (n.prev >= 0 && n.next >= 0) tear_edges_.insert(edge_key(nodes_[n.prev].vertex, nodes_[n.next].vertex));
+    FeatureState& f = features_[feature_[u]];
+    if (n.prev >= 0) nodes_[n.prev].next = n.next;
+    if (n.next >= 0) nodes_[n.next].prev = n.prev;
+    if (f.head == removed_node) f.head = n.next;
+    n.alive = false;
+    --f.size;
+    node_of_[u] = -1;
+  }
+  ++stats_.collapses;
+
+  // Costs change around v and every moved vertex.
+  ++version_[v];
+  push_edges(v);
+  for (int i = 2; i < num_moved; ++i) {
+    ++version_[moved[i].first];
+    push_edges(moved[i].first);
+  }
+  return true;
+}
+
+SimplifyStats Simplifier::run() {
+  setup();
+  rebuild_heap();
+  size_t rebuild_at = 4 * heap_.size();
+  while (alive_vertices_ > options_.target_vertices && !heap_.empty()) {
+    const Entry e = heap_.top();
+    heap_.pop();
+    if (!vertex_alive_[e.remove] || !vertex_alive_[e.keep]) continue;
+    if (static_cast<uint16_t>(version_[e.remove]) != e.version_remove ||
+        static_cast<uint16_t>(version_[e.keep]) != e.version_keep) {
+      continue;
+    }
+    const Plan p = plan_direction(e.remove, e.keep);
+    if (p.remove < 0) continue;
+    try_collapse(p);
+    if (heap_.size() > rebuild_at) {
+      rebuild_heap();
+      rebuild_at = std::max<size_t>(4 * heap_.size(), 1024);
+    }
+  }
+  write_back();
+  return stats_;
+}
+
+void Simplifier::write_back() {
+  ControlMesh out;
+  std::vector<int32_t> vmap(pos_.size(), -1), cmap(quadric_.size(), -1);
+  for (size_t v = 0; v < pos_.size(); ++v) {
+    if (!vertex_alive_[v]) continue;
+    vmap[v] = out.num_vertices();
+    out.positions.push_back(pos_[v]);
+  }
+  std::vector<int32_t> color_vertex;
+  for (size_t f = 0; f < tri_.size(); ++f) {
+    if (!face_alive_[f]) continue;
+    Tri t, c;
+    for (int k = 0; k < 3; ++k) {
+      t[k] = vmap[tri_[f][k]];
+      int32_t& ci = cmap[tcol_[f][k]];
+      if (ci < 0) {
+        ci = static_cast<int32_t>(color_vertex.size());
+        color_vertex.push_back(tri_[f][k]);
+        const Vec2 p = pos_[tri_[f][k]];
+        const Eigen::Vector3d rgb = best_color(quadric_[tcol_[f][k]], {p.x, p.y}) / options_.color_scale;
+        out.colors.push_back({static_cast<float>(rgb(0)), static_cast<float>(rgb(1)), static_cast<float>(rgb(2))});
+      }
+      c[k] = ci;
+    }
+    out.triangles.push_back(t);
+    out.triangle_colors.push_back(c);
+  }
+  for (const EdgeVerts& e : mesh_.creases)
+    if (vmap[e[0]] >= 0 && vmap[e[1]] >= 0) out.creases.push_back({vmap[e[0]], vmap[e[1]]});
+  for (const FeatureState& f : features_) {
+    Feature g;
+    g.id = f.id;
+    g.saliency = f.saliency;
+    int32_t n = f.head;
+    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) g.vertices.push_back(vmap[nodes_[n].vertex]);
+    if (f.closed) g.vertices.push_back(g.vertices.front());
+    out.features.push_back(std::move(g));
+  }
+  mesh_ = std::move(out);
+}
+
+}  // namespace
+
+SimplifyStats simplify(ControlMesh& mesh, int width, int height, const SimplifyOptions& options) {
+  if (options.target_vertices < 4) {
+    throw Error(ErrorCode::kInvalidArgument, "simplify: target of " + std::to_string(options.target_vertices) +
+                                                 " vertices is below the 4 image corners");
+  }
+  if (!(options.max_feature_error > 0) || !(options.color_scale > 0)) {
+    throw Error(ErrorCode::kInvalidArgument, "simplify: max_feature_error and color_scale must be positive");
+  }
+  Simplifier s(mesh, width, height, options);
+  return s.run();
+}
+
+}  // namespace subvec

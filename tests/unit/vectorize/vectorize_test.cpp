@@ -1,0 +1,198 @@
+// Vectorization stages on synthetic images whose answer is known, and the whole pipeline on the
+// shared photographs (../shared/images, skipped with a message when absent).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "subvec/core/error.h"
+#include "subvec/core/metrics.h"
+#include "subvec/io/image_io.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/render/renderer.h"
+#include "subvec/subdiv/subdivision.h"
+#include "subvec/vectorize/vectorize.h"
+
+namespace subvec {
+namespace {
+
+// A disk of radius r at (cx, cy) over a horizontal gradient, anti-aliased by 8x8 supersampling.
+Image8 disk_image(int w, int h, double cx, double cy, double r) {
+  Image8 img(w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double inside = 0;
+      for (int sy = 0; sy < 8; ++sy)
+        for (int sx = 0; sx < 8; ++sx)
+          inside += std::hypot(x + (sx + 0.5) / 8 - cx, y + (sy + 0.5) / 8 - cy) < r ? 1.0 / 64 : 0;
+      const double bg[3] = {40 + 120.0 * x / w, 60.0, 200 - 100.0 * x / w};
+      const double fg[3] = {230, 200 - 60.0 * y / h, 40};
+      uint8_t* p = img.row(y) + 3 * x;
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround(inside * fg[k] + (1 - inside) * bg[k]));
+    }
+  }
+  return img;
+}
+
+TEST(Features, FindsTheDiskBoundaryAtSubpixelAccuracy) {
+  const double cx = 40.3, cy = 37.6, r = 21.4;
+  const Image8 img = disk_image(80, 72, cx, cy, r);
+  const auto features = detect_features(img);
+  ASSERT_EQ(features.size(), 1u);
+  EXPECT_TRUE(features[0].closed());
+  EXPECT_NEAR(features[0].length, 2 * M_PI * r, 0.05 * 2 * M_PI * r);
+  double worst = 0;
+  for (const Vec2& p : features[0].points) worst = std::max(worst, std::abs(std::hypot(p.x - cx, p.y - cy) - r));
+  EXPECT_LT(worst, 0.35);
+}
+
+TEST(Features, FlatAndNoisyImagesHaveNoFeatures) {
+  Image8 flat(64, 48, 3);
+  std::fill(flat.pixels.begin(), flat.pixels.end(), uint8_t{128});
+  EXPECT_TRUE(detect_features(flat).empty());
+  Image8 noise(64, 48, 3);
+  uint32_t state = 12345;
+  for (uint8_t& p : noise.pixels) {
+    state = state * 1664525u + 1013904223u;
+    p = static_cast<uint8_t>(120 + (state >> 29));  // +-4 gray levels of noise
+  }
+  EXPECT_TRUE(detect_features(noise).empty());
+}
+
+TEST(InitialMesh, IsValidAndFollowsTheFeatures) {
+  const Image8 img = disk_image(64, 64, 31.7, 32.2, 17.3);
+  const auto features = detect_features(img);
+  const ControlMesh mesh = build_initial_mesh(img, features);
+  const MeshTopology topo = validate_level(mesh, 64, 64);
+  ASSERT_EQ(mesh.features.size(), 1u);
+  EXPECT_TRUE(mesh.features[0].closed());
+  // Roughly one vertex per pixel, plus the border and the feature, minus what the feature displaced.
+  EXPECT_GT(mesh.num_vertices(), 64 * 64 * 9 / 10);
+  EXPECT_LT(mesh.num_vertices(), 64 * 64 + 4 * 64 + 200);
+  // Each tear vertex has two colors: the disk's on one side, the background's on the other.
+  int split = 0;
+  for (VertexTag tag : topo.vertex_tags) split += tag == VertexTag::kTear;
+  EXPECT_EQ(mesh.num_colors(), mesh.num_vertices() + split);
+}
+
+// Distance from p to the polyline.
+double polyline_distance(const Vec2& p, const std::vector<Vec2>& line) {
+  double best = 1e30;
+  for (size_t i = 0; i + 1 < line.size(); ++i) {
+    const Vec2 a = line[i], b = line[i + 1];
+    const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+    const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0;
+    best = std::min(best, std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy));
+  }
+  return best;
+}
+
+// The limit feature curves of a mesh as refined polylines (depth 4), one list of segments each.
+std::vector<std::array<Vec2, 2>> limit_tear_segments(const ControlMesh& mesh, int w, int h) {
+  const MeshTopology topo = MeshTopology::build(mesh, w, h);
+  const Subdivision sub(mesh, topo, 4);
+  RefinedMesh r;
+  sub.evaluate(mesh.positions, mesh.colors, r);
+  std::vector<std::array<Vec2, 2>> out;
+  for (const EdgeVerts& e : r.tear_edges) {
+    out.push_back({Vec2{r.positions[2 * e[0]], r.positions[2 * e[0] + 1]},
+                   Vec2{r.positions[2 * e[1]], r.positions[2 * e[1] + 1]}});
+  }
+  return out;
+}
+
+// Checks the invariants every vectorization must keep and returns the rendered MAE.
+double check_vectorization(const Image8& img, const VectorizeOptions& options, const char* name) {
+  VectorizeReport report;
+  const VectorImage v = vectorize(img, options, &report);
+  EXPECT_NO_THROW(validate(v)) << name;
+  const ControlMesh& mesh = v.levels[0];
+  // No flipped or degenerate triangle.
+  for (const Tri& t : mesh.triangles) {
+    const Vec2 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+    EXPECT_GT((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x), 1e-4) << name;
+  }
+  // Every detected point of every kept feature lies within 1 px of the limit feature curves.
+  const auto segments = limit_tear_segments(mesh, img.width, img.height);
+  std::vector<Vec2> curve;
+  double worst = 0;
+  for (const auto& target : report.feature_targets) {
+    for (const Vec2& p : target) {
+      double best = 1e30;
+      for (const auto& s : segments) best = std::min(best, polyline_distance(p, {s[0], s[1]}));
+      worst = std::max(worst, best);
+    }
+  }
+  EXPECT_LE(worst, 1.0 + 1e-6) << name;
+  RenderOptions ro;
+  const Image8 rendered = render(v, ro);
+  return compare(img, rendered).mae_mean;
+}
+
+TEST(Vectorize, DiskIsReproducedWithATearOnItsBoundary) {
+  const Image8 img = disk_image(96, 80, 47.2, 38.9, 24.6);
+  VectorizeOptions options;
+  options.vertices = 120;
+  const double mae = check_vectorization(img, options, "disk");
+  EXPECT_LT(mae, 2.0);
+}
+
+TEST(Vectorize, IsDeterministic) {
+  const Image8 img = disk_image(64, 64, 30.2, 33.1, 18.4);
+  VectorizeOptions options;
+  options.vertices = 80;
+  const VectorImage a = vectorize(img, options), b = vectorize(img, options);
+  ASSERT_EQ(a.levels[0].num_vertices(), b.levels[0].num_vertices());
+  EXPECT_EQ(a.levels[0].positions, b.levels[0].positions);
+  EXPECT_EQ(a.levels[0].colors, b.levels[0].colors);
+  EXPECT_EQ(a.levels[0].triangles, b.levels[0].triangles);
+}
+
+TEST(Vectorize, PixelFitBeatsVertexFitAndErrorFallsWithRatio) {
+  const Image8 img = disk_image(96, 96, 44.0, 50.5, 27.5);
+  VectorizeOptions pixel_fit;
+  pixel_fit.vertices = 90;
+  VectorizeOptions vertex_fit = pixel_fit;
+  vertex_fit.fit.target = ColorFitTarget::kRefinedVertices;
+  const double pixel_mae = compare(img, render(vectorize(img, pixel_fit), {})).mae_mean;
+  const double vertex_mae = compare(img, render(vectorize(img, vertex_fit), {})).mae_mean;
+  EXPECT_LT(pixel_mae, vertex_mae);
+  VectorizeOptions finer = pixel_fit;
+  finer.vertices = 400;
+  EXPECT_LT(compare(img, render(vectorize(img, finer), {})).mae_mean, pixel_mae);
+}
+
+TEST(Vectorize, RejectsBadOptions) {
+  const Image8 img = disk_image(32, 32, 16, 16, 8);
+  VectorizeOptions options;
+  options.ratio = 0;
+  EXPECT_THROW(vectorize(img, options), Error);
+  options.ratio = 1.5;
+  EXPECT_THROW(vectorize(img, options), Error);
+  options.ratio = -0.1;
+  EXPECT_THROW(vectorize(img, options), Error);
+  EXPECT_THROW(vectorize(Image8(1, 1, 3), {}), Error);
+}
+
+// The shared photographs: valid meshes, no flips, feature curves within 1 px of the detected
+// features, and an error in the range the quality table reports (docs/quality.md).
+TEST(Vectorize, SharedPhotographs) {
+  const std::filesystem::path dir = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no " << dir << ": shared photographs not present";
+  int count = 0;
+  for (const char* name : {"astronaut", "chelsea", "rocket", "fruits", "butterfly", "home", "squirrel", "apple"}) {
+    const auto path = dir / (std::string(name) + ".png");
+    if (!std::filesystem::exists(path)) continue;
+    const Image8 img = read_image(path);
+    VectorizeOptions options;
+    options.ratio = 0.01;
+    const double mae = check_vectorization(img, options, name);
+    EXPECT_LT(mae, 25.0) << name;
+    ++count;
+  }
+  EXPECT_GT(count, 0);
+}
+
+}  // namespace
+}  // namespace subvec
