@@ -37,7 +37,12 @@ void cached(benchmark::State& state, const RenderOptions& o) {
 void BM_RenderFull512(benchmark::State& state) {
   cached(state, options(512, 512, static_cast<int>(state.range(0))));
 }
-BENCHMARK(BM_RenderFull512)->Arg(0)->Arg(1)->ArgName("threads")->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderFull512)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("threads")
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 void BM_RenderFull512NoAA(benchmark::State& state) {
   RenderOptions o = options(512, 512);

@@ -1,15 +1,15 @@
-// Triangle rasterization with a top-left fill rule, Gouraud shading, tear anti-aliasing and overlays.
-// See raster_p.h for the design; this file is organised as
+// Triangle rasterization with a top-left fill rule, Gouraud shading, tear anti-aliasing and
+// overlays. See raster_p.h for the design; this file is organised as
 //   fixed point and the triangle setup (edge functions, fill rule),
 //   coverage traversal: which samples a triangle owns (shared with the sample_coverage test hook),
 //   shading, the marks of pixels to supersample, the two passes of a band, overlays, rasterize().
-#include "render/raster_p.h"
-
 #include <algorithm>
 #include <bit>
 #include <climits>
 #include <cmath>
 #include <cstring>
+
+#include "render/raster_p.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -42,7 +42,8 @@ int32_t to_fixed(double v) {
   v = v > -kGuard ? v : -kGuard;  // also maps NaN to the guard band
   v = v < kGuard ? v : kGuard;
   // Round half up: floor(v + 0.5), as a truncation of a non-negative value.
-  return static_cast<int32_t>(static_cast<int64_t>(v + (kGuard + 0.5)) - static_cast<int64_t>(kGuard));
+  return static_cast<int32_t>(static_cast<int64_t>(v + (kGuard + 0.5)) -
+                              static_cast<int64_t>(kGuard));
 }
 
 // Floor division of a fixed-point value by one pixel (arithmetic shift floors negatives).
@@ -104,21 +105,28 @@ struct TriangleSetup {
 // magnitude, which floats hold exactly, so the float tests are the integer tests.
 constexpr int32_t kSmall = 8 << kSubpixelBits;
 
-bool is_small(const TriangleSetup& t) { return (t.max_x - t.min_x < kSmall) & (t.max_y - t.min_y < kSmall); }
+bool is_small(const TriangleSetup& t) {
+  return (t.max_x - t.min_x < kSmall) & (t.max_y - t.min_y < kSmall);
+}
 
 // Tests `rows` rows of 4 samples starting at (x, y) (fixed point), sample pitch `step`; returns a
 // mask with bit 4 j + i set for covered sample (i, j) and fills e1, e2 (unbiased) for all lanes.
-[[gnu::always_inline]] inline unsigned test_rows(const TriangleSetup& t, int64_t x, int64_t y, int64_t step, int rows, float* e1s, float* e2s) {
+[[gnu::always_inline]] inline unsigned test_rows(const TriangleSetup& t, int64_t x, int64_t y,
+                                                 int64_t step, int rows, float* e1s, float* e2s) {
   const __m128 lane = _mm_setr_ps(0.f, 1.f, 2.f, 3.f), zero = _mm_setzero_ps();
-  __m128 e0 = _mm_add_ps(_mm_set1_ps(float(t.edge0(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy0 * step))));
-  __m128 e1 = _mm_add_ps(_mm_set1_ps(float(t.edge1(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy1 * step))));
-  __m128 e2 = _mm_add_ps(_mm_set1_ps(float(t.edge2(x, y))), _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy2 * step))));
+  __m128 e0 = _mm_add_ps(_mm_set1_ps(float(t.edge0(x, y))),
+                         _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy0 * step))));
+  __m128 e1 = _mm_add_ps(_mm_set1_ps(float(t.edge1(x, y))),
+                         _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy1 * step))));
+  __m128 e2 = _mm_add_ps(_mm_set1_ps(float(t.edge2(x, y))),
+                         _mm_mul_ps(lane, _mm_set1_ps(float(-t.dy2 * step))));
   const __m128 s0 = _mm_set1_ps(float(t.dx0 * step)), s1 = _mm_set1_ps(float(t.dx1 * step));
   const __m128 s2 = _mm_set1_ps(float(t.dx2 * step));
   const __m128 b1 = _mm_set1_ps(float(t.b1)), b2 = _mm_set1_ps(float(t.b2));
   unsigned mask = 0;
   for (int j = 0; j < rows; ++j) {
-    const __m128 outside = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
+    const __m128 outside = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)),
+                                     _mm_cmplt_ps(e2, zero));
     mask |= (~unsigned(_mm_movemask_ps(outside)) & 0xfu) << (4 * j);
     _mm_store_ps(e1s + 4 * j, _mm_sub_ps(e1, b1));
     _mm_store_ps(e2s + 4 * j, _mm_sub_ps(e2, b2));
@@ -281,7 +289,8 @@ struct Shader {
 void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, int64_t area2) {
   const Tri& tc = mesh.triangle_colors[ti];
   const float* colors = mesh.colors.data();
-  shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3, area2);
+  shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3,
+              area2);
 }
 
 // ---- Pixels marked for supersampling ----------------------------------------------------------
@@ -323,7 +332,8 @@ class MarkTiles {
         xb = a.x + (double(b.x) - a.x) * (yb - a.y) / dy;
       }
       const int c0 = std::max(static_cast<int>(std::floor((std::min(xa, xb) - 1) / kOne)), 0);
-      const int c1 = std::min(static_cast<int>(std::floor((std::max(xa, xb) + 1) / kOne)), width_ - 1);
+      const int c1 =
+          std::min(static_cast<int>(std::floor((std::max(xa, xb) + 1) / kOne)), width_ - 1);
       for (int c = c0; c <= c1; ++c) mark(c, r);
     }
   }
@@ -364,16 +374,20 @@ class MarkTiles {
   // the set bits of the tile masks.
   template <class Visit>
   void for_each_marked(int x0, int x1, int y0, int y1, Visit&& visit) {
-    x0 = std::max(x0, 0), x1 = std::min(x1, width_ - 1), y0 = std::max(y0, 0), y1 = std::min(y1, height_ - 1);
+    x0 = std::max(x0, 0), x1 = std::min(x1, width_ - 1), y0 = std::max(y0, 0),
+    y1 = std::min(y1, height_ - 1);
     for (int ty = y0 >> kTileBits; ty <= y1 >> kTileBits; ++ty) {
       // Rows of this tile inside [y0, y1], as a byte selector.
-      const int ly0 = std::max(y0 - (ty << kTileBits), 0), ly1 = std::min(y1 - (ty << kTileBits), kTile - 1);
+      const int ly0 = std::max(y0 - (ty << kTileBits), 0),
+                ly1 = std::min(y1 - (ty << kTileBits), kTile - 1);
       const uint64_t rows = (~uint64_t{0} >> (8 * (kTile - 1 - ly1))) & (~uint64_t{0} << (8 * ly0));
       for (int tx = x0 >> kTileBits; tx <= x1 >> kTileBits; ++tx) {
         const int32_t t = tile_[size_t(ty) * tiles_x_ + tx];
         if (t < 0) continue;
-        const int lx0 = std::max(x0 - (tx << kTileBits), 0), lx1 = std::min(x1 - (tx << kTileBits), kTile - 1);
-        const uint64_t columns = ((uint64_t{2} << lx1) - (uint64_t{1} << lx0)) * 0x0101010101010101ull;
+        const int lx0 = std::max(x0 - (tx << kTileBits), 0),
+                  lx1 = std::min(x1 - (tx << kTileBits), kTile - 1);
+        const uint64_t columns =
+            ((uint64_t{2} << lx1) - (uint64_t{1} << lx0)) * 0x0101010101010101ull;
         uint64_t mask = masks_[t] & rows & columns;
         while (mask) {
           const int b = std::countr_zero(mask);
@@ -403,7 +417,8 @@ class MarkTiles {
         return;
       }
       for (int c = 0; c < 3; ++c) p[c] = static_cast<uint8_t>((sum[c] + count / 2) / count);
-      if (out.channels == 4) p[3] = static_cast<uint8_t>((count * 255 + kSubsamples / 2) / kSubsamples);
+      if (out.channels == 4)
+        p[3] = static_cast<uint8_t>((count * 255 + kSubsamples / 2) / kSubsamples);
     });
   }
 
@@ -429,8 +444,8 @@ struct Frame {
 // Pass 1: the pixel-centre samples of the band's blocks, rows [band_y0, band_y1). The triangles
 // whose bounding box meets a marked tile are collected for pass 2 into `near` (when not null).
 template <int kChannels>
-void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* unit_data, Image8& out,
-                  int band_y0, int band_y1, std::vector<int32_t>* near) {
+void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* unit_data,
+                  Image8& out, int band_y0, int band_y1, std::vector<int32_t>* near) {
   const RefinedMesh& mesh = *f.mesh;
   const Tri* tris = mesh.triangles.data();
   const int last_x = f.width - 1, last_y = band_y1 - 1;
@@ -440,16 +455,20 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
   Shader shader;
   for (const int32_t u : units) {
     const Unit& unit = unit_data[u];
-    const bool near_unit = near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0), std::min(unit.y1, last_y));
+    const bool near_unit = near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0),
+                                                     std::min(unit.y1, last_y));
     for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
       const Tri& tri = tris[ti];
       t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
-      if (near_unit && f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x), std::max(pixel_floor(t.min_y), band_y0),
+      if (near_unit && f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x),
+                                         std::max(pixel_floor(t.min_y), band_y0),
                                          std::min(pixel_floor(t.max_y), last_y))) {
         near->push_back(ti);
       }
-      const int px0 = std::max(first_centre(t.min_x), 0), px1 = std::min(last_centre(t.max_x), last_x);
-      const int py0 = std::max(first_centre(t.min_y), band_y0), py1 = std::min(last_centre(t.max_y), last_y);
+      const int px0 = std::max(first_centre(t.min_x), 0),
+                px1 = std::min(last_centre(t.max_x), last_x);
+      const int py0 = std::max(first_centre(t.min_y), band_y0),
+                py1 = std::min(last_centre(t.max_y), last_y);
       if ((px0 > px1) | (py0 > py1)) continue;
       bool shaded = false;
       for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
@@ -477,7 +496,8 @@ void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int ban
     const Tri& tri = mesh.triangles[ti];
     t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
     const int ax0 = std::max(pixel_floor(t.min_x), 0), ax1 = std::min(pixel_floor(t.max_x), last_x);
-    const int ay0 = std::max(pixel_floor(t.min_y), band_y0), ay1 = std::min(pixel_floor(t.max_y), last_y);
+    const int ay0 = std::max(pixel_floor(t.min_y), band_y0),
+              ay1 = std::min(pixel_floor(t.max_y), last_y);
     if (!t.init_edges()) continue;
     bool shaded = false;
     marks.for_each_marked(ax0, ax1, ay0, ay1, [&](int px, int py, uint32_t* samples) {
@@ -507,18 +527,20 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
       const int px0 = pixel(minx, 0, w), px1 = pixel(maxx, -1, w - 1);
       const int py0 = pixel(miny, y0, y1), py1 = pixel(maxy, y0 - 1, y1 - 1);
       if (px0 > px1 || py0 > py1) return;
-      bx0 = std::min(bx0, px0), bx1 = std::max(bx1, px1), by0 = std::min(by0, py0), by1 = std::max(by1, py1);
+      bx0 = std::min(bx0, px0), bx1 = std::max(bx1, px1), by0 = std::min(by0, py0),
+      by1 = std::max(by1, py1);
       for (int py = py0; py <= py1; ++py) {
         float* row = coverage.data() + size_t(py - y0) * w;
-        for (int px = px0; px <= px1; ++px) row[px] = std::max(row[px], cov(float(px) + 0.5f, float(py) + 0.5f));
+        for (int px = px0; px <= px1; ++px)
+          row[px] = std::max(row[px], cov(float(px) + 0.5f, float(py) + 0.5f));
       }
     };
     const float reach = layer.half_width + 1.f;
     for (const auto& s : layer.segments) {
       const float ax = s[0], ay = s[1], dx = s[2] - s[0], dy = s[3] - s[1];
       const float len2 = dx * dx + dy * dy;
-      splat(std::min(s[0], s[2]) - reach, std::max(s[0], s[2]) + reach, std::min(s[1], s[3]) - reach,
-            std::max(s[1], s[3]) + reach, [&](float x, float y) {
+      splat(std::min(s[0], s[2]) - reach, std::max(s[0], s[2]) + reach,
+            std::min(s[1], s[3]) - reach, std::max(s[1], s[3]) + reach, [&](float x, float y) {
               float u = len2 > 0 ? ((x - ax) * dx + (y - ay) * dy) / len2 : 0.f;
               u = std::clamp(u, 0.f, 1.f);
               const float ex = x - (ax + u * dx), ey = y - (ay + u * dy);
@@ -552,14 +574,16 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
 
 // ---- Frame setup -------------------------------------------------------------------------------
 
-void snap_vertices(const RefinedMesh& mesh, const ViewTransform& view, int threads, std::vector<Fixed>& fixed) {
+void snap_vertices(const RefinedMesh& mesh, const ViewTransform& view, int threads,
+                   std::vector<Fixed>& fixed) {
   const int n = mesh.num_vertices();
   fixed.resize(n);
   constexpr int kChunk = 1 << 16;
   parallel_for((n + kChunk - 1) / kChunk, threads, [&](int chunk) {
     const int end = std::min(n, (chunk + 1) * kChunk);
     for (int i = chunk * kChunk; i < end; ++i) {
-      const auto o = view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
+      const auto o =
+          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
       fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
     }
   });
@@ -585,7 +609,10 @@ void bound_unit(const RefinedMesh& mesh, const Frame& f, const ViewTransform& vi
     // Snapping moves a vertex by at most half a subpixel unit: widen the box by one unit.
     constexpr double kMargin = 1.0 / kOne;
     const auto lo = view.to_output(b.x0, b.y0), hi = view.to_output(b.x1, b.y1);
-    auto floor_px = [](double v) { return static_cast<int>(std::floor(std::clamp(v, -1e9, 1e9))); };
+    auto floor_px = [](double v) {  // floor, clamped (NaN -> -1e9)
+      v = v > -1e9 ? v : -1e9;
+      return static_cast<int>(std::floor(v < 1e9 ? v : 1e9));
+    };
     x0 = floor_px(lo[0] - kMargin), x1 = floor_px(hi[0] + kMargin);
     y0 = floor_px(lo[1] - kMargin), y1 = floor_px(hi[1] + kMargin);
   } else {
@@ -625,20 +652,23 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
   work.fixed.resize(num_vertices);
   f.fixed = work.fixed.data();
   const bool given = !options.blocks.empty();
-  const int num_units = given ? static_cast<int>(options.blocks.size()) : (mesh.num_triangles() + 63) / 64;
+  const int num_units =
+      given ? static_cast<int>(options.blocks.size()) : (mesh.num_triangles() + 63) / 64;
   work.units.resize(num_units);
   constexpr int kVerticesPerJob = 1 << 16, kUnitsPerJob = 1024;
   const int vertex_jobs = (num_vertices + kVerticesPerJob - 1) / kVerticesPerJob;
   const int unit_jobs = (num_units + kUnitsPerJob - 1) / kUnitsPerJob;
   auto bound_units = [&](int job) {
     const int end = std::min(num_units, (job + 1) * kUnitsPerJob);
-    for (int u = job * kUnitsPerJob; u < end; ++u) bound_unit(mesh, f, view, options.blocks, u, work.units[u]);
+    for (int u = job * kUnitsPerJob; u < end; ++u)
+      bound_unit(mesh, f, view, options.blocks, u, work.units[u]);
   };
   parallel_for(vertex_jobs + (given ? unit_jobs : 0), threads, [&](int job) {
     if (job >= vertex_jobs) return bound_units(job - vertex_jobs);
     const int end = std::min(num_vertices, (job + 1) * kVerticesPerJob);
     for (int i = job * kVerticesPerJob; i < end; ++i) {
-      const auto o = view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
+      const auto o =
+          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
       work.fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
     }
   });
@@ -663,7 +693,8 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
   work.band_begin.assign(num_bands + 2, 0);
   int64_t* begin = work.band_begin.data() + 1;  // count into begin[band + 1], then prefix
   for (const Unit& unit : work.units) {
-    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band) ++begin[band + 1];
+    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band)
+      ++begin[band + 1];
   }
   for (int band = 0; band < num_bands; ++band) begin[band + 1] += begin[band];
   work.binned.resize(begin[num_bands]);
@@ -676,13 +707,27 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
   // begin[band] now ends band `band`, i.e. band_begin[band + 1]: the lists start at band_begin.
 
   // Each band: centres, then subsamples and their resolve, then overlays; one writer per pixel.
-  parallel_for(num_bands, threads, [&](int band) {
+  // Bands are handed out heaviest first (by triangles binned) to balance the threads; the order
+  // does not change the output.
+  std::vector<std::pair<int64_t, int>> order(num_bands);
+  for (int band = 0; band < num_bands; ++band) {
+    int64_t load = 0;
+    for (int64_t i = work.band_begin[band]; i < work.band_begin[band + 1]; ++i) {
+      const Unit& unit = work.units[work.binned[i]];
+      load += unit.end - unit.begin;
+    }
+    order[band] = {-load, band};
+  }
+  std::sort(order.begin(), order.end());
+  parallel_for(num_bands, threads, [&](int job) {
+    const int band = order[job].second;
     const int y0 = band * band_h, y1 = std::min(height, y0 + band_h);
     const std::span<const int32_t> list(work.binned.data() + work.band_begin[band],
                                         work.binned.data() + work.band_begin[band + 1]);
     thread_local std::vector<int32_t> near_list;
     near_list.clear();
-    std::vector<int32_t>* near = f.marks && marks.any_tile(0, width - 1, y0, y1 - 1) ? &near_list : nullptr;
+    std::vector<int32_t>* near =
+        f.marks && marks.any_tile(0, width - 1, y0, y1 - 1) ? &near_list : nullptr;
     if (options.channels == 4) {
       draw_centres<4>(f, list, work.units.data(), out, y0, y1, near);
     } else {
@@ -710,18 +755,25 @@ std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransfor
   for (const Tri& tri : mesh.triangles) {
     t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
     if (!subsamples) {
-      const int px0 = std::max(first_centre(t.min_x), 0), px1 = std::min(last_centre(t.max_x), width - 1);
-      const int py0 = std::max(first_centre(t.min_y), 0), py1 = std::min(last_centre(t.max_y), height - 1);
+      const int px0 = std::max(first_centre(t.min_x), 0),
+                px1 = std::min(last_centre(t.max_x), width - 1);
+      const int py0 = std::max(first_centre(t.min_y), 0),
+                py1 = std::min(last_centre(t.max_y), height - 1);
       if (px0 > px1 || py0 > py1) continue;
-      for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
+      for_each_centre(t, px0, px1, py0, py1,
+                      [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
       continue;
     }
     if (!t.init_edges()) continue;
-    const int ax0 = std::max(pixel_floor(t.min_x), 0), ax1 = std::min(pixel_floor(t.max_x), width - 1);
-    const int ay0 = std::max(pixel_floor(t.min_y), 0), ay1 = std::min(pixel_floor(t.max_y), height - 1);
+    const int ax0 = std::max(pixel_floor(t.min_x), 0),
+              ax1 = std::min(pixel_floor(t.max_x), width - 1);
+    const int ay0 = std::max(pixel_floor(t.min_y), 0),
+              ay1 = std::min(pixel_floor(t.max_y), height - 1);
     for (int py = ay0; py <= ay1; ++py) {
       for (int px = ax0; px <= ax1; ++px) {
-        for_each_subsample(t, px, py, [&](int k, float, float) { ++counts[(size_t(py) * width + px) * kSubsamples + k]; });
+        for_each_subsample(t, px, py, [&](int k, float, float) {
+          ++counts[(size_t(py) * width + px) * kSubsamples + k];
+        });
       }
     }
   }

@@ -34,7 +34,9 @@ struct ViewTransform {
   double sx = 1, sy = 1;  // output pixels per image pixel
   int width = 0, height = 0;
 
-  std::array<double, 2> to_output(double x, double y) const { return {(x - x0) * sx, (y - y0) * sy}; }
+  std::array<double, 2> to_output(double x, double y) const {
+    return {(x - x0) * sx, (y - y0) * sy};
+  }
 };
 
 // One overlay layer: anti-aliased segments and dots (output pixel coordinates) of one color.
@@ -43,7 +45,7 @@ struct ViewTransform {
 struct OverlayLayer {
   std::array<uint8_t, 3> color{255, 255, 255};
   float opacity = 1;
-  float half_width = 0.5f;                   // segments: half the line width, pixels
+  float half_width = 0.5f;                     // segments: half the line width, pixels
   std::vector<std::array<float, 4>> segments;  // x0, y0, x1, y1
   std::vector<std::array<float, 3>> dots;      // x, y, radius
 };

@@ -32,7 +32,8 @@
 namespace subvec {
 namespace detail {
 
-std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh, const MeshTopology& topology) {
+std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh,
+                                              const MeshTopology& topology) {
   // Bounding box of each vertex's star (the vertices of its incident faces), then per face the
   // union over its three corners.
   const int nv = mesh.num_vertices();
@@ -81,8 +82,8 @@ std::string num(double v) {
 // Output size for a window of ww x wh image pixels.
 std::array<int, 2> output_size(const RenderOptions& options, double ww, double wh) {
   if (options.width < 0 || options.height < 0) {
-    invalid("output size " + std::to_string(options.width) + " x " + std::to_string(options.height) +
-            " is negative");
+    invalid("output size " + std::to_string(options.width) + " x " +
+            std::to_string(options.height) + " is negative");
   }
   double w = options.width, h = options.height;
   if (w == 0 && h == 0) {
@@ -95,8 +96,10 @@ std::array<int, 2> output_size(const RenderOptions& options, double ww, double w
   }
   w = std::max(1.0, std::round(w));
   h = std::max(1.0, std::round(h));
-  if (w > Limits::kMaxDimension || h > Limits::kMaxDimension || w * h > double(Limits::kMaxPixels)) {
-    throw Error(ErrorCode::kLimit, "output size " + num(w) + " x " + num(h) + " is over the limit of " +
+  if (w > Limits::kMaxDimension || h > Limits::kMaxDimension ||
+      w * h > double(Limits::kMaxPixels)) {
+    throw Error(ErrorCode::kLimit, "output size " + num(w) + " x " + num(h) +
+                                       " is over the limit of " +
                                        std::to_string(Limits::kMaxDimension) + " per side and " +
                                        std::to_string(Limits::kMaxPixels) + " pixels");
   }
@@ -109,8 +112,8 @@ ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
                    std::span<const std::array<double, 4>> boxes, const RenderOptions& options) {
   ViewPlan p;
   const Window w = options.window.value_or(Window{0, 0, double(image.width), double(image.height)});
-  if (!std::isfinite(w.x0) || !std::isfinite(w.y0) || !std::isfinite(w.x1) || !std::isfinite(w.y1) ||
-      !(w.x0 < w.x1) || !(w.y0 < w.y1)) {
+  if (!std::isfinite(w.x0) || !std::isfinite(w.y0) || !std::isfinite(w.x1) ||
+      !std::isfinite(w.y1) || !(w.x0 < w.x1) || !(w.y0 < w.y1)) {
     invalid("window " + num(w.x0) + "," + num(w.y0) + "," + num(w.x1) + "," + num(w.y1) +
             " is empty or not finite (want x0 < x1, y0 < y1)");
   }
@@ -149,13 +152,16 @@ ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
     p.depth = options.depth;
     if (count * (int64_t{1} << (2 * p.depth)) > int64_t{1} << 26) {
       throw Error(ErrorCode::kLimit, "depth " + std::to_string(p.depth) + " over " +
-                                         std::to_string(count) + " faces would refine more than 2^26 triangles");
+                                         std::to_string(count) +
+                                         " faces would refine more than 2^26 triangles");
     }
   } else {
     p.depth = choose_depth(p.mean_edge_pixels, options.max_edge_pixels, count);
   }
   return p;
 }
+
+namespace {
 
 // Overlay of the control mesh: the control polygon as ~1 px white lines, tears and creases in
 // their own colors, control vertices as dots, all over a dark halo.
@@ -180,7 +186,10 @@ std::vector<OverlayLayer> mesh_overlay(const ControlMesh& mesh, const MeshTopolo
     const std::array<float, 4> s{a[0], a[1], b[0], b[1]};
     halo.segments.push_back(s);
     const EdgeTag tag = topology.edge_tags[e];
-    (tag == EdgeTag::kTear ? tears : tag == EdgeTag::kCrease ? creases : lines).segments.push_back(s);
+    (tag == EdgeTag::kTear     ? tears
+     : tag == EdgeTag::kCrease ? creases
+                               : lines)
+        .segments.push_back(s);
   }
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     const auto a = out(v);
@@ -196,8 +205,10 @@ std::vector<OverlayLayer> feature_overlay(const RefinedMesh& refined, const View
   OverlayLayer halo{{0, 0, 0}, 0.5f, 1.75f, {}, {}};
   OverlayLayer curves{{255, 0, 255}, 1.f, 0.75f, {}, {}};
   for (const EdgeVerts& e : refined.tear_edges) {
-    const auto a = view.to_output(refined.positions[2 * size_t(e[0])], refined.positions[2 * size_t(e[0]) + 1]);
-    const auto b = view.to_output(refined.positions[2 * size_t(e[1])], refined.positions[2 * size_t(e[1]) + 1]);
+    const auto a = view.to_output(refined.positions[2 * size_t(e[0])],
+                                  refined.positions[2 * size_t(e[0]) + 1]);
+    const auto b = view.to_output(refined.positions[2 * size_t(e[1])],
+                                  refined.positions[2 * size_t(e[1]) + 1]);
     const std::array<float, 4> s{float(a[0]), float(a[1]), float(b[0]), float(b[1])};
     halo.segments.push_back(s);
     curves.segments.push_back(s);
@@ -205,17 +216,17 @@ std::vector<OverlayLayer> feature_overlay(const RefinedMesh& refined, const View
   return {halo, curves};
 }
 
+}  // namespace
 }  // namespace detail
 
 namespace {
 
 // Everything derived from one level that survives between frames.
 struct LevelState {
-  std::optional<MeshTopology> topology;  // from validate_level: the level is valid
+  std::optional<MeshTopology> topology;      // from validate_level: the level is valid
   std::vector<std::array<double, 4>> boxes;  // ring boxes; empty when positions changed
 };
 
-// The refinement of the last view and its limit values.
 // The refinement of the last view and its limit values. A later view reuses it when it needs the
 // same level and depth and a subset of its faces (a pan or zoom within the refined region); the
 // rasterizer skips the blocks of refined triangles that the view does not meet.
@@ -236,7 +247,9 @@ void update_blocks(RefineCache& c, int threads) {
   if (c.blocks.empty()) {
     for (int32_t t = 0; t < r.num_triangles();) {
       int32_t end = t + 1;
-      while (end < r.num_triangles() && end - t < kBlock && r.triangle_parent[end] == r.triangle_parent[t]) ++end;
+      while (end < r.num_triangles() && end - t < kBlock &&
+             r.triangle_parent[end] == r.triangle_parent[t])
+        ++end;
       c.blocks.push_back({t, end, 0, 0, 0, 0});
       t = end;
     }
@@ -267,7 +280,8 @@ struct State {
 
 LevelState& level_state(const VectorImage& image, State& state, int level) {
   if (level < 0 || level >= static_cast<int>(image.levels.size())) {
-    throw Error(ErrorCode::kInvalidArgument, "level " + std::to_string(level) + " is out of range (" +
+    throw Error(ErrorCode::kInvalidArgument, "level " + std::to_string(level) +
+                                                 " is out of range (" +
                                                  std::to_string(image.levels.size()) + " levels)");
   }
   if (state.levels.size() != image.levels.size()) state.levels.resize(image.levels.size());
@@ -290,9 +304,10 @@ Image8 render_with(const VectorImage& image, State& state, const RenderOptions& 
   if (plan.all_faces) plan.faces.clear();
 
   RefineCache& c = state.cache;
-  const bool reuse = c.subdivision && c.level == options.level && c.depth == plan.depth &&
-                     (c.faces.empty() || (!plan.all_faces && std::includes(c.faces.begin(), c.faces.end(),
-                                                                           plan.faces.begin(), plan.faces.end())));
+  const bool reuse =
+      c.subdivision && c.level == options.level && c.depth == plan.depth &&
+      (c.faces.empty() || (!plan.all_faces && std::includes(c.faces.begin(), c.faces.end(),
+                                                            plan.faces.begin(), plan.faces.end())));
   if (!reuse) {
     c.subdivision.reset();
     c.refined = RefinedMesh{};
@@ -321,8 +336,10 @@ Image8 render_with(const VectorImage& image, State& state, const RenderOptions& 
   raster.threads = threads;
   raster.blocks = c.blocks;
   std::vector<detail::OverlayLayer> overlay;
-  if (options.overlay == Overlay::kMesh) overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
-  if (options.overlay == Overlay::kFeatures) overlay = detail::feature_overlay(c.refined, plan.view);
+  if (options.overlay == Overlay::kMesh)
+    overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
+  if (options.overlay == Overlay::kFeatures)
+    overlay = detail::feature_overlay(c.refined, plan.view);
   return detail::rasterize(c.refined, plan.view, raster, overlay, &state.scratch);
 }
 
@@ -338,29 +355,35 @@ struct Renderer::Impl {
   State state;
 };
 
-Renderer::Renderer(VectorImage image) : impl_(std::make_unique<Impl>()) { impl_->image = std::move(image); }
+Renderer::Renderer(VectorImage image) : impl_(std::make_unique<Impl>()) {
+  impl_->image = std::move(image);
+}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
 const VectorImage& Renderer::image() const { return impl_->image; }
 
-Image8 Renderer::render(const RenderOptions& options) { return render_with(impl_->image, impl_->state, options); }
+Image8 Renderer::render(const RenderOptions& options) {
+  return render_with(impl_->image, impl_->state, options);
+}
 
 void Renderer::set_positions(int level, std::span<const Vec2> positions) {
   VectorImage& image = impl_->image;
   if (level < 0 || level >= static_cast<int>(image.levels.size())) {
-    throw Error(ErrorCode::kInvalidArgument, "set_positions: level " + std::to_string(level) + " is out of range");
+    throw Error(ErrorCode::kInvalidArgument,
+                "set_positions: level " + std::to_string(level) + " is out of range");
   }
   ControlMesh& mesh = image.levels[level];
   if (static_cast<int>(positions.size()) != mesh.num_vertices()) {
     throw Error(ErrorCode::kInvalidArgument, "set_positions: " + std::to_string(positions.size()) +
-                                                 " positions for " + std::to_string(mesh.num_vertices()) +
-                                                 " vertices");
+                                                 " positions for " +
+                                                 std::to_string(mesh.num_vertices()) + " vertices");
   }
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!std::isfinite(positions[i].x) || !std::isfinite(positions[i].y)) {
-      throw Error(ErrorCode::kInvalidArgument, "set_positions: position " + std::to_string(i) + " is not finite");
+      throw Error(ErrorCode::kInvalidArgument,
+                  "set_positions: position " + std::to_string(i) + " is not finite");
     }
   }
   mesh.positions.assign(positions.begin(), positions.end());
@@ -372,16 +395,19 @@ void Renderer::set_positions(int level, std::span<const Vec2> positions) {
 void Renderer::set_colors(int level, std::span<const Color> colors) {
   VectorImage& image = impl_->image;
   if (level < 0 || level >= static_cast<int>(image.levels.size())) {
-    throw Error(ErrorCode::kInvalidArgument, "set_colors: level " + std::to_string(level) + " is out of range");
+    throw Error(ErrorCode::kInvalidArgument,
+                "set_colors: level " + std::to_string(level) + " is out of range");
   }
   ControlMesh& mesh = image.levels[level];
   if (static_cast<int>(colors.size()) != mesh.num_colors()) {
-    throw Error(ErrorCode::kInvalidArgument, "set_colors: " + std::to_string(colors.size()) + " colors for " +
-                                                 std::to_string(mesh.num_colors()) + " color values");
+    throw Error(ErrorCode::kInvalidArgument,
+                "set_colors: " + std::to_string(colors.size()) + " colors for " +
+                    std::to_string(mesh.num_colors()) + " color values");
   }
   for (size_t i = 0; i < colors.size(); ++i) {
     if (!std::isfinite(colors[i].r) || !std::isfinite(colors[i].g) || !std::isfinite(colors[i].b)) {
-      throw Error(ErrorCode::kInvalidArgument, "set_colors: color " + std::to_string(i) + " is not finite");
+      throw Error(ErrorCode::kInvalidArgument,
+                  "set_colors: color " + std::to_string(i) + " is not finite");
     }
   }
   mesh.colors.assign(colors.begin(), colors.end());

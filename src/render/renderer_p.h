@@ -18,15 +18,16 @@ constexpr int kMaxAutoDepth = 8;
 
 // Per control face, the bounding box (x0, y0, x1, y1) of the control vertices of every face that
 // shares a vertex with it: its limit patch lies in their convex hull, so inside this box.
-std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh, const MeshTopology& topology);
+std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh,
+                                              const MeshTopology& topology);
 
 struct ViewPlan {
   ViewTransform view;
   Window window;
-  int channels = 3;            // 4 when the window leaves the image
-  bool all_faces = false;      // every control face is visible (faces lists them all)
-  std::vector<int32_t> faces;  // visible control faces, ascending
-  double mean_edge_pixels = 0; // mean control edge length of the visible faces, output pixels
+  int channels = 3;             // 4 when the window leaves the image
+  bool all_faces = false;       // every control face is visible (faces lists them all)
+  std::vector<int32_t> faces;   // visible control faces, ascending
+  double mean_edge_pixels = 0;  // mean control edge length of the visible faces, output pixels
   int depth = 0;
 };
 

@@ -246,9 +246,16 @@ struct Subdivision::Impl {
   std::vector<int32_t> out_colors;     // output color -> last-level fvar value
   mutable SparseMatrix position_stencils, color_stencils;
   mutable bool have_position_stencils = false, have_color_stencils = false;
+  // Meshes up to this many output rows evaluate through the limit stencils (built on first use,
+  // then one sparse product per evaluation, split over threads); larger ones refine level by
+  // level, which needs no stencil memory. The choice depends on the size alone, so a given
+  // Subdivision always computes the same numbers.
+  static constexpr size_t kMaxStencilRows = size_t{1} << 19;
+  bool use_stencils() const { return out_vertices.size() + out_colors.size() <= kMaxStencilRows; }
 
+  // Refines N channels of data; writes channel c of output value i to out[i * stride + offset + c].
   template <int N, bool FaceVarying, class Gather>
-  void refine_and_limit(Gather gather, std::span<float> out) const;
+  void refine_and_limit(Gather gather, std::span<float> out, int stride = N, int offset = 0) const;
   SparseMatrix limit_stencils(bool face_varying) const;
 };
 
@@ -352,7 +359,7 @@ const RefinedMesh& Subdivision::topology() const { return impl_->topology; }
 // Refines N-channel data level by level, pushes the last level to the limit (when asked) and
 // writes the output vertices (or color values) as floats.
 template <int N, bool FaceVarying, class Gather>
-void Subdivision::Impl::refine_and_limit(Gather gather, std::span<float> out) const {
+void Subdivision::Impl::refine_and_limit(Gather gather, std::span<float> out, int stride, int offset) const {
   const auto count = [&](int level) {
     const Far::TopologyLevel& l = refiner->GetLevel(level);
     return FaceVarying ? l.GetNumFVarValues(0) : l.GetNumVertices();
@@ -384,14 +391,47 @@ void Subdivision::Impl::refine_and_limit(Gather gather, std::span<float> out) co
     limit = std::move(current);
   }
   const std::vector<int32_t>& out_map = FaceVarying ? out_colors : out_vertices;
-  if (out.size() < out_map.size() * N) throw Error(ErrorCode::kInvalidArgument, "evaluate: output buffer too small");
+  if (out.size() < out_map.size() * stride) throw Error(ErrorCode::kInvalidArgument, "evaluate: output buffer too small");
   for (size_t i = 0; i < out_map.size(); ++i)
-    for (int c = 0; c < N; ++c) out[i * N + c] = static_cast<float>(limit[out_map[i]].v[c]);
+    for (int c = 0; c < N; ++c) out[i * stride + offset + c] = static_cast<float>(limit[out_map[i]].v[c]);
 }
 
-void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int) const {
+namespace {
+
+// out (rows x N floats, row stride N) = s * values, rows split over threads; each row is summed in
+// a fixed order, so the result does not depend on the thread count.
+template <int N, class Get>
+void apply_stencils(const SparseMatrix& s, Get get, std::span<float> out, int threads) {
+  if (out.size() < size_t(s.rows()) * N) throw Error(ErrorCode::kInvalidArgument, "evaluate: output buffer too small");
+  const int rows = static_cast<int>(s.rows());
+  auto work = [&](int begin, int end) {
+    for (int r = begin; r < end; ++r) {
+      double acc[N] = {};
+      for (SparseMatrix::InnerIterator it(s, r); it; ++it) {
+        const auto v = get(static_cast<int>(it.col()));
+        for (int c = 0; c < N; ++c) acc[c] += it.value() * v[c];
+      }
+      for (int c = 0; c < N; ++c) out[size_t(r) * N + c] = static_cast<float>(acc[c]);
+    }
+  };
+  const int t = std::clamp(resolve_threads(threads), 1, std::max(1, rows / 4096));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < t; ++i) pool.emplace_back(work, int(int64_t(rows) * i / t), int(int64_t(rows) * (i + 1) / t));
+  work(0, int(int64_t(rows) / t));
+  for (std::thread& th : pool) th.join();
+}
+
+}  // namespace
+
+void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads) const {
   if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
+  }
+  if (impl_->use_stencils()) {
+    apply_stencils<2>(
+        position_stencils(), [&](int i) { return std::array<double, 2>{positions[i].x, positions[i].y}; }, out,
+        threads);
+    return;
   }
   impl_->refine_and_limit<2, false>(
       [&](int i, double* v) {
@@ -401,9 +441,35 @@ void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<
       out);
 }
 
-void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int) const {
+void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
   if (static_cast<int>(colors.size()) != impl_->num_control_colors) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: color count does not match the mesh");
+  }
+  if (impl_->use_stencils()) {
+    apply_stencils<3>(
+        color_stencils(), [&](int i) { return std::array<double, 3>{colors[i].r, colors[i].g, colors[i].b}; },
+        out, threads);
+    return;
+  }
+  if (resolve_threads(threads) > 1) {
+    // Channels refine independently with the same weights in the same order, so splitting them
+    // over threads gives bit-identical results: (r, g) on a helper thread, b here.
+    std::thread rg([&] {
+      impl_->refine_and_limit<2, true>(
+          [&](int i, double* v) {
+            v[0] = colors[i].r;
+            v[1] = colors[i].g;
+          },
+          out, 3, 0);
+    });
+    try {
+      impl_->refine_and_limit<1, true>([&](int i, double* v) { v[0] = colors[i].b; }, out, 3, 2);
+    } catch (...) {
+      rg.join();
+      throw;
+    }
+    rg.join();
+    return;
   }
   impl_->refine_and_limit<3, true>(
       [&](int i, double* v) {
@@ -424,7 +490,7 @@ void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Colo
   out.colors.resize(impl_->out_colors.size() * 3);
   // Positions and colors are independent passes over the same topology: run them side by side.
   if (resolve_threads(threads) > 1) {
-    std::thread color_thread([&] { evaluate_colors(colors, out.colors); });
+    std::thread color_thread([&] { evaluate_colors(colors, out.colors, 1); });
     try {
       evaluate_positions(positions, out.positions);
     } catch (...) {
@@ -434,7 +500,7 @@ void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Colo
     color_thread.join();
   } else {
     evaluate_positions(positions, out.positions);
-    evaluate_colors(colors, out.colors);
+    evaluate_colors(colors, out.colors, 1);
   }
 }
 
@@ -447,12 +513,13 @@ SparseMatrix Subdivision::Impl::limit_stencils(bool face_varying) const {
   const std::vector<int32_t>& base_map = face_varying ? sub.colors : sub.vertices;
   const int num_control = face_varying ? num_control_colors : num_control_vertices;
 
-  // Refinement: last-level value i = sum_j w_ij control_j.
-  SparseMatrix refine(num_last, num_control);
+  // Refinement as CSR arrays: last-level value j = sum over k of weights[k] * control[columns[k]].
+  std::vector<int32_t> refine_offsets(size_t(num_last) + 1, 0), refine_columns;
+  std::vector<double> refine_weights;
   if (depth == 0) {
-    std::vector<Triplet> t;
-    for (int i = 0; i < num_last; ++i) t.emplace_back(i, base_map[i], 1.0);
-    refine.setFromTriplets(t.begin(), t.end());
+    std::iota(refine_offsets.begin(), refine_offsets.end(), 0);
+    refine_columns.assign(base_map.begin(), base_map.end());
+    refine_weights.assign(num_last, 1.0);
   } else {
     Far::StencilTableFactoryReal<double>::Options options;
     options.interpolationMode = face_varying ? Far::StencilTableFactoryReal<double>::INTERPOLATE_FACE_VARYING
@@ -465,43 +532,64 @@ SparseMatrix Subdivision::Impl::limit_stencils(bool face_varying) const {
     const auto& sizes = table->GetSizes();
     const auto& offsets = table->GetOffsets();
     const auto& indices = table->GetControlIndices();
-    const auto& weights = table->GetWeights();
-    std::vector<Triplet> t;
-    t.reserve(indices.size());
-    for (int i = 0; i < table->GetNumStencils(); ++i)
-      for (int k = offsets[i]; k < offsets[i] + sizes[i]; ++k)
-        t.emplace_back(i, base_map[indices[k]], weights[k]);
-    refine.setFromTriplets(t.begin(), t.end());
+    refine_weights = table->GetWeights();
+    refine_columns.resize(indices.size());
+    for (size_t k = 0; k < indices.size(); ++k) refine_columns[k] = base_map[indices[k]];
+    for (int j = 0; j < num_last; ++j) refine_offsets[j + 1] = offsets[j] + sizes[j];
   }
 
-  // Limit masks at the last level, recorded as a matrix (the identity without the limit push).
-  std::vector<Triplet> t;
-  t.reserve(size_t(num_last) * 8);
+  // Limit masks at the last level (the identity without the limit push). The sink receives each
+  // vertex's weights in vertex order, so the triplets are already grouped by row.
+  std::vector<Triplet> limit;
+  limit.reserve(size_t(num_last) * 8);
   if (push_to_limit) {
     Far::PrimvarRefinerReal<double> primvar(*refiner);
     UnitSource src;
-    TripletSink sink{&t};
+    TripletSink sink{&limit};
     if (face_varying) {
       primvar.LimitFaceVarying(src, sink, 0);
     } else {
       primvar.Limit(src, sink);
     }
   } else {
-    for (int i = 0; i < num_last; ++i) t.emplace_back(i, i, 1.0);
+    for (int i = 0; i < num_last; ++i) limit.emplace_back(i, i, 1.0);
   }
-  SparseMatrix limit(num_last, num_last);
-  limit.setFromTriplets(t.begin(), t.end());
+  std::vector<int32_t> limit_offsets(size_t(num_last) + 1, 0);
+  for (const Triplet& t : limit) ++limit_offsets[t.row() + 1];
+  std::partial_sum(limit_offsets.begin(), limit_offsets.end(), limit_offsets.begin());
 
-  // Keep the output rows only.
+  // Compose the output rows: row i = sum over limit entries (j, w) of w * refine row j, with a
+  // dense accumulator over the touched columns; rows come out in order with sorted columns.
   const std::vector<int32_t>& out_map = face_varying ? out_colors : out_vertices;
-  std::vector<Triplet> select;
-  for (size_t i = 0; i < out_map.size(); ++i) select.emplace_back(static_cast<int32_t>(i), out_map[i], 1.0);
-  SparseMatrix selection(static_cast<int32_t>(out_map.size()), num_last);
-  selection.setFromTriplets(select.begin(), select.end());
-  SparseMatrix result = selection * limit * refine;
-  result.prune(0.0);
-  result.makeCompressed();
-  return result;
+  std::vector<double> acc(num_control, 0.0);
+  std::vector<uint8_t> seen(num_control, 0);
+  std::vector<int32_t> touched, outer(out_map.size() + 1, 0), inner;
+  std::vector<double> values;
+  inner.reserve(out_map.size() * 16);
+  values.reserve(out_map.size() * 16);
+  for (size_t i = 0; i < out_map.size(); ++i) {
+    touched.clear();
+    const int32_t r = out_map[i];
+    for (int32_t e = limit_offsets[r]; e < limit_offsets[r + 1]; ++e) {
+      const int32_t j = limit[e].col();
+      const double w = limit[e].value();
+      for (int32_t k = refine_offsets[j]; k < refine_offsets[j + 1]; ++k) {
+        const int32_t c = refine_columns[k];
+        if (!seen[c]) seen[c] = 1, touched.push_back(c);
+        acc[c] += w * refine_weights[k];
+      }
+    }
+    std::sort(touched.begin(), touched.end());
+    for (int32_t c : touched) {
+      if (acc[c] != 0.0) inner.push_back(c), values.push_back(acc[c]);
+      acc[c] = 0.0;
+      seen[c] = 0;
+    }
+    outer[i + 1] = static_cast<int32_t>(inner.size());
+  }
+  return Eigen::Map<const SparseMatrix>(static_cast<int32_t>(out_map.size()), num_control,
+                                        static_cast<int32_t>(inner.size()), outer.data(), inner.data(),
+                                        values.data());
 }
 
 const SparseMatrix& Subdivision::position_stencils() const {

@@ -42,7 +42,8 @@ class Random {
 using GridPoint = std::array<int, 2>;
 
 // Traces a curve (grid coordinates, t in [0, 1]) as an 8-connected chain of grid vertices.
-std::vector<GridPoint> trace(const std::function<std::array<double, 2>(double)>& curve, bool closed) {
+std::vector<GridPoint> trace(const std::function<std::array<double, 2>(double)>& curve,
+                             bool closed) {
   std::vector<GridPoint> chain;
   constexpr int kSteps = 20000;
   for (int s = 0; s <= kSteps; ++s) {
@@ -62,14 +63,16 @@ std::vector<GridPoint> trace(const std::function<std::array<double, 2>(double)>&
   // Cut the corners of staircases: a vertex whose neighbours are diagonal neighbours is skipped,
   // so the chain takes the cell diagonal instead.
   for (size_t k = 1; k + 1 < chain.size();) {
-    if (std::abs(chain[k + 1][0] - chain[k - 1][0]) == 1 && std::abs(chain[k + 1][1] - chain[k - 1][1]) == 1) {
+    if (std::abs(chain[k + 1][0] - chain[k - 1][0]) == 1 &&
+        std::abs(chain[k + 1][1] - chain[k - 1][1]) == 1) {
       chain.erase(chain.begin() + static_cast<std::ptrdiff_t>(k));
     } else {
       ++k;
     }
   }
   for (size_t i = 1; i < chain.size(); ++i) {
-    if (std::abs(chain[i][0] - chain[i - 1][0]) > 1 || std::abs(chain[i][1] - chain[i - 1][1]) > 1) {
+    if (std::abs(chain[i][0] - chain[i - 1][0]) > 1 ||
+        std::abs(chain[i][1] - chain[i - 1][1]) > 1) {
       throw std::logic_error("synthetic: curve traced with a gap");
     }
   }
@@ -106,7 +109,9 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
         },
         false));
     chains.push_back(trace(
-        [&](double t) { return std::array<double, 2>{(0.58 + 0.3 * t) * nx, (0.24 - 0.16 * t) * ny}; },
+        [&](double t) {
+          return std::array<double, 2>{(0.58 + 0.3 * t) * nx, (0.24 - 0.16 * t) * ny};
+        },
         false));
     closed = {true, true, false, false};
   }
@@ -117,7 +122,8 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
   for (size_t f = 0; f < chains.size(); ++f) {
     for (size_t k = 0; k < chains[f].size(); ++k) {
       const auto [i, j] = chains[f][k];
-      if (i < 1 || j < 1 || i >= nx || j >= ny) throw std::logic_error("synthetic: feature on the border");
+      if (i < 1 || j < 1 || i >= nx || j >= ny)
+        throw std::logic_error("synthetic: feature on the border");
       int& owner = on_feature[vid(i, j)];
       if (owner >= 0 && owner != int(f)) throw std::logic_error("synthetic: features touch");
       owner = int(f);
@@ -179,20 +185,24 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
   std::array<std::vector<Wave>, 3> waves;
   for (auto& w : waves) {
     for (int m = 0; m < 3; ++m) {
-      w.push_back({rng.uniform(-2.5, 2.5), rng.uniform(-2.5, 2.5), rng.uniform(0, 6.3), rng.uniform(15, 30)});
+      w.push_back({rng.uniform(-2.5, 2.5), rng.uniform(-2.5, 2.5), rng.uniform(0, 6.3),
+                   rng.uniform(15, 30)});
     }
   }
   std::vector<std::array<double, 3>> offsets(chains.size() + 1, {0, 0, 0});
   for (size_t r = 1; r < offsets.size(); ++r) {
-    for (double& c : offsets[r]) c = rng.uniform(0, 1) < 0.5 ? rng.uniform(-110, -60) : rng.uniform(60, 110);
+    for (double& c : offsets[r])
+      c = rng.uniform(0, 1) < 0.5 ? rng.uniform(-110, -60) : rng.uniform(60, 110);
   }
-  auto field = [&](double x, double y, int region, double jump_weight, const std::array<double, 3>& jump) {
+  auto field = [&](double x, double y, int region, double jump_weight,
+                   const std::array<double, 3>& jump) {
     Color c;
     float* out[3] = {&c.r, &c.g, &c.b};
     for (int ch = 0; ch < 3; ++ch) {
       double v = 128 + offsets[region][ch] + jump_weight * jump[ch];
       for (const Wave& w : waves[ch]) {
-        v += w.amplitude * std::sin(2 * std::numbers::pi * (w.kx * x / o.width + w.ky * y / o.height) + w.phase);
+        v += w.amplitude *
+             std::sin(2 * std::numbers::pi * (w.kx * x / o.width + w.ky * y / o.height) + w.phase);
       }
       *out[ch] = static_cast<float>(std::clamp(v, 5.0, 250.0));
     }
@@ -219,7 +229,8 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
   std::vector<std::array<double, 3>> jumps(chains.size(), {0, 0, 0});
   for (size_t f = 0; f < chains.size(); ++f) {
     if (closed[f]) continue;
-    for (double& c : jumps[f]) c = rng.uniform(0, 1) < 0.5 ? rng.uniform(-70, -40) : rng.uniform(40, 70);
+    for (double& c : jumps[f])
+      c = rng.uniform(0, 1) < 0.5 ? rng.uniform(-70, -40) : rng.uniform(40, 70);
     const auto& c = chains[f];
     for (size_t k = 1; k + 1 < c.size(); ++k) {
       const int v = vid(c[k][0], c[k][1]);
@@ -234,7 +245,9 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
     const auto& tris = incident[v];
     std::vector<int> parent(tris.size());
     std::iota(parent.begin(), parent.end(), 0);
-    std::function<int(int)> find = [&](int a) { return parent[a] == a ? a : parent[a] = find(parent[a]); };
+    std::function<int(int)> find = [&](int a) {
+      return parent[a] == a ? a : parent[a] = find(parent[a]);
+    };
     auto others = [&](int t) {
       std::vector<int> r;
       for (int u : mesh.triangles[t]) {
@@ -267,7 +280,8 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
       auto [it, inserted] = color_of_root.try_emplace(root, mesh.num_colors());
       if (inserted) {
         const double side = jump_next[v] < 0 ? 0 : (root == plus_root ? 1.0 : -1.0);
-        const std::array<double, 3> jump = jump_feature[v] < 0 ? std::array<double, 3>{0, 0, 0} : jumps[jump_feature[v]];
+        const std::array<double, 3> jump =
+            jump_feature[v] < 0 ? std::array<double, 3>{0, 0, 0} : jumps[jump_feature[v]];
         mesh.colors.push_back(field(mesh.positions[v].x, mesh.positions[v].y, label[tris[a]],
                                     side * jump_weight[v], jump));
       }

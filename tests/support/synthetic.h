@@ -10,10 +10,10 @@ namespace subvec::test {
 
 struct SyntheticOptions {
   int width = 512, height = 512;
-  int vertices = 3000;  // approximate control vertex count (a grid of about this many)
-  uint32_t seed = 1;    // colors and jitter
-  bool features = true; // two closed tears (circles) and two open ones (an arc and a segment)
-  double jitter = 0.2;  // interior non-feature vertices move up to this fraction of a cell
+  int vertices = 3000;   // approximate control vertex count (a grid of about this many)
+  uint32_t seed = 1;     // colors and jitter
+  bool features = true;  // two closed tears (circles) and two open ones (an arc and a segment)
+  double jitter = 0.2;   // interior non-feature vertices move up to this fraction of a cell
 };
 
 // A valid one-level VectorImage: border vertices on the border, the 4 corners present, positive

@@ -25,23 +25,32 @@ struct Window {
 enum class Overlay { kNone, kMesh, kFeatures };
 
 struct RenderOptions {
-  int width = 0;                  // output width; 0: the window's width in image pixels
-  int height = 0;                 // output height; 0: keep the window's aspect ratio
-  std::optional<Window> window;   // default: the whole image
-  int level = 0;                  // level of detail
+  int width = 0;                 // output width; 0: the window's width in image pixels
+  int height = 0;                // output height; 0: keep the window's aspect ratio
+  std::optional<Window> window;  // default: the whole image
+  int level = 0;                 // level of detail
   Overlay overlay = Overlay::kNone;
-  bool antialias = true;          // supersample pixels crossed by tears and the border
-  int threads = 0;                // <= 0: all cores
-  int depth = -1;                 // subdivision depth; -1: from the output scale
-  double max_edge_pixels = 2.5;   // depth rule: refine until refined edges average at most this
+  bool antialias = true;         // supersample pixels crossed by tears and the border
+  int threads = 0;               // <= 0: all cores
+  int depth = -1;                // subdivision depth 0..10; -1: from the output scale
+  double max_edge_pixels = 2.5;  // depth rule: refine until refined edges average at most this
 };
 
+// The depth rule (docs/performance.md): with L the mean control edge length, in output pixels, of
+// the faces whose limit surface may touch the window, the depth is the smallest k in 0..8 with
+// L / 2^k <= max_edge_pixels, lowered while the refined triangles would exceed 2^24. A window
+// zoomed 2^z times refines z more levels over fewer faces: it costs about what a full view of the
+// same output size costs.
+
 // Draws the image as described by `options`; RGB, or RGBA when the window leaves the image.
-// Throws Error(kInvalidArgument) for a bad level, size or window.
+// Throws Error(kInvalidArgument) for a bad level, size, window or depth, Error(kLimit) for an
+// output over the size limits, Error(kInvalidMesh) when the level fails validate_level().
 Image8 render(const VectorImage& image, const RenderOptions& options);
 
-// A renderer that keeps the refined topology of the last view, so that redrawing the same view or
-// drawing after an edit of positions or colors (set_positions / set_colors) skips refinement.
+// A renderer that keeps the refinement of the last view, so that redrawing the same view, a view
+// inside it at the same depth (pan, zoom within a level), or drawing after an edit of positions or
+// colors (set_positions / set_colors: limit values re-evaluated) skips refinement. Not thread-safe;
+// one render at a time per Renderer.
 class Renderer {
  public:
   explicit Renderer(VectorImage image);

@@ -62,7 +62,9 @@ class Subdivision {
   // Limit (without the limit push: refined) positions and colors of the refined vertices for the
   // given control values (the full control arrays of the mesh this was built from). Fills
   // out.positions / out.colors and copies the topology into `out` when its triangle count
-  // differs. `threads` <= 0: all cores.
+  // differs. `threads` <= 0: all cores. Views of up to 2^19 refined values evaluate through the
+  // limit stencils (built on first use, then one sparse product split over the threads); larger
+  // ones refine level by level. The path depends on the size alone, never on call history.
   void evaluate(std::span<const Vec2> positions, std::span<const Color> colors, RefinedMesh& out,
                 int threads = 0) const;
   void evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads = 0) const;

@@ -37,7 +37,8 @@ RefinedMesh grid_mesh(const std::vector<double>& xs, const std::vector<double>& 
 }
 
 // Gives every triangle corner its own color value.
-void corner_colors(RefinedMesh& m, const std::function<std::array<float, 3>(int tri, int corner)>& color) {
+void corner_colors(RefinedMesh& m,
+                   const std::function<std::array<float, 3>(int tri, int corner)>& color) {
   m.colors.clear();
   m.triangle_colors.clear();
   for (int t = 0; t < m.num_triangles(); ++t) {
@@ -69,7 +70,7 @@ RefinedMesh awkward_mesh(int size, uint32_t seed) {
   std::uniform_real_distribution<double> u(-0.3, 0.3);
   std::vector<double> xs{0}, ys{0};
   for (double v = 2; v < size - 1; v += 2) {
-    xs.push_back(v + 0.5);         // a pixel-centre column
+    xs.push_back(v + 0.5);                                    // a pixel-centre column
     ys.push_back(v + 0.125 + (int(v) % 4 == 0 ? 0.0 : 0.5));  // subsample rows
   }
   xs.push_back(size);
@@ -81,9 +82,16 @@ RefinedMesh awkward_mesh(int size, uint32_t seed) {
     for (int i = 1; i + 1 < nx; ++i) {
       float* p = m.positions.data() + 2 * (j * nx + i);
       switch ((i * 7 + j * 3) % 4) {
-        case 0: p[0] += static_cast<float>(u(rng)); p[1] += static_cast<float>(u(rng)); break;
-        case 1: p[0] = std::floor(p[0]) + 0.5f; p[1] = std::floor(p[1]) + 0.5f; break;
-        default: break;
+        case 0:
+          p[0] += static_cast<float>(u(rng));
+          p[1] += static_cast<float>(u(rng));
+          break;
+        case 1:
+          p[0] = std::floor(p[0]) + 0.5f;
+          p[1] = std::floor(p[1]) + 0.5f;
+          break;
+        default:
+          break;
       }
     }
   }
@@ -103,12 +111,13 @@ RefinedMesh fan_mesh() {
   const int centre = add(16.5f, 16.5f);
   // Ring around the square [0, 33]^2, clockwise in y-down coordinates so that (centre, r_k, r_k+1)
   // has positive area.
-  std::vector<std::array<float, 2>> ring = {{0, 0},     {16.5f, 0},  {33, 0},     {33, 8.25f},  {33, 16.5f},
-                                            {33, 33},   {24.75f, 33}, {16.5f, 33}, {0, 33},     {0, 24.75f},
-                                            {0, 16.5f}, {0, 4.125f}};
+  std::vector<std::array<float, 2>> ring = {{0, 0},      {16.5f, 0},  {33, 0},      {33, 8.25f},
+                                            {33, 16.5f}, {33, 33},    {24.75f, 33}, {16.5f, 33},
+                                            {0, 33},     {0, 24.75f}, {0, 16.5f},   {0, 4.125f}};
   std::vector<int> ids;
   for (auto [x, y] : ring) ids.push_back(add(x, y));
-  for (size_t k = 0; k < ids.size(); ++k) m.triangles.push_back({centre, ids[k], ids[(k + 1) % ids.size()]});
+  for (size_t k = 0; k < ids.size(); ++k)
+    m.triangles.push_back({centre, ids[k], ids[(k + 1) % ids.size()]});
   corner_colors(m, [](int t, int) { return std::array<float, 3>{float(t), 0, 0}; });
   return m;
 }
@@ -148,21 +157,24 @@ TEST(RasterFillRule, FanAroundASampleVertex) {
   const RefinedMesh m = fan_mesh();
   for (bool sub : {false, true}) {
     const auto counts = sample_coverage(m, identity_view(33, 33), sub);
-    for (size_t i = 0; i < counts.size(); ++i) ASSERT_EQ(counts[i], 1) << "sample " << i << " sub " << sub;
+    for (size_t i = 0; i < counts.size(); ++i)
+      ASSERT_EQ(counts[i], 1) << "sample " << i << " sub " << sub;
   }
   // Scaled views put the vertex and the spokes on other sample positions.
   for (double s : {2.0, 0.5, 3.0}) {
     const int n = static_cast<int>(33 * s);
     const auto counts = sample_coverage(m, {0, 0, s, s, n, n}, false);
-    for (size_t i = 0; i < counts.size(); ++i) ASSERT_EQ(counts[i], 1) << "sample " << i << " scale " << s;
+    for (size_t i = 0; i < counts.size(); ++i)
+      ASSERT_EQ(counts[i], 1) << "sample " << i << " scale " << s;
   }
 }
 
 TEST(RasterFillRule, BackFacingAndDegenerateTrianglesDrawNothing) {
   RefinedMesh m;
   m.positions = {0, 0, 10, 0, 10, 10, 5, 5};
-  m.triangles = {{0, 2, 1}, {0, 1, 3}};  // clockwise in y-down terms: negative area; then a valid one
-  m.triangles.push_back({0, 3, 2});      // collinear: zero area... (0,0),(5,5),(10,10)
+  m.triangles = {{0, 2, 1},
+                 {0, 1, 3}};         // clockwise in y-down terms: negative area; then a valid one
+  m.triangles.push_back({0, 3, 2});  // collinear: zero area... (0,0),(5,5),(10,10)
   const auto counts = sample_coverage(m, identity_view(10, 10), false);
   int total = 0;
   for (int c : counts) total += c;
@@ -190,7 +202,9 @@ TEST(Raster, ConstantColorIsExactEverywhere) {
 
 TEST(Raster, GouraudReproducesAnAffineField) {
   RefinedMesh m = awkward_mesh(48, 9);
-  auto f = [](double x, double y) { return std::array<double, 3>{20 + 4 * x, 250 - 3.5 * y, 10 + 2 * x + 2 * y}; };
+  auto f = [](double x, double y) {
+    return std::array<double, 3>{20 + 4 * x, 250 - 3.5 * y, 10 + 2 * x + 2 * y};
+  };
   corner_colors(m, [&](int t, int k) {
     const int v = m.triangles[t][k];
     const auto c = f(m.positions[2 * v], m.positions[2 * v + 1]);
@@ -304,7 +318,8 @@ TEST(Raster, OverlayCoversItsLine) {
   RefinedMesh m = grid_mesh({0, 32}, {0, 32});
   corner_colors(m, [](int, int) { return std::array<float, 3>{0, 0, 0}; });
   OverlayLayer line{{255, 255, 255}, 1.f, 0.5f, {{{0, 16.5f, 32, 16.5f}}}, {}};
-  const Image8 img = rasterize(m, identity_view(32, 32), opts(3, true, false, 1), std::span(&line, 1));
+  const Image8 img =
+      rasterize(m, identity_view(32, 32), opts(3, true, false, 1), std::span(&line, 1));
   for (int x = 0; x < 32; ++x) {
     EXPECT_EQ(img.row(16)[3 * x], 255);  // centre row of the line: fully covered
     EXPECT_EQ(img.row(14)[3 * x], 0);    // two rows away: untouched

@@ -1,4 +1,6 @@
 // The renderer end to end: subdivision + view planning + rasterization.
+#include "subvec/render/renderer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +8,6 @@
 #include "render/renderer_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/render/renderer.h"
 #include "support/synthetic.h"
 
 namespace subvec {
@@ -70,7 +71,9 @@ TEST(Render, ConstantColorRendersExactlyEverywhere) {
 TEST(Render, AffineColorFieldIsReproduced) {
   VectorImage image = small_image(false);
   ControlMesh& mesh = image.levels[0];
-  auto f = [](double x, double y) { return std::array<double, 3>{10 + 1.5 * x, 240 - 2 * y, 30 + x + y}; };
+  auto f = [](double x, double y) {
+    return std::array<double, 3>{10 + 1.5 * x, 240 - 2 * y, 30 + x + y};
+  };
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     const auto c = f(mesh.positions[v].x, mesh.positions[v].y);
     mesh.colors[v] = {float(c[0]), float(c[1]), float(c[2])};
@@ -299,8 +302,14 @@ TEST(Render, RejectsBadOptions) {
   };
   EXPECT_EQ(code([](RenderOptions& o) { o.level = 1; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code([](RenderOptions& o) { o.width = -4; }), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(code([](RenderOptions& o) { o.window = Window{10, 0, 10, 5}; }), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(code([](RenderOptions& o) { o.window = Window{0, 0, NAN, 5}; }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code([](RenderOptions& o) {
+              o.window = Window{10, 0, 10, 5};
+            }),
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code([](RenderOptions& o) {
+              o.window = Window{0, 0, NAN, 5};
+            }),
+            ErrorCode::kInvalidArgument);
   EXPECT_EQ(code([](RenderOptions& o) { o.depth = 11; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code([](RenderOptions& o) { o.max_edge_pixels = 0; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code([](RenderOptions& o) { o.width = 1 << 20; }), ErrorCode::kLimit);

@@ -1,0 +1,32 @@
+// Evaluation paths agree bit for bit: threads split the color channels, never the arithmetic.
+#include <gtest/gtest.h>
+
+#include "subvec/subdiv/subdivision.h"
+#include "support/test_meshes.h"
+
+namespace subvec {
+namespace {
+
+TEST(Evaluate, ColorsAreIdenticalWhateverTheThreadCount) {
+  const testing::TestMesh t = testing::torn_disk();
+  const MeshTopology topo = t.topology();
+  const Subdivision sub(t.mesh, topo, 3);
+  int32_t colors = 0;
+  for (const Tri& c : sub.topology().triangle_colors) colors = std::max({colors, c[0] + 1, c[1] + 1, c[2] + 1});
+  std::vector<float> one(size_t(colors) * 3), two(size_t(colors) * 3), three(size_t(colors) * 3);
+  sub.evaluate_colors(t.mesh.colors, one, 1);
+  sub.evaluate_colors(t.mesh.colors, two, 2);
+  sub.evaluate_colors(t.mesh.colors, three, 3);
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, three);
+  // And the values are the stencils' (to float precision).
+  const SparseMatrix& s = sub.color_stencils();
+  for (int i = 0; i < colors; ++i) {
+    double r = 0;
+    for (SparseMatrix::InnerIterator it(s, i); it; ++it) r += it.value() * t.mesh.colors[it.col()].r;
+    EXPECT_NEAR(one[3 * size_t(i)], r, 1e-3);
+  }
+}
+
+}  // namespace
+}  // namespace subvec
