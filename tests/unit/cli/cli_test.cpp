@@ -366,5 +366,60 @@ TEST_F(Cli, HelpAndVersion) {
   }
 }
 
+
+// ---- vectorize -------------------------------------------------------------------------------
+
+// A 64 x 48 picture: a disk over a gradient, written as PNG through the library.
+void write_test_photo(const fs::path& path) {
+  subvec::Image8 img(64, 48, 3);
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const bool inside = (x - 30.5) * (x - 30.5) + (y - 22.5) * (y - 22.5) < 15.0 * 15.0;
+      uint8_t* p = img.row(y) + 3 * x;
+      p[0] = inside ? 220 : static_cast<uint8_t>(40 + 2 * x);
+      p[1] = inside ? 180 : 90;
+      p[2] = inside ? 40 : static_cast<uint8_t>(200 - 2 * y);
+    }
+  }
+  subvec::write_png(path, img);
+}
+
+TEST_F(Cli, VectorizeWritesAValidImageAndReportsIt) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec";
+  write_test_photo(photo);
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 60 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["width"], 64);
+  EXPECT_EQ(j["height"], 48);
+  EXPECT_LE(j["vertices"].get<int>(), 60);
+  EXPECT_GE(j["features"].get<int>(), 1);
+  EXPECT_LT(j["mae"].get<double>(), 6.0);
+  for (const char* stage : {"features", "mesh", "simplify", "fit"}) EXPECT_TRUE(j["seconds"].contains(stage));
+  // The output is a valid vector image that renders at the photo's size.
+  const CliResult info = subvec("info " + q(out) + " --json");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out)["levels"][0]["vertices"], j["vertices"]);
+  // Same input and options, same bytes.
+  const fs::path again = dir_ / "again.svec";
+  ASSERT_EQ(subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60").status, 0);
+  EXPECT_EQ(read_text(out), read_text(again));
+}
+
+TEST_F(Cli, VectorizeBadInputs) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "out.svec";
+  write_test_photo(photo);
+  expect_failure(subvec("vectorize " + q(dir_ / "missing.png") + " -o " + q(out)), "missing.png");
+  write_text(dir_ / "garbage.png", "this is not an image");
+  expect_failure(subvec("vectorize " + q(dir_ / "garbage.png") + " -o " + q(out)), "garbage.png");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio 0"), "--ratio");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio 1.5"), "--ratio");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio -1"), "--ratio");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 2"), "--vertices");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(dir_ / "out.png")), ".png");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-pixels 100"), "pixels");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace subvec
