@@ -639,8 +639,19 @@ void bound_unit(const RefinedMesh& mesh, const Frame& f, const ViewTransform& vi
 
 Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                  std::span<const OverlayLayer> overlay, RasterScratch* scratch) {
+  Image8 out;
+  rasterize_into(mesh, view, options, overlay, scratch, out);
+  return out;
+}
+
+void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
+                    std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out) {
   const int width = view.width, height = view.height, threads = std::max(options.threads, 1);
-  Image8 out(width, height, options.channels);
+  if (out.width != width || out.height != height || out.channels != options.channels) {
+    out = Image8(width, height, options.channels);
+  } else {
+    std::fill(out.pixels.begin(), out.pixels.end(), uint8_t{0});
+  }
   RasterScratch local;
   RasterScratch& work = scratch ? *scratch : local;
   Frame f{&mesh, nullptr, width, height, nullptr};
@@ -742,7 +753,6 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
       draw_overlay_band(out, y0, y1, overlay, coverage);
     }
   });
-  return out;
 }
 
 std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransform& view,

@@ -90,6 +90,10 @@ struct RasterScratch {
 
 Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                  std::span<const OverlayLayer> overlay = {}, RasterScratch* scratch = nullptr);
+// The same into `out`, whose memory is reused when it already has the size (a redraw then
+// allocates nothing: fresh pages cost more than the drawing of a 4K frame's last tenth).
+void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
+                    std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out);
 
 // Test hook: runs the coverage traversal of rasterize() over every triangle and counts how many
 // triangles claim each sample. Returns #H*W counts of the pixel-centre samples, or with

@@ -292,7 +292,7 @@ LevelState& level_state(const VectorImage& image, State& state, int level) {
   return s;
 }
 
-Image8 render_with(const VectorImage& image, State& state, const RenderOptions& options) {
+void render_with(const VectorImage& image, State& state, const RenderOptions& options, Image8& out) {
   if (image.width < 1 || image.height < 1) {
     throw Error(ErrorCode::kInvalidArgument, "the image has no pixels");
   }
@@ -300,7 +300,10 @@ Image8 render_with(const VectorImage& image, State& state, const RenderOptions& 
   const ControlMesh& mesh = image.levels[options.level];
   detail::ViewPlan plan = detail::plan_view(image, mesh, ls.boxes, options);
   const int threads = detail::resolve_threads(options.threads);
-  if (plan.faces.empty()) return Image8(plan.view.width, plan.view.height, plan.channels);
+  if (plan.faces.empty()) {
+    out = Image8(plan.view.width, plan.view.height, plan.channels);
+    return;
+  }
   if (plan.all_faces) plan.faces.clear();
 
   RefineCache& c = state.cache;
@@ -340,14 +343,16 @@ Image8 render_with(const VectorImage& image, State& state, const RenderOptions& 
     overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
   if (options.overlay == Overlay::kFeatures)
     overlay = detail::feature_overlay(c.refined, plan.view);
-  return detail::rasterize(c.refined, plan.view, raster, overlay, &state.scratch);
+  detail::rasterize_into(c.refined, plan.view, raster, overlay, &state.scratch, out);
 }
 
 }  // namespace
 
 Image8 render(const VectorImage& image, const RenderOptions& options) {
   State state;
-  return render_with(image, state, options);
+  Image8 out;
+  render_with(image, state, options, out);
+  return out;
 }
 
 struct Renderer::Impl {
@@ -365,7 +370,13 @@ Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 const VectorImage& Renderer::image() const { return impl_->image; }
 
 Image8 Renderer::render(const RenderOptions& options) {
-  return render_with(impl_->image, impl_->state, options);
+  Image8 out;
+  render_with(impl_->image, impl_->state, options, out);
+  return out;
+}
+
+void Renderer::render(const RenderOptions& options, Image8& out) {
+  render_with(impl_->image, impl_->state, options, out);
 }
 
 void Renderer::set_positions(int level, std::span<const Vec2> positions) {

@@ -60,6 +60,9 @@ class Renderer {
 
   const VectorImage& image() const;
   Image8 render(const RenderOptions& options);
+  // The same into `out`, reusing its memory when its size matches (an interactive redraw then
+  // allocates nothing).
+  void render(const RenderOptions& options, Image8& out);
   // Edits that keep topology: the cached refinement is kept and only re-evaluated.
   void set_positions(int level, std::span<const Vec2> positions);
   void set_colors(int level, std::span<const Color> colors);

@@ -242,6 +242,25 @@ TEST(Render, OverlaysDrawOverTheImage) {
   EXPECT_NE(mesh.pixels, features.pixels);
 }
 
+TEST(Renderer, RedrawIntoAReusedBufferMatchesAFreshRender) {
+  const VectorImage image = make_synthetic_image();
+  Renderer renderer(image);
+  RenderOptions plain;
+  plain.width = 200;
+  plain.window = Window{-50, -50, 300, 300};  // RGBA, transparent where it leaves the image
+  RenderOptions lines = plain;
+  lines.overlay = Overlay::kMesh;
+  Image8 frame;
+  renderer.render(lines, frame);  // leaves mesh lines in the buffer
+  const uint8_t* memory = frame.pixels.data();
+  renderer.render(plain, frame);  // same size and channels: the buffer is reused and redrawn
+  EXPECT_EQ(frame.pixels.data(), memory);
+  EXPECT_EQ(frame.channels, 4);
+  EXPECT_EQ(frame.pixels, render(image, plain).pixels);
+  renderer.render(lines, frame);
+  EXPECT_EQ(frame.pixels, render(image, lines).pixels);
+}
+
 TEST(Renderer, EditsMatchAFreshRender) {
   const VectorImage image = small_image();
   Renderer r(image);
