@@ -82,18 +82,6 @@ std::array<double, 3> pixel(const Image8& image, int x, int y) {
   return {double(p[0]), double(p[1]), double(p[2])};
 }
 
-std::array<double, 3> bilinear(const Image8& image, double x, double y) {
-  const double fx = std::clamp(x - 0.5, 0.0, double(image.width - 1));
-  const double fy = std::clamp(y - 0.5, 0.0, double(image.height - 1));
-  const int x0 = std::min(int(fx), image.width - 1), y0 = std::min(int(fy), image.height - 1);
-  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
-  const double ax = fx - x0, ay = fy - y0;
-  const auto a = pixel(image, x0, y0), b = pixel(image, x1, y0), c = pixel(image, x0, y1), d = pixel(image, x1, y1);
-  std::array<double, 3> out;
-  for (int k = 0; k < 3; ++k) out[k] = (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
-  return out;
-}
-
 }  // namespace
 
 int default_fit_depth(const ControlMesh& mesh) {
@@ -260,7 +248,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
       }
       const int32_t value = v;
       const double one = 1.0;
-      add_row(&value, &one, 1, bilinear(image, x, y));
+      add_row(&value, &one, 1, sample_bilinear(image, x, y));
     }
   }
 

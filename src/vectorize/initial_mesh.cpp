@@ -34,22 +34,6 @@ double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
   return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
 }
 
-// Bilinear sample of the image at (x, y) in image coordinates (pixel centres at +0.5).
-Color sample(const Image8& image, double x, double y) {
-  const double fx = std::clamp(x - 0.5, 0.0, double(image.width - 1));
-  const double fy = std::clamp(y - 0.5, 0.0, double(image.height - 1));
-  const int x0 = std::min(int(fx), image.width - 1), y0 = std::min(int(fy), image.height - 1);
-  const int x1 = std::min(x0 + 1, image.width - 1), y1 = std::min(y0 + 1, image.height - 1);
-  const double ax = fx - x0, ay = fy - y0;
-  float c[3];
-  for (int k = 0; k < 3; ++k) {
-    auto at = [&](int xx, int yy) { return double(image.row(yy)[xx * image.channels + k]); };
-    c[k] = static_cast<float>((1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
-                              ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1)));
-  }
-  return {c[0], c[1], c[2]};
-}
-
 }  // namespace
 
 ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
@@ -171,7 +155,8 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
       const double len = std::hypot(toward[ci].x, toward[ci].y);
       if (len > 0) p.x += options.side_offset * toward[ci].x / len, p.y += options.side_offset * toward[ci].y / len;
     }
-    mesh.colors[ci] = sample(image, p.x, p.y);
+    const auto rgb = sample_bilinear(image, p.x, p.y);
+    mesh.colors[ci] = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
   }
   return mesh;
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -17,5 +18,9 @@ struct Image8 {
   uint8_t* row(int y) { return pixels.data() + size_t(y) * width * channels; }
   const uint8_t* row(int y) const { return pixels.data() + size_t(y) * width * channels; }
 };
+
+// Bilinear sample of the RGB channels at image coordinates (x, y), pixel centres at +0.5; clamped
+// to the image. Values on the 0-255 scale.
+std::array<double, 3> sample_bilinear(const Image8& image, double x, double y);
 
 }  // namespace subvec
