@@ -28,7 +28,6 @@ struct Chain {
   std::vector<Pixel> pixels;
   int start = -1, end = -1;  // node ids; -1 = free end
   bool closed = false;
-  bool dead = false;
 };
 
 // One pass of Zhang-Suen thinning until stable: removes the redundant pixels of 8-connected
