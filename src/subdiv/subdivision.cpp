@@ -355,6 +355,8 @@ Subdivision& Subdivision::operator=(Subdivision&&) noexcept = default;
 int Subdivision::depth() const { return impl_->depth; }
 bool Subdivision::push_to_limit() const { return impl_->push_to_limit; }
 const RefinedMesh& Subdivision::topology() const { return impl_->topology; }
+int Subdivision::num_vertices() const { return static_cast<int>(impl_->out_vertices.size()); }
+int Subdivision::num_colors() const { return static_cast<int>(impl_->out_colors.size()); }
 
 // Refines N-channel data level by level, pushes the last level to the limit (when asked) and
 // writes the output vertices (or color values) as floats.

@@ -111,8 +111,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   const int depth = options.depth >= 0 ? options.depth : default_fit_depth(mesh);
   const Subdivision sub(mesh, topo, depth);
   const RefinedMesh& refined = sub.topology();
-  int32_t num_refined = 0;  // every refined vertex belongs to a refined triangle
-  for (const Tri& t : refined.triangles) num_refined = std::max({num_refined, t[0] + 1, t[1] + 1, t[2] + 1});
+  const int num_refined = sub.num_vertices();
   std::vector<float> limit(size_t(num_refined) * 2);
   sub.evaluate_positions(mesh.positions, limit);
   const SparseMatrix& s = sub.color_stencils();

@@ -58,6 +58,9 @@ class Subdivision {
   bool push_to_limit() const;
   // Topology of the refined mesh (positions and colors left empty).
   const RefinedMesh& topology() const;
+  // Sizes of the evaluated arrays: refined vertices (#N) and refined color values (#M).
+  int num_vertices() const;
+  int num_colors() const;
 
   // Limit (without the limit push: refined) positions and colors of the refined vertices for the
   // given control values (the full control arrays of the mesh this was built from). Fills
