@@ -18,7 +18,7 @@ enum class ColorFitTarget { kPixels, kRefinedVertices };
 struct ColorFitOptions {
   ColorFitTarget target = ColorFitTarget::kPixels;
   int depth = -1;             // subdivision depth of the fit; -1: what the renderer uses at 1x
-  double band = 1.0;          // pixels this close to a tear get hole-filled targets
+  double band = 0.5;          // pixels this close to a tear get hole-filled targets
   double fill_radius = 3.0;   // how far hole filling looks for same-side pixels
   double regularization = 1e-6;  // relative Tikhonov weight toward the current colors
 };

@@ -12,7 +12,7 @@ namespace subvec {
 struct SimplifyOptions {
   int target_vertices = 0;          // stop when this many control vertices remain
   double max_feature_error = 1.0;   // pixels
-  double color_scale = 1.0;         // colors enter the quadrics as color_scale * (0..255)
+  double color_scale = 2.0;         // colors enter the quadrics as color_scale * (0..255)
 };
 
 struct SimplifyStats {

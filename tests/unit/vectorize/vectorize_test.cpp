@@ -124,7 +124,10 @@ double check_vectorization(const Image8& img, const VectorizeOptions& options, c
       worst = std::max(worst, best);
     }
   }
-  EXPECT_LE(worst, 1.0 + 1e-6) << name;
+  // The simplifier bounds the parametric distance to the exact limit curve by 1 px; the depth-4
+  // chords measured here sag inside the curve by up to ~len^2 * curvature / 8, a few thousandths
+  // of a pixel for these curves.
+  EXPECT_LE(worst, 1.005) << name;
   RenderOptions ro;
   const Image8 rendered = render(v, ro);
   return compare(img, rendered).mae_mean;

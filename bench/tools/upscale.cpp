@@ -1,0 +1,33 @@
+// subvec_upscale: a bicubic upscale of a photograph, the input of the large-image vectorization
+// benchmark (scripts/bench-vectorize).
+//
+//   subvec_upscale IN OUT.png FACTOR
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "subvec/core/error.h"
+#include "subvec/io/image_io.h"
+
+int main(int argc, char** argv) {
+  try {
+    if (argc != 4) throw subvec::Error(subvec::ErrorCode::kInvalidArgument, "usage: subvec_upscale IN OUT.png FACTOR");
+    const int factor = std::stoi(argv[3]);
+    if (factor < 1 || factor > 16) throw subvec::Error(subvec::ErrorCode::kInvalidArgument, "FACTOR must be 1..16");
+    const subvec::Image8 in = subvec::read_image(argv[1]);
+    const cv::Mat src(in.height, in.width, in.channels == 4 ? CV_8UC4 : CV_8UC3,
+                      const_cast<uint8_t*>(in.pixels.data()));
+    cv::Mat dst;
+    cv::resize(src, dst, cv::Size(in.width * factor, in.height * factor), 0, 0, cv::INTER_CUBIC);
+    subvec::Image8 out(dst.cols, dst.rows, in.channels);
+    for (int y = 0; y < dst.rows; ++y) std::copy_n(dst.ptr<uint8_t>(y), out.row(y + 1) - out.row(y), out.row(y));
+    subvec::write_png(argv[2], out);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "subvec_upscale: %s\n", e.what());
+    return 1;
+  }
+}
