@@ -170,7 +170,8 @@ const char* type_name(const Json& j) {
 
 // Rejects keys outside `allowed`, naming the first unknown one.
 void check_keys(const Json& object, const Path& path, std::initializer_list<const char*> allowed) {
-  for (const auto& [key, value] : object.items()) {
+  for (const auto& item : object.items()) {
+    const std::string& key = item.key();
     const bool known =
         std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; });
     if (!known) {
