@@ -492,11 +492,15 @@ void run_vectorize(const VectorizeArgs& a) {
   std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n", report.vertices,
               report.triangles, report.features, report.tear_vertices);
   if (options.segment) {
+    std::string boundary = "is 1 closed feature";
+    if (!segment_is_closed) {
+      boundary = segment_features == 0 ? "lies on the image border (no feature)"
+                                       : "is " + std::to_string(segment_features) +
+                                             (segment_features == 1 ? " open feature" : " open features") +
+                                             " ending on the image border";
+    }
     std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
-                static_cast<long long>(report.segment_mask.area()),
-                segment_is_closed ? "is 1 closed feature"
-                                  : (std::to_string(segment_features) +
-                                     " open feature(s) ending on the image border").c_str());
+                static_cast<long long>(report.segment_mask.area()), boundary.c_str());
   }
   std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n", d.mae_mean,
               d.psnr, d.ssim);

@@ -331,7 +331,7 @@ TEST_F(Cli, BadImagesForCompare) {
   const fs::path good = dir_ / "good.png";
   ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(good)).status, 0);
   expect_failure(subvec("compare " + q(good) + " " + q(dir_ / "junk.png")),
-                 "file is truncated or not an image");
+                 "not a PNG, JPEG, WebP, TIFF or BMP file");
 }
 
 TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {
