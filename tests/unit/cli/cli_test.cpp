@@ -458,6 +458,21 @@ TEST_F(Cli, VectorizeSegment) {
   EXPECT_TRUE(nlohmann::json::parse(plain.out)["segment"].is_null());
 }
 
+// The bundled photograph that scripts/demo vectorizes: public domain, in the repository.
+TEST_F(Cli, VectorizeTheExamplePhotograph) {
+  const fs::path photo = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png";
+  ASSERT_TRUE(fs::exists(photo));
+  EXPECT_LE(fs::file_size(photo), 150u * 1024);
+  const fs::path out = dir_ / "rocket.svec";
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio 0.005 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["width"], 384);
+  EXPECT_EQ(j["height"], 256);
+  EXPECT_LT(j["mae"].get<double>(), 8.0);
+  ASSERT_EQ(subvec("render " + q(out) + " -o " + q(dir_ / "mesh.png") + " --scale 4 --overlay mesh").status, 0);
+}
+
 TEST_F(Cli, VectorizeSegmentBadRectangles) {
   const fs::path photo = dir_ / "photo.png", out = dir_ / "out.svec";
   write_test_photo(photo);  // 64 x 48
