@@ -4,9 +4,9 @@
 // CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
 // status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
 // partial file and never clobbers an existing one.
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -319,7 +319,8 @@ std::string parse_rect(const std::string& text, subvec::PixelRect& r) {
     }
   }
   if (p != end) return usage;
-  if (v[2] <= 0 || v[3] <= 0) return "the rectangle '" + text + "' is empty (W and H must be positive)";
+  if (v[2] <= 0 || v[3] <= 0)
+    return "the rectangle '" + text + "' is empty (W and H must be positive)";
   r = {v[0], v[1], v[2], v[3]};
   return "";
 }
@@ -428,23 +429,29 @@ void run_vectorize(const VectorizeArgs& a) {
   subvec::VectorizeOptions options;
   options.ratio = a.ratio;
   options.vertices = a.vertices;
-  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices : subvec::ColorFitTarget::kPixels;
+  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
+                                           : subvec::ColorFitTarget::kPixels;
   if (!a.segment.empty()) {
     subvec::PixelRect rect;
     parse_rect(a.segment, rect);  // already validated by CLI11
     options.segment = rect;
   }
-  options.progress = [&](const std::string& stage, double fraction) { progress.update(stage, fraction); };
+  options.progress = [&](const std::string& stage, double fraction) {
+    progress.update(stage, fraction);
+  };
   subvec::VectorizeReport report;
   const subvec::VectorImage v = subvec::vectorize(image, options, &report);
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
-  const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
-  const double compare_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  const subvec::ImageDifference d =
+      subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
+  const double compare_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
   progress.update("writing", 1.0);
   subvec::write_svec(a.output, v);
   progress.finish();
-  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // The segment's boundary: how many mesh features follow it and whether it is one closed curve.
   int segment_closed = 0;
@@ -477,7 +484,8 @@ void run_vectorize(const VectorizeArgs& a) {
       j["segment"] = nullptr;
     }
     j["mae"] = d.mae_mean;
-    j["psnr"] = std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
+    j["psnr"] =
+        std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
     j["ssim"] = d.ssim;
     nlohmann::ordered_json stages;
     for (const auto& s : report.stages) stages[s.stage] = s.seconds;
@@ -489,21 +497,22 @@ void run_vectorize(const VectorizeArgs& a) {
   }
   std::printf("%s -> %s\n", a.input.c_str(), a.output.c_str());
   std::printf("size      %d x %d pixels\n", image.width, image.height);
-  std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n", report.vertices,
-              report.triangles, report.features, report.tear_vertices);
+  std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n",
+              report.vertices, report.triangles, report.features, report.tear_vertices);
   if (options.segment) {
     std::string boundary = "is 1 closed feature";
     if (!segment_is_closed) {
-      boundary = segment_features == 0 ? "lies on the image border (no feature)"
-                                       : "is " + std::to_string(segment_features) +
-                                             (segment_features == 1 ? " open feature" : " open features") +
-                                             " ending on the image border";
+      boundary = segment_features == 0
+                     ? "lies on the image border (no feature)"
+                     : "is " + std::to_string(segment_features) +
+                           (segment_features == 1 ? " open feature" : " open features") +
+                           " ending on the image border";
     }
     std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
                 static_cast<long long>(report.segment_mask.area()), boundary.c_str());
   }
-  std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n", d.mae_mean,
-              d.psnr, d.ssim);
+  std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n",
+              d.mae_mean, d.psnr, d.ssim);
   std::printf("seconds  ");
   for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
   std::printf(" render+compare %.3f, total %.3f\n", compare_seconds, total);
@@ -527,7 +536,8 @@ std::string command_path(const CLI::App& app) {
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
-      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares raster images.",
+      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares "
+      "raster images.",
       "subvec");
   app.footer(
       "Examples:\n"
@@ -639,24 +649,34 @@ int run(int argc, char** argv) {
 
   // vectorize
   VectorizeArgs va;
-  CLI::App* vectorize = app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
+  CLI::App* vectorize =
+      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
   vectorize->add_option("input", va.input, "Raster image")->required();
-  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")->required();
+  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
+      ->required();
   CLI::Option* ratio_opt =
-      vectorize->add_option("--ratio", va.ratio, "Control vertices as a fraction of the pixel count (default 0.01)")
+      vectorize
+          ->add_option("--ratio", va.ratio,
+                       "Control vertices as a fraction of the pixel count (default 0.01)")
           ->check(CLI::Validator(
               [](std::string& text) {
                 double v = 0;
-                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
+                const bool ok =
+                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
                 return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
               },
               "RATIO", "ratio"));
-  CLI::Option* vertices_opt = vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
-                                  ->check(CLI::Range(4, 1 << 26));
+  CLI::Option* vertices_opt =
+      vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
+          ->check(CLI::Range(4, 1 << 26));
   ratio_opt->excludes(vertices_opt);
-  vectorize->add_option("--max-pixels", va.max_pixels, "Refuse larger images (default 8388608, about 12 GB of memory)")
+  vectorize
+      ->add_option("--max-pixels", va.max_pixels,
+                   "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
-  vectorize->add_option("--fit", va.fit, "Color fit: every pixel (default) or the paper's subdivided vertices")
+  vectorize
+      ->add_option("--fit", va.fit,
+                   "Color fit: every pixel (default) or the paper's subdivided vertices")
       ->check(CLI::IsMember({"pixels", "vertices"}))
       ->default_str("pixels");
   vectorize
@@ -672,7 +692,8 @@ int run(int argc, char** argv) {
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   vectorize->footer(
       "Examples:\n"
-      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as vertices\n"
+      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
+      "vertices\n"
       "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
       "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
@@ -695,7 +716,8 @@ int run(int argc, char** argv) {
         message = "a command is required: vectorize, render, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, render, info, convert or compare)";
+                  extra.front() +
+                  "' (expected a command: vectorize, render, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }

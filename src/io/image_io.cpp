@@ -2,7 +2,8 @@
 //
 // Reading: the whole file is read into memory (io/file.h), its size checked against `max_pixels`
 // from the header where we can parse it cheaply (PNG IHDR, JPEG SOFn, BMP DIB header, WebP VP8 /
-// VP8L / VP8X, the first TIFF directory) before anything is decoded, and again after decoding. Everything becomes 8-bit RGB:
+// VP8L / VP8X, the first TIFF directory) before anything is decoded, and again after decoding.
+// Everything becomes 8-bit RGB:
 //  - gray (and gray + alpha) is replicated to R = G = B;
 //  - 16-bit samples are scaled by 255/65535 with rounding, float samples are taken as 0-1;
 //  - alpha is composited over black (c * a / 255), so a transparent pixel reads as black; this
@@ -191,11 +192,13 @@ uint32_t little_endian_u16(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(
 
 bool is_bmp(const std::vector<uint8_t>& b) { return b.size() >= 2 && b[0] == 'B' && b[1] == 'M'; }
 bool is_webp(const std::vector<uint8_t>& b) {
-  return b.size() >= 12 && std::memcmp(b.data(), "RIFF", 4) == 0 && std::memcmp(b.data() + 8, "WEBP", 4) == 0;
+  return b.size() >= 12 && std::memcmp(b.data(), "RIFF", 4) == 0 &&
+         std::memcmp(b.data() + 8, "WEBP", 4) == 0;
 }
 bool is_tiff(const std::vector<uint8_t>& b) {  // classic (42) or BigTIFF (43), either byte order
-  return b.size() >= 4 && ((b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
-                           (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)));
+  return b.size() >= 4 &&
+         ((b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
+          (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)));
 }
 
 // BMP: "BM", then at 14 the DIB header: its size, then width and height (16-bit in the old
@@ -204,7 +207,8 @@ HeaderSize bmp_size(const std::vector<uint8_t>& b) {
   if (b.size() < 26 || b[0] != 'B' || b[1] != 'M') return {};
   const uint32_t dib = little_endian_u32(b.data() + 14);
   if (dib == 12) return {little_endian_u16(b.data() + 18), little_endian_u16(b.data() + 20)};
-  const auto width = int32_t(little_endian_u32(b.data() + 18)), height = int32_t(little_endian_u32(b.data() + 22));
+  const auto width = int32_t(little_endian_u32(b.data() + 18)),
+             height = int32_t(little_endian_u32(b.data() + 22));
   return {std::abs(int64_t{width}), std::abs(int64_t{height})};
 }
 
@@ -213,9 +217,11 @@ HeaderSize bmp_size(const std::vector<uint8_t>& b) {
 // the file header declares, when it declares one.
 bool bmp_complete(const std::vector<uint8_t>& b) {
   if (b.size() < 26) return false;
-  const uint32_t declared = little_endian_u32(b.data() + 2), offset = little_endian_u32(b.data() + 10);
+  const uint32_t declared = little_endian_u32(b.data() + 2),
+                 offset = little_endian_u32(b.data() + 10);
   const uint32_t dib = little_endian_u32(b.data() + 14);
-  if (dib < 12 || b.size() < 14 + uint64_t{dib} || offset < 14 + uint64_t{dib} || offset > b.size()) return false;
+  if (dib < 12 || b.size() < 14 + uint64_t{dib} || offset < 14 + uint64_t{dib} || offset > b.size())
+    return false;
   int64_t width, height;
   uint32_t bits, compression = 0;
   if (dib == 12) {
@@ -238,7 +244,9 @@ bool bmp_complete(const std::vector<uint8_t>& b) {
 // code 9d 01 2a), "VP8L" (lossless: signature 0x2f, then 14-bit width - 1 and height - 1) or
 // "VP8X" (extended: 24-bit canvas width - 1 and height - 1).
 HeaderSize webp_size(const std::vector<uint8_t>& b) {
-  if (b.size() < 30 || std::memcmp(b.data(), "RIFF", 4) != 0 || std::memcmp(b.data() + 8, "WEBP", 4) != 0) return {};
+  if (b.size() < 30 || std::memcmp(b.data(), "RIFF", 4) != 0 ||
+      std::memcmp(b.data() + 8, "WEBP", 4) != 0)
+    return {};
   const uint8_t* chunk = b.data() + 12;
   const uint8_t* data = chunk + 8;
   if (std::memcmp(chunk, "VP8 ", 4) == 0 && data[3] == 0x9d && data[4] == 0x01 && data[5] == 0x2a) {
@@ -249,7 +257,9 @@ HeaderSize webp_size(const std::vector<uint8_t>& b) {
     return {(bits & 0x3fff) + 1, ((bits >> 14) & 0x3fff) + 1};
   }
   if (std::memcmp(chunk, "VP8X", 4) == 0) {
-    const auto u24 = [](const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16; };
+    const auto u24 = [](const uint8_t* p) {
+      return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+    };
     return {int64_t{u24(data + 4)} + 1, int64_t{u24(data + 7)} + 1};
   }
   return {};
@@ -262,8 +272,12 @@ HeaderSize tiff_size(const std::vector<uint8_t>& b) {
   const bool little = b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0;
   const bool big = b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42;
   if (!little && !big) return {};
-  const auto u16 = [&](size_t at) { return little ? little_endian_u16(b.data() + at) : big_endian_u16(b.data() + at); };
-  const auto u32 = [&](size_t at) { return little ? little_endian_u32(b.data() + at) : big_endian_u32(b.data() + at); };
+  const auto u16 = [&](size_t at) {
+    return little ? little_endian_u16(b.data() + at) : big_endian_u16(b.data() + at);
+  };
+  const auto u32 = [&](size_t at) {
+    return little ? little_endian_u32(b.data() + at) : big_endian_u32(b.data() + at);
+  };
   const size_t ifd = u32(4);
   if (ifd > b.size() - 2) return {};
   const size_t entries = u16(ifd);

@@ -13,10 +13,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <string>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "subvec/core/error.h"
 
@@ -66,8 +65,8 @@ std::vector<Vec2> resample(const std::vector<Vec2>& p, double spacing) {
   const int segments = std::max(1, static_cast<int>(std::lround(length / spacing)));
   std::vector<Vec2> out{p.front()};
   const double step = length / segments;
-  size_t i = 0;          // current segment p[i] .. p[i + 1]
-  double at = 0;         // arc length at p[i]
+  size_t i = 0;   // current segment p[i] .. p[i + 1]
+  double at = 0;  // arc length at p[i]
   for (int k = 1; k < segments; ++k) {
     const double s = k * step;
     while (i + 2 < p.size()) {
@@ -86,17 +85,22 @@ std::vector<Vec2> resample(const std::vector<Vec2>& p, double spacing) {
 
 double point_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
   const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  const double t =
+      len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
   return std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy);
 }
 
-double orient(Vec2 a, Vec2 b, Vec2 c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+double orient(Vec2 a, Vec2 b, Vec2 c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
 
 double segment_distance(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
-  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
-  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return 0;
-  return std::min({point_segment_distance(a, c, d), point_segment_distance(b, c, d), point_segment_distance(c, a, b),
-                   point_segment_distance(d, a, b)});
+  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a),
+               o4 = orient(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return 0;
+  return std::min({point_segment_distance(a, c, d), point_segment_distance(b, c, d),
+                   point_segment_distance(c, a, b), point_segment_distance(d, a, b)});
 }
 
 // The boundary's segments, bucketed on a coarse grid for distance queries.
@@ -104,12 +108,15 @@ class SegmentGrid {
  public:
   SegmentGrid(const std::vector<DetectedFeature>& lines, double cell) : cell_(cell) {
     for (const DetectedFeature& f : lines)
-      for (size_t i = 0; i + 1 < f.points.size(); ++i) segments_.push_back({f.points[i], f.points[i + 1]});
+      for (size_t i = 0; i + 1 < f.points.size(); ++i)
+        segments_.push_back({f.points[i], f.points[i + 1]});
     if (segments_.empty()) return;
     x0_ = y0_ = 1e300;
     double x1 = -1e300, y1 = -1e300;
     for (const auto& s : segments_) {
-      for (const Vec2& p : s) x0_ = std::min(x0_, p.x), y0_ = std::min(y0_, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+      for (const Vec2& p : s)
+        x0_ = std::min(x0_, p.x), y0_ = std::min(y0_, p.y), x1 = std::max(x1, p.x),
+        y1 = std::max(y1, p.y);
     }
     nx_ = static_cast<int>((x1 - x0_) / cell_) + 1;
     ny_ = static_cast<int>((y1 - y0_) / cell_) + 1;
@@ -136,8 +143,12 @@ class SegmentGrid {
   }
 
  private:
-  int cx(double x) const { return std::clamp(static_cast<int>(std::floor((x - x0_) / cell_)), 0, nx_ - 1); }
-  int cy(double y) const { return std::clamp(static_cast<int>(std::floor((y - y0_) / cell_)), 0, ny_ - 1); }
+  int cx(double x) const {
+    return std::clamp(static_cast<int>(std::floor((x - x0_) / cell_)), 0, nx_ - 1);
+  }
+  int cy(double y) const {
+    return std::clamp(static_cast<int>(std::floor((y - y0_) / cell_)), 0, ny_ - 1);
+  }
 
   double cell_;
   double x0_ = 0, y0_ = 0;
@@ -152,25 +163,29 @@ int64_t RegionMask::area() const {
   return std::count_if(inside.begin(), inside.end(), [](uint8_t v) { return v != 0; });
 }
 
-RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const SegmentOptions& options) {
+RegionMask segment_foreground(const Image8& image, const PixelRect& rect,
+                              const SegmentOptions& options) {
   const int w = image.width, h = image.height;
   if (rect.width <= 0 || rect.height <= 0) {
     throw Error(ErrorCode::kInvalidArgument, "segment rectangle " + rect_text(rect) + " is empty");
   }
   if (rect.x < 0 || rect.y < 0 || rect.x > w - rect.width || rect.y > h - rect.height) {
-    throw Error(ErrorCode::kInvalidArgument, "segment rectangle " + rect_text(rect) + " is not inside the " +
-                                                 std::to_string(w) + "x" + std::to_string(h) + " image");
+    throw Error(ErrorCode::kInvalidArgument, "segment rectangle " + rect_text(rect) +
+                                                 " is not inside the " + std::to_string(w) + "x" +
+                                                 std::to_string(h) + " image");
   }
   // GrabCut fits two 5-component colour models, one to the pixels inside and one to those outside.
   const int64_t inside = int64_t(rect.width) * rect.height, outside = int64_t(w) * h - inside;
   if (outside < 5) {
-    throw Error(ErrorCode::kInvalidArgument, "segment rectangle " + rect_text(rect) + " leaves fewer than 5 pixels of the " +
-                                                 std::to_string(w) + "x" + std::to_string(h) +
-                                                 " image outside it: GrabCut needs background pixels there");
+    throw Error(ErrorCode::kInvalidArgument,
+                "segment rectangle " + rect_text(rect) + " leaves fewer than 5 pixels of the " +
+                    std::to_string(w) + "x" + std::to_string(h) +
+                    " image outside it: GrabCut needs background pixels there");
   }
   if (inside < 5) {
     throw Error(ErrorCode::kInvalidArgument,
-                "segment rectangle " + rect_text(rect) + " is too small: GrabCut needs at least 5 pixels inside it");
+                "segment rectangle " + rect_text(rect) +
+                    " is too small: GrabCut needs at least 5 pixels inside it");
   }
   if (!(options.iterations >= 1 && options.iterations <= 100)) {
     throw Error(ErrorCode::kInvalidArgument, "GrabCut iterations must be in 1..100");
@@ -179,16 +194,18 @@ RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const 
   cv::Mat3b bgr(h, w);
   for (int y = 0; y < h; ++y) {
     const uint8_t* src = image.row(y);
-    for (int x = 0; x < w; ++x, src += image.channels) bgr(y, x) = cv::Vec3b(src[2], src[1], src[0]);
+    for (int x = 0; x < w; ++x, src += image.channels)
+      bgr(y, x) = cv::Vec3b(src[2], src[1], src[0]);
   }
   cv::Mat1b gc(h, w, static_cast<uint8_t>(cv::GC_BGD));
   cv::Mat background_model, foreground_model;
   try {
     const SeededRng rng(options.seed);
-    cv::grabCut(bgr, gc, cv::Rect(rect.x, rect.y, rect.width, rect.height), background_model, foreground_model,
-                options.iterations, cv::GC_INIT_WITH_RECT);
+    cv::grabCut(bgr, gc, cv::Rect(rect.x, rect.y, rect.width, rect.height), background_model,
+                foreground_model, options.iterations, cv::GC_INIT_WITH_RECT);
   } catch (const cv::Exception& e) {
-    throw Error(ErrorCode::kInvalidArgument, "GrabCut failed for segment rectangle " + rect_text(rect) + ": " + e.err);
+    throw Error(ErrorCode::kInvalidArgument,
+                "GrabCut failed for segment rectangle " + rect_text(rect) + ": " + e.err);
   }
 
   // Foreground: GC_FGD (1) and GC_PR_FGD (3).
@@ -204,7 +221,8 @@ RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const 
   const int count = cv::connectedComponentsWithStats(fg, labels, stats, centroids, 4, CV_32S);
   int best = 0;
   for (int k = 1; k < count; ++k)
-    if (best == 0 || stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = k;
+    if (best == 0 || stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
+      best = k;
   if (best == 0) {
     throw Error(ErrorCode::kInvalidArgument,
                 "GrabCut found no foreground in segment rectangle " + rect_text(rect));
@@ -233,7 +251,8 @@ RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const 
   return mask;
 }
 
-std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask, const SegmentOptions& options) {
+std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask,
+                                                      const SegmentOptions& options) {
   const int w = mask.width, h = mask.height;
   if (w <= 0 || h <= 0 || mask.inside.size() != size_t(w) * h) {
     throw Error(ErrorCode::kInvalidArgument, "region mask is empty or malformed");
@@ -263,18 +282,23 @@ std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask, co
     for (int i = -1; i < w; ++i) {
       // Corners a (i, j), b (i+1, j), c (i+1, j+1), d (i, j+1); edges top, right, bottom, left.
       const bool a = in(i, j), b = in(i + 1, j), c = in(i + 1, j + 1), d = in(i, j + 1);
-      const int top = horizontal(i, j), right = vertical(i + 1, j), bottom = horizontal(i, j + 1), left = vertical(i, j);
-      const Vec2 corner[4] = {{i + 0.5, j + 0.5}, {i + 1.5, j + 0.5}, {i + 1.5, j + 1.5}, {i + 0.5, j + 1.5}};
+      const int top = horizontal(i, j), right = vertical(i + 1, j), bottom = horizontal(i, j + 1),
+                left = vertical(i, j);
+      const Vec2 corner[4] = {
+          {i + 0.5, j + 0.5}, {i + 1.5, j + 0.5}, {i + 1.5, j + 1.5}, {i + 0.5, j + 1.5}};
       const bool inside[4] = {a, b, c, d};
-      // The two edges beside each corner, and the edge pair across the cell for two adjacent corners.
+      // The two edges beside each corner, and the edge pair across the cell for two adjacent
+      // corners.
       const int beside[4][2] = {{left, top}, {top, right}, {right, bottom}, {bottom, left}};
       auto link = [&](int e0, int e1, int reference) {
         // Orient e0 -> e1 so the region lies to the left: the reference corner is inside or not.
         const Vec2 p = position(e0), q = position(e1);
         const double side = orient(p, q, corner[reference]);
         const bool left_of = side < 0;  // y down: a negative orientation is on the left as drawn
-        if (left_of == inside[reference]) next[e0] = e1;
-        else next[e1] = e0;
+        if (left_of == inside[reference])
+          next[e0] = e1;
+        else
+          next[e1] = e0;
       };
       const int count = a + b + c + d;
       if (count == 0 || count == 4) continue;
@@ -359,8 +383,9 @@ std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask, co
   return out;
 }
 
-void clear_features_near(std::vector<DetectedFeature>& features, const std::vector<DetectedFeature>& boundary,
-                         double clearance, double min_length) {
+void clear_features_near(std::vector<DetectedFeature>& features,
+                         const std::vector<DetectedFeature>& boundary, double clearance,
+                         double min_length) {
   if (boundary.empty() || !(clearance > 0)) return;
   const SegmentGrid grid(boundary, 4.0);
   std::vector<DetectedFeature> out;
@@ -371,7 +396,8 @@ void clear_features_near(std::vector<DetectedFeature>& features, const std::vect
     std::vector<uint8_t> keep(n, 1);
     bool any_cut = false;
     for (size_t i = 0; i + 1 < n; ++i) {
-      if (grid.near(f.points[i], f.points[i + 1], clearance)) keep[i] = keep[i + 1] = 0, any_cut = true;
+      if (grid.near(f.points[i], f.points[i + 1], clearance))
+        keep[i] = keep[i + 1] = 0, any_cut = true;
     }
     if (!any_cut) {
       out.push_back(std::move(f));

@@ -19,12 +19,12 @@ struct PixelRect {
 };
 
 struct SegmentOptions {
-  int iterations = 5;       // GrabCut iterations
-  uint64_t seed = 0x5eed;   // GrabCut's GMM initialisation draws from cv::theRNG(), seeded with this
+  int iterations = 5;      // GrabCut iterations
+  uint64_t seed = 0x5eed;  // GrabCut's GMM initialisation draws from cv::theRNG(), seeded with this
   // [1 2 1]/4 passes over the pixel-edge boundary. One keeps it within 0.4 px of GrabCut's
   // pixels; the fitted subdivision curve smooths the rest (more passes cut corners further).
   int smoothing_passes = 1;
-  double clearance = 1.5;   // Canny feature parts closer than this to the boundary are cut, px
+  double clearance = 1.5;  // Canny feature parts closer than this to the boundary are cut, px
 };
 
 // A binary image: 1 inside the region, 0 outside; width * height values, rows top to bottom.
@@ -42,7 +42,8 @@ struct RegionMask {
 // caller's cv::theRNG() state is saved, seeded with `options.seed` and restored. Throws
 // Error(kInvalidArgument) when `rect` is empty, leaves the image, covers all of it (GrabCut needs
 // background samples) or when no foreground remains.
-RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const SegmentOptions& options = {});
+RegionMask segment_foreground(const Image8& image, const PixelRect& rect,
+                              const SegmentOptions& options = {});
 
 // The boundary of `mask` as features, in image coordinates: the crack between inside and outside
 // pixels (corner cells cut diagonally, as marching squares at level 1/2), smoothed by
@@ -50,13 +51,15 @@ RegionMask segment_foreground(const Image8& image, const PixelRect& rect, const 
 // border gives one closed feature. Where it touches the border the boundary is the border itself,
 // which is not a feature: the rest comes out as open features that end exactly on the border.
 // Pieces shorter than 3 px are dropped.
-std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask, const SegmentOptions& options = {});
+std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask,
+                                                      const SegmentOptions& options = {});
 
 // Cuts every part of `features` that passes within `clearance` px of a polyline of `boundary`:
 // points on a segment that comes that close are removed and the feature is split there (a cut end
 // is no junction). Pieces shorter than `min_length` are dropped. Afterwards no remaining segment is
 // within `clearance` of the boundary, so the constraints of the dense mesh neither cross nor touch.
-void clear_features_near(std::vector<DetectedFeature>& features, const std::vector<DetectedFeature>& boundary,
-                         double clearance, double min_length);
+void clear_features_near(std::vector<DetectedFeature>& features,
+                         const std::vector<DetectedFeature>& boundary, double clearance,
+                         double min_length);
 
 }  // namespace subvec

@@ -368,7 +368,6 @@ TEST_F(Cli, HelpAndVersion) {
   }
 }
 
-
 // ---- vectorize -------------------------------------------------------------------------------
 
 // A 64 x 48 picture: a disk over a gradient, written as PNG through the library.
@@ -397,7 +396,8 @@ TEST_F(Cli, VectorizeWritesAValidImageAndReportsIt) {
   EXPECT_LE(j["vertices"].get<int>(), 60);
   EXPECT_GE(j["features"].get<int>(), 1);
   EXPECT_LT(j["mae"].get<double>(), 6.0);
-  for (const char* stage : {"features", "mesh", "simplify", "fit"}) EXPECT_TRUE(j["seconds"].contains(stage));
+  for (const char* stage : {"features", "mesh", "simplify", "fit"})
+    EXPECT_TRUE(j["seconds"].contains(stage));
   // The output is a valid vector image that renders at the photo's size.
   const CliResult info = subvec("info " + q(out) + " --json");
   ASSERT_EQ(info.status, 0) << info.err;
@@ -427,15 +427,16 @@ TEST_F(Cli, VectorizeBadInputs) {
   write_text(dir_ / "cut.png", png.substr(0, png.size() / 2));
   expect_failure(subvec("vectorize " + q(dir_ / "cut.png") + " -o " + q(out)), "truncated");
   write_text(dir_ / "photo.ppm", "P6\n1 1\n255\nabc");
-  expect_failure(subvec("vectorize " + q(dir_ / "photo.ppm") + " -o " + q(out)), "not a PNG, JPEG, WebP, TIFF or BMP file");
+  expect_failure(subvec("vectorize " + q(dir_ / "photo.ppm") + " -o " + q(out)),
+                 "not a PNG, JPEG, WebP, TIFF or BMP file");
   EXPECT_FALSE(fs::exists(out));
 }
 
 TEST_F(Cli, VectorizeSegment) {
   const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec";
   write_test_photo(photo);  // the disk: centre (30.5, 22.5), radius 15
-  const CliResult r =
-      subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 60 --segment 10,3,42,40 --json");
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) +
+                             " --vertices 60 --segment 10,3,42,40 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -447,13 +448,15 @@ TEST_F(Cli, VectorizeSegment) {
   EXPECT_TRUE(j["seconds"].contains("segment"));
   // GrabCut draws random numbers: same input and options, still the same bytes.
   const fs::path again = dir_ / "again.svec";
-  const CliResult text = subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --segment 10,3,42,40");
+  const CliResult text =
+      subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --segment 10,3,42,40");
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_EQ(read_text(out), read_text(again));
   EXPECT_NE(text.out.find("segment   10,3,42,40: "), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("boundary is 1 closed feature"), std::string::npos) << text.out;
   // Without --segment the JSON says so.
-  const CliResult plain = subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --json");
+  const CliResult plain =
+      subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --json");
   ASSERT_EQ(plain.status, 0) << plain.err;
   EXPECT_TRUE(nlohmann::json::parse(plain.out)["segment"].is_null());
 }
@@ -470,14 +473,17 @@ TEST_F(Cli, VectorizeTheExamplePhotograph) {
   EXPECT_EQ(j["width"], 384);
   EXPECT_EQ(j["height"], 256);
   EXPECT_LT(j["mae"].get<double>(), 8.0);
-  ASSERT_EQ(subvec("render " + q(out) + " -o " + q(dir_ / "mesh.png") + " --scale 4 --overlay mesh").status, 0);
+  ASSERT_EQ(subvec("render " + q(out) + " -o " + q(dir_ / "mesh.png") + " --scale 4 --overlay mesh")
+                .status,
+            0);
 }
 
 TEST_F(Cli, VectorizeSegmentBadRectangles) {
   const fs::path photo = dir_ / "photo.png", out = dir_ / "out.svec";
   write_test_photo(photo);  // 64 x 48
   const std::string run = "vectorize " + q(photo) + " -o " + q(out) + " --segment ";
-  for (const char* malformed : {"1,2,3", "a,b,c,d", "1,2,3,4,5", "1,2,3,4,", "1.5,2,3,4", "", " 1,2,3,4"}) {
+  for (const char* malformed :
+       {"1,2,3", "a,b,c,d", "1,2,3,4,5", "1,2,3,4,", "1.5,2,3,4", "", " 1,2,3,4"}) {
     const CliResult r = subvec(run + q(std::string(malformed)));
     expect_failure(r, "expected four integers X,Y,W,H");
     EXPECT_EQ(r.status, 105) << malformed;
@@ -496,7 +502,8 @@ TEST_F(Cli, VectorizeSegmentBadRectangles) {
 
 // Runs `subvec <args...>` with stderr on a pseudo-terminal and stdout in a file; returns what the
 // terminal received and the exit status.
-std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args, const fs::path& stdout_file,
+std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args,
+                                            const fs::path& stdout_file,
                                             const char* progress_delay) {
   int master = -1;
   const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
@@ -525,12 +532,13 @@ std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args
 }
 
 TEST_F(Cli, VectorizeProgressOnlyOnATerminal) {
-  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec", summary = dir_ / "summary.txt";
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec",
+                 summary = dir_ / "summary.txt";
   write_test_photo(photo);
   // On a terminal, with the delay at 0 so that even this short run shows it: a line redrawn with
   // '\r' per stage, erased at the end (the last thing written is spaces and '\r').
-  const auto [terminal, status] =
-      run_on_terminal({"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "0");
+  const auto [terminal, status] = run_on_terminal(
+      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "0");
   ASSERT_EQ(status, 0) << terminal;
   EXPECT_NE(terminal.find("\rsubvec: vectorizing photo.png: "), std::string::npos) << terminal;
   EXPECT_NE(terminal.find("%, 0 s"), std::string::npos) << terminal;
@@ -539,8 +547,8 @@ TEST_F(Cli, VectorizeProgressOnlyOnATerminal) {
   EXPECT_EQ(terminal.find('\n'), std::string::npos) << terminal;
   EXPECT_NE(read_text(summary).find("mesh      "), std::string::npos);
   // The default delay of a second hides it for a short run.
-  const auto [quiet, quiet_status] =
-      run_on_terminal({"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "1");
+  const auto [quiet, quiet_status] = run_on_terminal(
+      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "1");
   ASSERT_EQ(quiet_status, 0) << quiet;
   EXPECT_EQ(quiet, "");
   // Not a terminal: nothing on stderr whatever the delay.

@@ -286,7 +286,8 @@ TEST_F(ImageIo, WriteIntoMissingDirectoryFails) {
 // ---- every format, through OpenCV's encoders ---------------------------------------------------
 
 // Encodes a BGR(A) / gray OpenCV image with imencode (extension picks the format).
-std::vector<uint8_t> encode(const std::string& ext, const cv::Mat& m, const std::vector<int>& params = {}) {
+std::vector<uint8_t> encode(const std::string& ext, const cv::Mat& m,
+                            const std::vector<int>& params = {}) {
   std::vector<uint8_t> bytes;
   EXPECT_TRUE(cv::imencode(ext, m, bytes, params)) << ext;
   return bytes;
@@ -296,7 +297,8 @@ std::vector<uint8_t> encode(const std::string& ext, const cv::Mat& m, const std:
 cv::Mat3b smooth_bgr() {
   cv::Mat3b m(16, 24);
   for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 24; ++x) m(y, x) = cv::Vec3b(uint8_t(40 + 6 * y), uint8_t(200 - 5 * x), uint8_t(60 + 3 * (x + y)));
+    for (int x = 0; x < 24; ++x)
+      m(y, x) = cv::Vec3b(uint8_t(40 + 6 * y), uint8_t(200 - 5 * x), uint8_t(60 + 3 * (x + y)));
   return m;
 }
 
@@ -330,7 +332,8 @@ TEST_F(ImageIo, EveryFormatReadsAsRgb) {
     ASSERT_EQ(back.height, 16) << c.name;
     ASSERT_EQ(back.channels, 3) << c.name;
     double worst = 0;
-    for (size_t i = 0; i < expected.size(); ++i) worst = std::max(worst, std::abs(double(back.pixels[i]) - expected[i]));
+    for (size_t i = 0; i < expected.size(); ++i)
+      worst = std::max(worst, std::abs(double(back.pixels[i]) - expected[i]));
     EXPECT_LE(worst, c.max_error) << c.name;
   }
 }
@@ -367,7 +370,8 @@ TEST_F(ImageIo, FloatTiffIsTakenAsZeroToOne) {
   gray << 0.25f, 0.4f, 1.0f, 2.0f;  // 63.75, 102, 255, and over-range clamped to 255
   write_bytes(dir_ / "f.tif", encode(".tiff", gray));
   const Image8 back = read_image(dir_ / "f.tif");
-  EXPECT_EQ(back.pixels, (std::vector<uint8_t>{64, 64, 64, 102, 102, 102, 255, 255, 255, 255, 255, 255}));
+  EXPECT_EQ(back.pixels,
+            (std::vector<uint8_t>{64, 64, 64, 102, 102, 102, 255, 255, 255, 255, 255, 255}));
 }
 
 TEST_F(ImageIo, AlphaInTiffAndWebpIsCompositedOverBlack) {
@@ -377,7 +381,8 @@ TEST_F(ImageIo, AlphaInTiffAndWebpIsCompositedOverBlack) {
     write_bytes(dir_ / name, encode(ext, bgra, {cv::IMWRITE_WEBP_QUALITY, 101}));
     const Image8 back = read_image(dir_ / name);
     ASSERT_EQ(back.channels, 3);
-    EXPECT_EQ(std::vector<uint8_t>(back.pixels.begin(), back.pixels.begin() + 3), (std::vector<uint8_t>{40, 20, 10}))
+    EXPECT_EQ(std::vector<uint8_t>(back.pixels.begin(), back.pixels.begin() + 3),
+              (std::vector<uint8_t>{40, 20, 10}))
         << ext;
   }
 }
@@ -385,16 +390,19 @@ TEST_F(ImageIo, AlphaInTiffAndWebpIsCompositedOverBlack) {
 // OpenCV cannot write CMYK JPEGs: tests/data/images/cmyk.jpg comes from make_cmyk_jpeg.c there
 // (Adobe-style inverted CMYK, four flat 8 x 8 blocks).
 TEST_F(ImageIo, CmykJpegIsConvertedToRgb) {
-  const Image8 img = read_image(fs::path(SUBVEC_SOURCE_DIR) / "tests" / "data" / "images" / "cmyk.jpg");
+  const Image8 img =
+      read_image(fs::path(SUBVEC_SOURCE_DIR) / "tests" / "data" / "images" / "cmyk.jpg");
   ASSERT_EQ(img.width, 16);
   ASSERT_EQ(img.height, 16);
   const struct {
     int x, y;
     std::array<int, 3> rgb;
-  } blocks[] = {{4, 4, {255, 0, 0}}, {12, 4, {0, 255, 0}}, {4, 12, {0, 0, 255}}, {12, 12, {127, 127, 127}}};
+  } blocks[] = {
+      {4, 4, {255, 0, 0}}, {12, 4, {0, 255, 0}}, {4, 12, {0, 0, 255}}, {12, 12, {127, 127, 127}}};
   for (const auto& b : blocks) {
     const uint8_t* p = img.row(b.y) + 3 * b.x;
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(p[k], b.rgb[k], 4) << "block at " << b.x << "," << b.y << " channel " << k;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(p[k], b.rgb[k], 4) << "block at " << b.x << "," << b.y << " channel " << k;
   }
 }
 
@@ -409,7 +417,8 @@ TEST_F(ImageIo, TruncatedFilesInEveryFormat) {
       const std::string name = std::string("cut") + ext;
       write_bytes(dir_ / name, cut);
       std::string msg;
-      EXPECT_EQ(error_of([&] { read_image(dir_ / name); }, &msg), ErrorCode::kBadFile) << ext << " " << keep;
+      EXPECT_EQ(error_of([&] { read_image(dir_ / name); }, &msg), ErrorCode::kBadFile)
+          << ext << " " << keep;
       EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
     }
   }
@@ -417,14 +426,18 @@ TEST_F(ImageIo, TruncatedFilesInEveryFormat) {
 
 TEST_F(ImageIo, PixelLimitIsCheckedFromBmpWebpAndTiffHeaders) {
   // Headers only, each claiming 100000 x 100000 (or 100000 x 70000): refused before decoding.
-  const std::vector<uint8_t> bmp = {'B', 'M', 0, 0, 0, 0, 0, 0, 0, 0, 54, 0, 0, 0,  // file header
-                                    40, 0, 0, 0, 0xa0, 0x86, 0x01, 0, 0x60, 0x79, 0xfe, 0xff};  // w, -h
-  const std::vector<uint8_t> webp = {'R', 'I', 'F', 'F', 30, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'X', 10, 0, 0, 0,
-                                     0, 0, 0, 0, 0x9f, 0x86, 0x01, 0x9f, 0x86, 0x01};  // (w-1, h-1) 24-bit
-  const std::vector<uint8_t> tiff = {'M', 'M', 0, 42, 0, 0, 0, 8, 0, 2,  // big-endian, IFD at 8 with 2 entries
-                                     1, 0, 0, 4, 0, 0, 0, 1, 0, 1, 0x86, 0xa0,   // ImageWidth LONG 100000
-                                     1, 1, 0, 4, 0, 0, 0, 1, 0, 1, 0x11, 0x70};  // ImageLength LONG 70000
-  for (const auto& [name, bytes] : {std::pair{"huge.bmp", bmp}, std::pair{"huge.webp", webp}, std::pair{"huge.tif", tiff}}) {
+  const std::vector<uint8_t> bmp = {
+      'B', 'M', 0, 0, 0,    0,    0,    0, 0,    0,    54,   0,   0, 0,  // file header
+      40,  0,   0, 0, 0xa0, 0x86, 0x01, 0, 0x60, 0x79, 0xfe, 0xff};      // w, -h
+  const std::vector<uint8_t> webp = {
+      'R', 'I', 'F', 'F', 30, 0, 0, 0, 'W',  'E',  'B',  'P',  'V',  'P', '8', 'X',
+      10,  0,   0,   0,   0,  0, 0, 0, 0x9f, 0x86, 0x01, 0x9f, 0x86, 0x01};  // (w-1, h-1) 24-bit
+  const std::vector<uint8_t> tiff = {
+      'M', 'M', 0, 42, 0, 0, 0, 8, 0, 2,               // big-endian, IFD at 8 with 2 entries
+      1,   0,   0, 4,  0, 0, 0, 1, 0, 1, 0x86, 0xa0,   // ImageWidth LONG 100000
+      1,   1,   0, 4,  0, 0, 0, 1, 0, 1, 0x11, 0x70};  // ImageLength LONG 70000
+  for (const auto& [name, bytes] :
+       {std::pair{"huge.bmp", bmp}, std::pair{"huge.webp", webp}, std::pair{"huge.tif", tiff}}) {
     write_bytes(dir_ / name, bytes);
     std::string msg;
     EXPECT_EQ(error_of([&] { read_image(dir_ / name); }, &msg), ErrorCode::kLimit) << name;

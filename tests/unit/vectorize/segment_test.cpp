@@ -1,6 +1,8 @@
 // GrabCut segmentation as a feature source (vectorize/segment.h): the mask, its boundary as
 // features, the clearance cut of Canny features, and the whole pipeline with a segment rectangle
 // on a synthetic picture and on a shared photograph (skipped when ../shared is absent).
+#include "subvec/vectorize/segment.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,7 +16,6 @@
 #include "subvec/core/error.h"
 #include "subvec/io/image_io.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/vectorize/segment.h"
 #include "subvec/vectorize/vectorize.h"
 
 namespace subvec {
@@ -32,7 +33,8 @@ Image8 disk_image(int w, int h, double cx, double cy, double r) {
       const double bg[3] = {30 + 40.0 * x / w, 110 + 50.0 * y / h, 170};
       const double fg[3] = {235, 140, 40};
       uint8_t* p = img.row(y) + 3 * x;
-      for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround(inside * fg[k] + (1 - inside) * bg[k]));
+      for (int k = 0; k < 3; ++k)
+        p[k] = static_cast<uint8_t>(std::lround(inside * fg[k] + (1 - inside) * bg[k]));
     }
   }
   return img;
@@ -40,7 +42,8 @@ Image8 disk_image(int w, int h, double cx, double cy, double r) {
 
 double point_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
   const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  const double t =
+      len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
   return std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy);
 }
 
@@ -48,13 +51,17 @@ double point_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
 // and the image border beside inside pixels.
 std::vector<std::array<Vec2, 2>> crack_edges(const RegionMask& m) {
   std::vector<std::array<Vec2, 2>> out;
-  auto in = [&](int x, int y) { return x >= 0 && y >= 0 && x < m.width && y < m.height && m.at(x, y); };
+  auto in = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < m.width && y < m.height && m.at(x, y);
+  };
   for (int y = 0; y <= m.height; ++y)
     for (int x = 0; x < m.width; ++x)
-      if (in(x, y - 1) != in(x, y)) out.push_back({Vec2{double(x), double(y)}, Vec2{x + 1.0, double(y)}});
+      if (in(x, y - 1) != in(x, y))
+        out.push_back({Vec2{double(x), double(y)}, Vec2{x + 1.0, double(y)}});
   for (int y = 0; y < m.height; ++y)
     for (int x = 0; x <= m.width; ++x)
-      if (in(x - 1, y) != in(x, y)) out.push_back({Vec2{double(x), double(y)}, Vec2{double(x), y + 1.0}});
+      if (in(x - 1, y) != in(x, y))
+        out.push_back({Vec2{double(x), double(y)}, Vec2{double(x), y + 1.0}});
   return out;
 }
 
@@ -75,7 +82,8 @@ class Segments {
       for (int dx = -radius; dx <= radius; ++dx) {
         const auto it = cells_.find(int64_t(cy + dy) * 100000 + (cx + dx));
         if (it == cells_.end()) continue;
-        for (size_t k : it->second) best = std::min(best, point_segment_distance(p, s_[k][0], s_[k][1]));
+        for (size_t k : it->second)
+          best = std::min(best, point_segment_distance(p, s_[k][0], s_[k][1]));
       }
     }
     return best;
@@ -97,12 +105,14 @@ std::vector<Vec2> closed_bspline(const std::vector<Vec2>& control, int per_span)
   const size_t n = control.size();
   std::vector<Vec2> out;
   for (size_t k = 0; k < n; ++k) {
-    const Vec2 p0 = control[(k + n - 1) % n], p1 = control[k], p2 = control[(k + 1) % n], p3 = control[(k + 2) % n];
+    const Vec2 p0 = control[(k + n - 1) % n], p1 = control[k], p2 = control[(k + 1) % n],
+               p3 = control[(k + 2) % n];
     for (int s = 0; s < per_span; ++s) {
       const double t = double(s) / per_span, t2 = t * t, t3 = t2 * t;
       const double b0 = (1 - t) * (1 - t) * (1 - t) / 6, b1 = (3 * t3 - 6 * t2 + 4) / 6,
                    b2 = (-3 * t3 + 3 * t2 + 3 * t + 1) / 6, b3 = t3 / 6;
-      out.push_back({b0 * p0.x + b1 * p1.x + b2 * p2.x + b3 * p3.x, b0 * p0.y + b1 * p1.y + b2 * p2.y + b3 * p3.y});
+      out.push_back({b0 * p0.x + b1 * p1.x + b2 * p2.x + b3 * p3.x,
+                     b0 * p0.y + b1 * p1.y + b2 * p2.y + b3 * p3.y});
     }
   }
   return out;
@@ -157,9 +167,10 @@ TEST(Segment, IsDeterministicAndLeavesTheCallersRngAlone) {
 
 TEST(Segment, RejectsBadRectangles) {
   const Image8 img = disk_image(40, 30, 20, 15, 8);
-  for (const PixelRect& r : {PixelRect{5, 5, 0, 10}, PixelRect{5, 5, 10, -1}, PixelRect{-1, 0, 10, 10},
-                             PixelRect{0, 25, 10, 10}, PixelRect{35, 5, 6, 5}, PixelRect{0, 0, 40, 30},
-                             PixelRect{10, 10, 2, 2}}) {
+  for (const PixelRect& r :
+       {PixelRect{5, 5, 0, 10}, PixelRect{5, 5, 10, -1}, PixelRect{-1, 0, 10, 10},
+        PixelRect{0, 25, 10, 10}, PixelRect{35, 5, 6, 5}, PixelRect{0, 0, 40, 30},
+        PixelRect{10, 10, 2, 2}}) {
     EXPECT_EQ(error_of([&] { segment_foreground(img, r); }), ErrorCode::kInvalidArgument)
         << r.x << "," << r.y << "," << r.width << "," << r.height;
   }
@@ -197,7 +208,10 @@ TEST(Segment, ClearFeaturesNearCutsCannyFeaturesBack) {
   DetectedFeature box;
   for (int k = 0; k <= 80; ++k) {
     const double s = k * 0.25 * 4;  // 0..80 along the perimeter, 1 px steps
-    Vec2 p = s < 20 ? Vec2{20 + s, 20} : s < 40 ? Vec2{40, s} : s < 60 ? Vec2{80 - s, 40} : Vec2{20, 100 - s};
+    Vec2 p = s < 20   ? Vec2{20 + s, 20}
+             : s < 40 ? Vec2{40, s}
+             : s < 60 ? Vec2{80 - s, 40}
+                      : Vec2{20, 100 - s};
     box.points.push_back(p);
   }
   box.points.back() = box.points.front();
@@ -206,7 +220,8 @@ TEST(Segment, ClearFeaturesNearCutsCannyFeaturesBack) {
   for (int x = 0; x <= 60; ++x) line.points.push_back({x + 0.3, 30.2});
   line.start_node = 4, line.end_node = 7;
   DetectedFeature ring;
-  for (int k = 0; k <= 40; ++k) ring.points.push_back({90 + 6 * std::cos(k * M_PI / 20), 30 + 6 * std::sin(k * M_PI / 20)});
+  for (int k = 0; k <= 40; ++k)
+    ring.points.push_back({90 + 6 * std::cos(k * M_PI / 20), 30 + 6 * std::sin(k * M_PI / 20)});
   ring.points.back() = ring.points.front();
   std::vector<DetectedFeature> features{line, ring};
   clear_features_near(features, {box}, 1.5, 5.0);
@@ -223,7 +238,8 @@ TEST(Segment, ClearFeaturesNearCutsCannyFeaturesBack) {
   for (size_t k = 0; k < 3; ++k) {
     for (const Vec2& p : features[k].points) {
       double d = 1e9;
-      for (size_t i = 0; i + 1 < box.points.size(); ++i) d = std::min(d, point_segment_distance(p, box.points[i], box.points[i + 1]));
+      for (size_t i = 0; i + 1 < box.points.size(); ++i)
+        d = std::min(d, point_segment_distance(p, box.points[i], box.points[i + 1]));
       EXPECT_GE(d, 1.5);
     }
   }
@@ -236,20 +252,24 @@ TEST(Segment, ClearFeaturesNearCutsCannyFeaturesBack) {
 // Checks that `v` has the segment boundary as one closed tear whose limit curve stays within 1 px
 // of the detected (smoothed) GrabCut boundary and within 1.5 px of the mask's pixel edges (the
 // smoothing keeps the detected boundary within 0.4 px of them), and that it follows all of it.
-void expect_closed_segment_tear(const VectorImage& v, const VectorizeReport& report, const char* name) {
+void expect_closed_segment_tear(const VectorImage& v, const VectorizeReport& report,
+                                const char* name) {
   ASSERT_EQ(report.segment_feature_ids.size(), 1u) << name;
   const ControlMesh& mesh = v.levels[0];
-  const auto it = std::find_if(mesh.features.begin(), mesh.features.end(),
-                               [&](const Feature& f) { return f.id == report.segment_feature_ids[0]; });
+  const auto it = std::find_if(mesh.features.begin(), mesh.features.end(), [&](const Feature& f) {
+    return f.id == report.segment_feature_ids[0];
+  });
   ASSERT_NE(it, mesh.features.end()) << name;
   ASSERT_TRUE(it->closed()) << name;
   // No other feature touches it, so it has no corner and its limit is a closed B-spline.
   for (const Feature& f : mesh.features) {
     if (f.id == it->id) continue;
-    for (int32_t a : f.vertices) EXPECT_EQ(std::count(it->vertices.begin(), it->vertices.end(), a), 0) << name;
+    for (int32_t a : f.vertices)
+      EXPECT_EQ(std::count(it->vertices.begin(), it->vertices.end(), a), 0) << name;
   }
   std::vector<Vec2> control;
-  for (size_t i = 0; i + 1 < it->vertices.size(); ++i) control.push_back(mesh.positions[it->vertices[i]]);
+  for (size_t i = 0; i + 1 < it->vertices.size(); ++i)
+    control.push_back(mesh.positions[it->vertices[i]]);
   const std::vector<Vec2> curve = closed_bspline(control, 16);
 
   // The detected boundary is what the mesh feature started from (report.feature_targets).
@@ -257,7 +277,8 @@ void expect_closed_segment_tear(const VectorImage& v, const VectorizeReport& rep
   ASSERT_LT(index, report.feature_targets.size());
   std::vector<std::array<Vec2, 2>> detected_segments;
   const std::vector<Vec2>& target = report.feature_targets[index];
-  for (size_t i = 0; i + 1 < target.size(); ++i) detected_segments.push_back({target[i], target[i + 1]});
+  for (size_t i = 0; i + 1 < target.size(); ++i)
+    detected_segments.push_back({target[i], target[i + 1]});
   const Segments detected(detected_segments);
   const std::vector<std::array<Vec2, 2>> cracks = crack_edges(report.segment_mask);
   const Segments pixel_edges(cracks);
@@ -269,14 +290,17 @@ void expect_closed_segment_tear(const VectorImage& v, const VectorizeReport& rep
   EXPECT_LE(to_detected, 1.0 + 1e-6) << name << ": limit curve to the detected GrabCut boundary";
   EXPECT_LE(to_pixels, 1.5) << name << ": limit curve to the GrabCut mask's pixel edges";
   std::vector<std::array<Vec2, 2>> curve_segments;
-  for (size_t i = 0; i < curve.size(); ++i) curve_segments.push_back({curve[i], curve[(i + 1) % curve.size()]});
+  for (size_t i = 0; i < curve.size(); ++i)
+    curve_segments.push_back({curve[i], curve[(i + 1) % curve.size()]});
   const Segments limit(curve_segments);
   double uncovered = 0;
-  for (const auto& c : cracks) uncovered = std::max(uncovered, limit.distance({(c[0].x + c[1].x) / 2, (c[0].y + c[1].y) / 2}));
+  for (const auto& c : cracks)
+    uncovered = std::max(uncovered, limit.distance({(c[0].x + c[1].x) / 2, (c[0].y + c[1].y) / 2}));
   EXPECT_LE(uncovered, 2.0) << name << ": GrabCut mask's pixel edges to the limit curve";
-  std::printf("[ %s ] segment: %zu control vertices; limit curve within %.3f px of the detected boundary, "
-              "%.3f px of the mask's pixel edges; those within %.3f px of the curve\n",
-              name, control.size(), to_detected, to_pixels, uncovered);
+  std::printf(
+      "[ %s ] segment: %zu control vertices; limit curve within %.3f px of the detected boundary, "
+      "%.3f px of the mask's pixel edges; those within %.3f px of the curve\n",
+      name, control.size(), to_detected, to_pixels, uncovered);
 }
 
 TEST(Segment, VectorizeMakesTheBoundaryAClosedTear) {
@@ -321,7 +345,8 @@ TEST(Segment, VectorizeEndsTheBoundaryOnTheImageBorder) {
 TEST(Segment, SharedPhotograph) {
   const std::filesystem::path path =
       std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "apple.png";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << "no " << path << ": shared photographs not present";
   const Image8 img = read_image(path);
   VectorizeOptions options;
   options.ratio = 0.01;
