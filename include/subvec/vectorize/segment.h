@@ -50,7 +50,8 @@ RegionMask segment_foreground(const Image8& image, const PixelRect& rect,
 // `options.smoothing_passes` and resampled to about 1 px spacing. A region that stays off the image
 // border gives one closed feature. Where it touches the border the boundary is the border itself,
 // which is not a feature: the rest comes out as open features that end exactly on the border.
-// Pieces shorter than 3 px are dropped.
+// Pieces shorter than 3 px are dropped. Their `contrast` is 0 (not measured) and they have no
+// junction nodes.
 std::vector<DetectedFeature> region_boundary_features(const RegionMask& mask,
                                                       const SegmentOptions& options = {});
 
