@@ -4,21 +4,28 @@
 // CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
 // status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
 // partial file and never clobbers an existing one.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "subvec/core/error.h"
@@ -29,8 +36,6 @@
 #include "subvec/mesh/validate.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
-#include <chrono>
-#include <unistd.h>
 
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
@@ -297,42 +302,168 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
 
 // ---- vectorize -------------------------------------------------------------------------------
 
+// Parses "X,Y,W,H" (integers); returns an error message, or "" and fills `r`. Whether the
+// rectangle lies inside the image is the library's check, once the image is read.
+std::string parse_rect(const std::string& text, subvec::PixelRect& r) {
+  const std::string usage = "expected four integers X,Y,W,H, got '" + text + "'";
+  int v[4];
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  for (int k = 0; k < 4; ++k) {
+    const auto [next, ec] = std::from_chars(p, end, v[k]);
+    if (ec != std::errc() || next == p) return usage;
+    p = next;
+    if (k < 3) {
+      if (p == end || *p != ',') return usage;
+      ++p;
+    }
+  }
+  if (p != end) return usage;
+  if (v[2] <= 0 || v[3] <= 0)
+    return "the rectangle '" + text + "' is empty (W and H must be positive)";
+  r = {v[0], v[1], v[2], v[3]};
+  return "";
+}
+
+// One line of progress on stderr for long runs: only when stderr is a terminal, and only once the
+// run has taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that). A thread redraws it a few
+// times a second and at every new stage (stage, share of the pipeline, elapsed seconds) and erases
+// it at the end, so the terminal keeps the summary alone and pipes and logs get nothing.
+class ProgressLine {
+ public:
+  explicit ProgressLine(std::string label)
+      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
+    if (const char* env = std::getenv("SUBVEC_PROGRESS_DELAY")) {
+      char* end = nullptr;
+      const double v = std::strtod(env, &end);
+      if (end != env && *end == '\0' && v >= 0 && std::isfinite(v)) delay_ = v;
+    }
+    if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
+  }
+  ~ProgressLine() { finish(); }
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
+
+  void update(const std::string& stage, double fraction) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stage_ = stage;
+      fraction_ = fraction;
+      changed_ = true;
+    }
+    wake_.notify_all();
+  }
+
+  // Stops redrawing and erases the line.
+  void finish() {
+    if (!thread_.joinable()) return;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+    if (shown_ > 0) std::fprintf(stderr, "\r%*s\r", shown_, "");
+    std::fflush(stderr);
+  }
+
+ private:
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      wake_.wait_for(lock, std::chrono::milliseconds(200), [this] { return done_ || changed_; });
+      if (done_) return;
+      changed_ = false;
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      if (elapsed < delay_) continue;
+      char line[512];
+      const int n = std::snprintf(line, sizeof line, "subvec: %s: %s %3d%%, %.0f s", label_.c_str(),
+                                  stage_.c_str(), static_cast<int>(std::lround(100 * fraction_)),
+                                  std::floor(elapsed));
+      const int len = std::min(n, static_cast<int>(sizeof line) - 1);
+      if (last_ == line) continue;
+      last_ = line;
+      std::fprintf(stderr, "\r%s%*s", line, std::max(0, shown_ - len), "");
+      std::fflush(stderr);
+      shown_ = std::max(shown_, len);
+    }
+  }
+
+  const std::string label_;
+  const std::chrono::steady_clock::time_point start_;
+  double delay_ = 1.0;  // seconds before the line appears
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread thread_;
+  std::string stage_ = "reading";
+  double fraction_ = 0;
+  bool changed_ = false, done_ = false;
+  std::string last_;  // the line on the terminal
+  int shown_ = 0;     // widest line drawn, in characters
+};
+
 struct VectorizeArgs {
   std::string input, output;
   double ratio = 0.01;
   int vertices = 0;
-  int64_t max_pixels = int64_t{1} << 26;
+  // 2^23 pixels: a 4K UHD frame (3840 x 2160) fits. Vectorizing takes about 1.5 KB of memory per
+  // pixel (the dense mesh has a vertex per pixel), so the default stays near 12 GB.
+  int64_t max_pixels = int64_t{1} << 23;
   std::string fit = "pixels";
+  std::string segment;  // X,Y,W,H, or empty
   bool json = false;
 };
 
 void run_vectorize(const VectorizeArgs& a) {
   subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
   const auto start = std::chrono::steady_clock::now();
-  const subvec::Image8 image = subvec::read_image(a.input, a.max_pixels);
+  ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
+  subvec::Image8 image;
+  try {
+    image = subvec::read_image(a.input, a.max_pixels);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kLimit) throw;
+    throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
+  }
   subvec::VectorizeOptions options;
   options.ratio = a.ratio;
   options.vertices = a.vertices;
-  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices : subvec::ColorFitTarget::kPixels;
-  // Progress on a terminal, for runs past a second.
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  bool printed = false;
+  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
+                                           : subvec::ColorFitTarget::kPixels;
+  if (!a.segment.empty()) {
+    subvec::PixelRect rect;
+    parse_rect(a.segment, rect);  // already validated by CLI11
+    options.segment = rect;
+  }
   options.progress = [&](const std::string& stage, double fraction) {
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!tty || elapsed < 1.0) return;
-    std::fprintf(stderr, "\rsubvec: vectorizing %s: %-9s %3d%%", a.input.c_str(), stage.c_str(),
-                 static_cast<int>(std::lround(100 * fraction)));
-    std::fflush(stderr);
-    printed = true;
+    progress.update(stage, fraction);
   };
   subvec::VectorizeReport report;
   const subvec::VectorImage v = subvec::vectorize(image, options, &report);
-  if (printed) std::fprintf(stderr, "\n");
+  progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
-  const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
-  const double compare_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  const subvec::ImageDifference d =
+      subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
+  const double compare_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  progress.update("writing", 1.0);
   subvec::write_svec(a.output, v);
-  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress.finish();
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // The segment's boundary: how many mesh features follow it and whether it is one closed curve.
+  int segment_closed = 0;
+  for (const subvec::Feature& f : v.levels[0].features) {
+    if (std::find(report.segment_feature_ids.begin(), report.segment_feature_ids.end(), f.id) !=
+        report.segment_feature_ids.end()) {
+      segment_closed += f.closed();
+    }
+  }
+  const int segment_features = static_cast<int>(report.segment_feature_ids.size());
+  const bool segment_is_closed = segment_features == 1 && segment_closed == 1;
+
   if (a.json) {
     nlohmann::ordered_json j;
     j["input"] = a.input;
@@ -343,8 +474,18 @@ void run_vectorize(const VectorizeArgs& a) {
     j["triangles"] = report.triangles;
     j["features"] = report.features;
     j["tear_vertices"] = report.tear_vertices;
+    if (options.segment) {
+      const subvec::PixelRect& r = *options.segment;
+      j["segment"] = {{"rect", {r.x, r.y, r.width, r.height}},
+                      {"foreground_pixels", report.segment_mask.area()},
+                      {"features", segment_features},
+                      {"closed", segment_is_closed}};
+    } else {
+      j["segment"] = nullptr;
+    }
     j["mae"] = d.mae_mean;
-    j["psnr"] = std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
+    j["psnr"] =
+        std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
     j["ssim"] = d.ssim;
     nlohmann::ordered_json stages;
     for (const auto& s : report.stages) stages[s.stage] = s.seconds;
@@ -356,13 +497,25 @@ void run_vectorize(const VectorizeArgs& a) {
   }
   std::printf("%s -> %s\n", a.input.c_str(), a.output.c_str());
   std::printf("size      %d x %d pixels\n", image.width, image.height);
-  std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n", report.vertices,
-              report.triangles, report.features, report.tear_vertices);
-  std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n", d.mae_mean,
-              d.psnr, d.ssim);
+  std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n",
+              report.vertices, report.triangles, report.features, report.tear_vertices);
+  if (options.segment) {
+    std::string boundary = "is 1 closed feature";
+    if (!segment_is_closed) {
+      boundary = segment_features == 0
+                     ? "lies on the image border (no feature)"
+                     : "is " + std::to_string(segment_features) +
+                           (segment_features == 1 ? " open feature" : " open features") +
+                           " ending on the image border";
+    }
+    std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
+                static_cast<long long>(report.segment_mask.area()), boundary.c_str());
+  }
+  std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n",
+              d.mae_mean, d.psnr, d.ssim);
   std::printf("seconds  ");
   for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
-  std::printf(" total %.3f\n", total);
+  std::printf(" render+compare %.3f, total %.3f\n", compare_seconds, total);
 }
 
 // ---- command line ----------------------------------------------------------------------------
@@ -383,7 +536,8 @@ std::string command_path(const CLI::App& app) {
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
-      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares raster images.",
+      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares "
+      "raster images.",
       "subvec");
   app.footer(
       "Examples:\n"
@@ -495,32 +649,54 @@ int run(int argc, char** argv) {
 
   // vectorize
   VectorizeArgs va;
-  CLI::App* vectorize = app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
+  CLI::App* vectorize =
+      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
   vectorize->add_option("input", va.input, "Raster image")->required();
-  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")->required();
+  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
+      ->required();
   CLI::Option* ratio_opt =
-      vectorize->add_option("--ratio", va.ratio, "Control vertices as a fraction of the pixel count (default 0.01)")
+      vectorize
+          ->add_option("--ratio", va.ratio,
+                       "Control vertices as a fraction of the pixel count (default 0.01)")
           ->check(CLI::Validator(
               [](std::string& text) {
                 double v = 0;
-                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
+                const bool ok =
+                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
                 return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
               },
               "RATIO", "ratio"));
-  CLI::Option* vertices_opt = vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
-                                  ->check(CLI::Range(4, 1 << 26));
+  CLI::Option* vertices_opt =
+      vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
+          ->check(CLI::Range(4, 1 << 26));
   ratio_opt->excludes(vertices_opt);
-  vectorize->add_option("--max-pixels", va.max_pixels, "Refuse larger images (default 67108864)")
+  vectorize
+      ->add_option("--max-pixels", va.max_pixels,
+                   "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
-  vectorize->add_option("--fit", va.fit, "Color fit: every pixel (default) or the paper's subdivided vertices")
+  vectorize
+      ->add_option("--fit", va.fit,
+                   "Color fit: every pixel (default) or the paper's subdivided vertices")
       ->check(CLI::IsMember({"pixels", "vertices"}))
       ->default_str("pixels");
+  vectorize
+      ->add_option("--segment", va.segment,
+                   "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
+                   "becomes a closed tear")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            subvec::PixelRect r;
+            return parse_rect(text, r);
+          },
+          "X,Y,W,H", "rect"));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   vectorize->footer(
       "Examples:\n"
-      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as vertices\n"
+      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
+      "vertices\n"
       "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
-      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json");
+      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
+      "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 
   try {
     app.parse(argc, argv);
@@ -540,7 +716,8 @@ int run(int argc, char** argv) {
         message = "a command is required: vectorize, render, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, render, info, convert or compare)";
+                  extra.front() +
+                  "' (expected a command: vectorize, render, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }

@@ -1,24 +1,30 @@
 // Raster image files through OpenCV (io/image_io.h).
 //
 // Reading: the whole file is read into memory (io/file.h), its size checked against `max_pixels`
-// from the header where we can parse it cheaply (PNG IHDR, JPEG SOFn) before anything is decoded,
-// and otherwise right after decoding. Everything becomes 8-bit RGB:
+// from the header where we can parse it cheaply (PNG IHDR, JPEG SOFn, BMP DIB header, WebP VP8 /
+// VP8L / VP8X, the first TIFF directory) before anything is decoded, and again after decoding.
+// Everything becomes 8-bit RGB:
 //  - gray (and gray + alpha) is replicated to R = G = B;
 //  - 16-bit samples are scaled by 255/65535 with rounding, float samples are taken as 0-1;
 //  - alpha is composited over black (c * a / 255), so a transparent pixel reads as black; this
 //    matches the renderer, whose transparent pixels outside the image are (0, 0, 0, 0);
 //  - JPEG is decoded with OpenCV's colour path, which converts CMYK/YCCK and applies the EXIF
 //    orientation; other formats are decoded as stored (IMREAD_UNCHANGED keeps alpha and depth).
-// A PNG whose chunks are cut short or fail their CRC, and a JPEG whose entropy-coded data has no
-// end-of-image marker, are reported as truncated before decoding (libpng would print to stderr,
-// libjpeg would fill the missing rows with grey). Decoders may still print warnings about
-// unusual but readable files (libpng's "iCCP: known incorrect sRGB profile").
+// A PNG whose chunks are cut short or fail their CRC, a JPEG whose entropy-coded data has no
+// end-of-image marker, and a BMP shorter than its rows are reported as truncated before decoding
+// (libpng would print to stderr, libjpeg would fill the missing rows with grey). Other formats are
+// refused before decoding. OpenCV's own messages about damaged files (std::cerr) are muted during
+// the decode; the decoders' C libraries may still print warnings about unusual but readable files
+// (libpng's "iCCP: known incorrect sRGB profile").
 //
 // Writing: encoded to memory, then written atomically.
 #include "subvec/io/image_io.h"
 
 #include <array>
+#include <cstdlib>
 #include <cstring>
+#include <iostream>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -48,6 +54,41 @@ void silence_opencv() {
   }();
   (void)once;
 }
+
+// cv::imdecode prints a decoder's exception to std::cerr ("imdecode_(''): can't read data: ...")
+// before it returns an empty image, for damaged TIFF, WebP and BMP files alike. The library
+// reports through exceptions, so std::cerr is muted while any decode runs. It is a process-wide
+// stream: what another thread writes to std::cerr meanwhile is lost too.
+class MutedCerr {
+ public:
+  MutedCerr() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (depth()++ == 0) saved() = std::cerr.rdbuf(nullptr);
+  }
+  ~MutedCerr() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (--depth() == 0) {
+      std::cerr.rdbuf(saved());
+      std::cerr.clear();  // writes to a null buffer set badbit
+    }
+  }
+  MutedCerr(const MutedCerr&) = delete;
+  MutedCerr& operator=(const MutedCerr&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& depth() {
+    static int d = 0;
+    return d;
+  }
+  static std::streambuf*& saved() {
+    static std::streambuf* s = nullptr;
+    return s;
+  }
+};
 
 uint32_t big_endian_u32(const uint8_t* p) {
   return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
@@ -144,6 +185,113 @@ JpegScan scan_jpeg(const std::vector<uint8_t>& b) {
   return scan;
 }
 
+uint32_t little_endian_u32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+uint32_t little_endian_u16(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8; }
+
+bool is_bmp(const std::vector<uint8_t>& b) { return b.size() >= 2 && b[0] == 'B' && b[1] == 'M'; }
+bool is_webp(const std::vector<uint8_t>& b) {
+  return b.size() >= 12 && std::memcmp(b.data(), "RIFF", 4) == 0 &&
+         std::memcmp(b.data() + 8, "WEBP", 4) == 0;
+}
+bool is_tiff(const std::vector<uint8_t>& b) {  // classic (42) or BigTIFF (43), either byte order
+  return b.size() >= 4 &&
+         ((b[0] == 'I' && b[1] == 'I' && (b[2] == 42 || b[2] == 43) && b[3] == 0) ||
+          (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && (b[3] == 42 || b[3] == 43)));
+}
+
+// BMP: "BM", then at 14 the DIB header: its size, then width and height (16-bit in the old
+// 12-byte core header, else signed 32-bit; a negative height means top-down rows).
+HeaderSize bmp_size(const std::vector<uint8_t>& b) {
+  if (b.size() < 26 || b[0] != 'B' || b[1] != 'M') return {};
+  const uint32_t dib = little_endian_u32(b.data() + 14);
+  if (dib == 12) return {little_endian_u16(b.data() + 18), little_endian_u16(b.data() + 20)};
+  const auto width = int32_t(little_endian_u32(b.data() + 18)),
+             height = int32_t(little_endian_u32(b.data() + 22));
+  return {std::abs(int64_t{width}), std::abs(int64_t{height})};
+}
+
+// OpenCV's BMP decoder prints to std::cerr when the file ends early, so check first that it holds
+// its headers and, for uncompressed pixels, every row (rows padded to 4 bytes); for RLE the size
+// the file header declares, when it declares one.
+bool bmp_complete(const std::vector<uint8_t>& b) {
+  if (b.size() < 26) return false;
+  const uint32_t declared = little_endian_u32(b.data() + 2),
+                 offset = little_endian_u32(b.data() + 10);
+  const uint32_t dib = little_endian_u32(b.data() + 14);
+  if (dib < 12 || b.size() < 14 + uint64_t{dib} || offset < 14 + uint64_t{dib} || offset > b.size())
+    return false;
+  int64_t width, height;
+  uint32_t bits, compression = 0;
+  if (dib == 12) {
+    width = little_endian_u16(b.data() + 18), height = little_endian_u16(b.data() + 20);
+    bits = little_endian_u16(b.data() + 24);
+  } else {
+    if (dib < 40) return false;
+    width = std::abs(int64_t{int32_t(little_endian_u32(b.data() + 18))});
+    height = std::abs(int64_t{int32_t(little_endian_u32(b.data() + 22))});
+    bits = little_endian_u16(b.data() + 28), compression = little_endian_u32(b.data() + 30);
+  }
+  if (compression == 0 || compression == 3 || compression == 6) {  // RGB, BITFIELDS, ALPHABITFIELDS
+    const int64_t row = (int64_t{bits} * width + 31) / 32 * 4;
+    return int64_t(b.size()) - offset >= row * height;
+  }
+  return declared == 0 || b.size() >= declared;
+}
+
+// WebP: "RIFF" size "WEBP", then the first chunk: "VP8 " (lossy: 14-bit sizes after the start
+// code 9d 01 2a), "VP8L" (lossless: signature 0x2f, then 14-bit width - 1 and height - 1) or
+// "VP8X" (extended: 24-bit canvas width - 1 and height - 1).
+HeaderSize webp_size(const std::vector<uint8_t>& b) {
+  if (b.size() < 30 || std::memcmp(b.data(), "RIFF", 4) != 0 ||
+      std::memcmp(b.data() + 8, "WEBP", 4) != 0)
+    return {};
+  const uint8_t* chunk = b.data() + 12;
+  const uint8_t* data = chunk + 8;
+  if (std::memcmp(chunk, "VP8 ", 4) == 0 && data[3] == 0x9d && data[4] == 0x01 && data[5] == 0x2a) {
+    return {little_endian_u16(data + 6) & 0x3fff, little_endian_u16(data + 8) & 0x3fff};
+  }
+  if (std::memcmp(chunk, "VP8L", 4) == 0 && data[0] == 0x2f) {
+    const uint32_t bits = little_endian_u32(data + 1);
+    return {(bits & 0x3fff) + 1, ((bits >> 14) & 0x3fff) + 1};
+  }
+  if (std::memcmp(chunk, "VP8X", 4) == 0) {
+    const auto u24 = [](const uint8_t* p) {
+      return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+    };
+    return {int64_t{u24(data + 4)} + 1, int64_t{u24(data + 7)} + 1};
+  }
+  return {};
+}
+
+// TIFF (classic, either byte order): the first image file directory's ImageWidth (256) and
+// ImageLength (257) entries, SHORT or LONG.
+HeaderSize tiff_size(const std::vector<uint8_t>& b) {
+  if (b.size() < 8) return {};
+  const bool little = b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0;
+  const bool big = b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42;
+  if (!little && !big) return {};
+  const auto u16 = [&](size_t at) {
+    return little ? little_endian_u16(b.data() + at) : big_endian_u16(b.data() + at);
+  };
+  const auto u32 = [&](size_t at) {
+    return little ? little_endian_u32(b.data() + at) : big_endian_u32(b.data() + at);
+  };
+  const size_t ifd = u32(4);
+  if (ifd > b.size() - 2) return {};
+  const size_t entries = u16(ifd);
+  HeaderSize size;
+  for (size_t k = 0; k < entries && ifd + 2 + 12 * (k + 1) <= b.size(); ++k) {
+    const size_t e = ifd + 2 + 12 * k;
+    const uint32_t tag = u16(e), type = u16(e + 2);
+    if ((tag != 256 && tag != 257) || (type != 3 && type != 4)) continue;
+    const int64_t value = type == 3 ? u16(e + 8) : u32(e + 8);
+    (tag == 256 ? size.width : size.height) = value;
+  }
+  return size.width >= 0 && size.height >= 0 ? size : HeaderSize{};
+}
+
 void check_pixels(const fs::path& path, int64_t width, int64_t height, int64_t max_pixels) {
   // width * height > max_pixels, without overflow for 32-bit header fields.
   if (width > 0 && height > max_pixels / width) {
@@ -184,28 +332,40 @@ Image8 read_image(const fs::path& path, int64_t max_pixels) {
   const std::vector<uint8_t> bytes = read_file(path);
   if (bytes.empty()) fail(ErrorCode::kBadFile, path, "file is empty");
 
+  // Only the five documented formats reach OpenCV's decoders.
+  constexpr const char* kTruncated = "file is truncated or not an image";
   int flags = cv::IMREAD_UNCHANGED;
   if (is_png(bytes)) {
     const HeaderSize size = png_size(bytes);
     if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
-    if (!png_complete(bytes)) fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+    if (!png_complete(bytes)) fail(ErrorCode::kBadFile, path, kTruncated);
   } else if (is_jpeg(bytes)) {
     const JpegScan scan = scan_jpeg(bytes);
     if (scan.size.width >= 0) check_pixels(path, scan.size.width, scan.size.height, max_pixels);
-    if (!scan.complete) fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+    if (!scan.complete) fail(ErrorCode::kBadFile, path, kTruncated);
     flags = cv::IMREAD_COLOR;  // CMYK conversion and EXIF orientation; JPEG has no alpha
+  } else if (is_bmp(bytes)) {
+    const HeaderSize size = bmp_size(bytes);
+    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+    if (!bmp_complete(bytes)) fail(ErrorCode::kBadFile, path, kTruncated);
+  } else if (is_webp(bytes) || is_tiff(bytes)) {
+    const HeaderSize size = is_webp(bytes) ? webp_size(bytes) : tiff_size(bytes);
+    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+  } else {
+    fail(ErrorCode::kBadFile, path, "not a PNG, JPEG, WebP, TIFF or BMP file");
   }
 
   cv::Mat decoded;
   try {
     // cv::imdecode takes a non-const Mat header over the buffer but does not write to it.
     const cv::Mat buffer(1, int(bytes.size()), CV_8U, const_cast<uint8_t*>(bytes.data()));
+    const MutedCerr quiet;
     decoded = cv::imdecode(buffer, flags);
   } catch (const cv::Exception&) {
     decoded.release();
   }
   if (decoded.empty() || decoded.dims != 2) {
-    fail(ErrorCode::kBadFile, path, "file is truncated or not an image");
+    fail(ErrorCode::kBadFile, path, kTruncated);
   }
   check_pixels(path, decoded.cols, decoded.rows, max_pixels);
 

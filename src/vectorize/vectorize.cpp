@@ -1,8 +1,11 @@
 #include "subvec/vectorize/vectorize.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -34,13 +37,40 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
     t = now;
   };
 
-  // Stage 1: features. Stage 2: the dense mesh. Rough shares of the run time drive the progress.
-  progress("features", 0.0);
-  const std::vector<DetectedFeature> features = detect_features(image, options.features);
+  // Stage 1: features, GrabCut's region boundary (first: it checks the rectangle) and Canny.
+  // Stage 2: the dense mesh. Rough shares of the run time drive the progress.
+  std::vector<DetectedFeature> boundary;
+  if (options.segment) {
+    progress("segment", 0.0);
+    r.segment_mask = segment_foreground(image, *options.segment, options.segment_options);
+    boundary = region_boundary_features(r.segment_mask, options.segment_options);
+    lap("segment");
+  }
+  progress("features", options.segment ? 0.08 : 0.0);
+  std::vector<DetectedFeature> features = detect_features(image, options.features);
+  const size_t num_boundary = boundary.size();
+  if (num_boundary > 0) {
+    clear_features_near(features, boundary, options.segment_options.clearance, options.features.min_length);
+    // First, so that the boundary keeps every edge it shares with nothing else and gets the first ids.
+    features.insert(features.begin(), std::make_move_iterator(boundary.begin()),
+                    std::make_move_iterator(boundary.end()));
+  }
   lap("features");
-  progress("mesh", 0.02);
+  progress("mesh", options.segment ? 0.1 : 0.02);
   ControlMesh mesh = build_initial_mesh(image, features, options.initial_mesh);
   lap("mesh");
+  if (num_boundary > 0) {
+    // The mesh features whose vertices are the boundary's points (the dense mesh keeps positions).
+    std::set<std::pair<double, double>> on_boundary;
+    for (size_t k = 0; k < num_boundary; ++k)
+      for (const Vec2& p : features[k].points) on_boundary.insert({p.x, p.y});
+    for (const Feature& f : mesh.features) {
+      const auto hits = std::count_if(f.vertices.begin(), f.vertices.end(), [&](int32_t v) {
+        return on_boundary.count({mesh.positions[v].x, mesh.positions[v].y}) > 0;
+      });
+      if (2 * hits > static_cast<std::ptrdiff_t>(f.vertices.size())) r.segment_feature_ids.push_back(f.id);
+    }
+  }
 
   r.feature_targets.clear();
   for (const Feature& f : mesh.features) {
@@ -50,7 +80,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   }
 
   // Stage 3: simplification.
-  progress("simplify", 0.25);
+  progress("simplify", options.segment ? 0.3 : 0.25);
   SimplifyOptions simplify_options;
   simplify_options.target_vertices = target;
   simplify_options.max_feature_error = options.max_feature_error;

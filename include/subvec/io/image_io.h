@@ -10,7 +10,7 @@ namespace subvec {
 // Reads PNG/JPEG/WebP/TIFF/BMP as 8-bit RGB: gray is expanded, 16-bit scaled down, alpha
 // composited over black (a transparent pixel reads as black), CMYK JPEG converted and the JPEG
 // EXIF orientation applied. Images over `max_pixels` are refused, from the header before decoding
-// for PNG and JPEG. Throws Error(kIo / kBadFile / kLimit) with the path in the message.
+// (PNG, JPEG, BMP, WebP, classic TIFF). Throws Error(kIo / kBadFile / kLimit) with the path in the message.
 Image8 read_image(const std::filesystem::path& path, int64_t max_pixels = int64_t{1} << 28);
 
 // Writes a PNG (RGB or RGBA) atomically: to a temporary file beside `path`, then renamed.

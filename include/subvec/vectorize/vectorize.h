@@ -13,6 +13,7 @@
 #include "subvec/vectorize/features.h"
 #include "subvec/vectorize/fit.h"
 #include "subvec/vectorize/initial_mesh.h"
+#include "subvec/vectorize/segment.h"
 #include "subvec/vectorize/simplify.h"
 
 namespace subvec {
@@ -21,6 +22,10 @@ struct VectorizeOptions {
   double ratio = 0.01;   // control vertices as a fraction of the pixel count
   int vertices = 0;      // > 0: an absolute vertex count instead of `ratio`
   FeatureOptions features;
+  // GrabCut from this rectangle: the foreground's boundary becomes a feature (closed unless the
+  // foreground touches the image border), and Canny features are cut back from it (segment.h).
+  std::optional<PixelRect> segment;
+  SegmentOptions segment_options;
   InitialMeshOptions initial_mesh;
   double max_feature_error = 1.0;  // pixels (simplification rolls back collapses beyond it)
   ColorFitOptions fit;
@@ -36,10 +41,14 @@ struct StageTime {
 struct VectorizeReport {
   int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;
   double fit_rms = 0;
-  std::vector<StageTime> stages;  // features, mesh, simplify, fit
+  std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, fit
   SimplifyStats simplify;
   // The detected polyline each output feature follows (same order as the mesh's features).
   std::vector<std::vector<Vec2>> feature_targets;
+  // With a segment rectangle: the cleaned GrabCut foreground, and the ids of the mesh features
+  // that follow its boundary.
+  RegionMask segment_mask;
+  std::vector<int32_t> segment_feature_ids;
 };
 
 // Vectorizes an RGB image into a one-level vector image of the same size. Throws

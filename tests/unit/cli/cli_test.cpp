@@ -1,6 +1,8 @@
 // End-to-end tests of the `subvec` command-line tool: they run the built binary (SUBVEC_CLI) in a
 // shell and check exit statuses, stderr messages and the files left behind.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <pty.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -329,7 +331,7 @@ TEST_F(Cli, BadImagesForCompare) {
   const fs::path good = dir_ / "good.png";
   ASSERT_EQ(subvec("render " + q(example("01-disk")) + " -o " + q(good)).status, 0);
   expect_failure(subvec("compare " + q(good) + " " + q(dir_ / "junk.png")),
-                 "file is truncated or not an image");
+                 "not a PNG, JPEG, WebP, TIFF or BMP file");
 }
 
 TEST_F(Cli, FailedRunDoesNotClobberExistingOutput) {
@@ -366,7 +368,6 @@ TEST_F(Cli, HelpAndVersion) {
   }
 }
 
-
 // ---- vectorize -------------------------------------------------------------------------------
 
 // A 64 x 48 picture: a disk over a gradient, written as PNG through the library.
@@ -395,7 +396,8 @@ TEST_F(Cli, VectorizeWritesAValidImageAndReportsIt) {
   EXPECT_LE(j["vertices"].get<int>(), 60);
   EXPECT_GE(j["features"].get<int>(), 1);
   EXPECT_LT(j["mae"].get<double>(), 6.0);
-  for (const char* stage : {"features", "mesh", "simplify", "fit"}) EXPECT_TRUE(j["seconds"].contains(stage));
+  for (const char* stage : {"features", "mesh", "simplify", "fit"})
+    EXPECT_TRUE(j["seconds"].contains(stage));
   // The output is a valid vector image that renders at the photo's size.
   const CliResult info = subvec("info " + q(out) + " --json");
   ASSERT_EQ(info.status, 0) << info.err;
@@ -417,8 +419,149 @@ TEST_F(Cli, VectorizeBadInputs) {
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio -1"), "--ratio");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 2"), "--vertices");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(dir_ / "out.png")), ".png");
-  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-pixels 100"), "pixels");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-pixels 100"),
+                 "64x48 pixels is over the limit of 100 pixels (--max-pixels raises the limit)");
+  write_text(dir_ / "empty.png", "");
+  expect_failure(subvec("vectorize " + q(dir_ / "empty.png") + " -o " + q(out)), "file is empty");
+  const std::string png = read_text(photo);
+  write_text(dir_ / "cut.png", png.substr(0, png.size() / 2));
+  expect_failure(subvec("vectorize " + q(dir_ / "cut.png") + " -o " + q(out)), "truncated");
+  write_text(dir_ / "photo.ppm", "P6\n1 1\n255\nabc");
+  expect_failure(subvec("vectorize " + q(dir_ / "photo.ppm") + " -o " + q(out)),
+                 "not a PNG, JPEG, WebP, TIFF or BMP file");
   EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, VectorizeSegment) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec";
+  write_test_photo(photo);  // the disk: centre (30.5, 22.5), radius 15
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) +
+                             " --vertices 60 --segment 10,3,42,40 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["segment"].is_object()) << r.out;
+  EXPECT_EQ(j["segment"]["rect"], nlohmann::json::parse("[10, 3, 42, 40]"));
+  EXPECT_EQ(j["segment"]["features"], 1);
+  EXPECT_EQ(j["segment"]["closed"], true);
+  EXPECT_NEAR(j["segment"]["foreground_pixels"].get<double>(), M_PI * 15 * 15, 60);
+  EXPECT_TRUE(j["seconds"].contains("segment"));
+  // GrabCut draws random numbers: same input and options, still the same bytes.
+  const fs::path again = dir_ / "again.svec";
+  const CliResult text =
+      subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --segment 10,3,42,40");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_EQ(read_text(out), read_text(again));
+  EXPECT_NE(text.out.find("segment   10,3,42,40: "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("boundary is 1 closed feature"), std::string::npos) << text.out;
+  // Without --segment the JSON says so.
+  const CliResult plain =
+      subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60 --json");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_TRUE(nlohmann::json::parse(plain.out)["segment"].is_null());
+}
+
+// The bundled photograph that scripts/demo vectorizes: public domain, in the repository.
+TEST_F(Cli, VectorizeTheExamplePhotograph) {
+  const fs::path photo = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png";
+  ASSERT_TRUE(fs::exists(photo));
+  EXPECT_LE(fs::file_size(photo), 150u * 1024);
+  const fs::path out = dir_ / "rocket.svec";
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio 0.005 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["width"], 384);
+  EXPECT_EQ(j["height"], 256);
+  EXPECT_LT(j["mae"].get<double>(), 8.0);
+  ASSERT_EQ(subvec("render " + q(out) + " -o " + q(dir_ / "mesh.png") + " --scale 4 --overlay mesh")
+                .status,
+            0);
+}
+
+TEST_F(Cli, VectorizeSegmentBadRectangles) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "out.svec";
+  write_test_photo(photo);  // 64 x 48
+  const std::string run = "vectorize " + q(photo) + " -o " + q(out) + " --segment ";
+  for (const char* malformed :
+       {"1,2,3", "a,b,c,d", "1,2,3,4,5", "1,2,3,4,", "1.5,2,3,4", "", " 1,2,3,4"}) {
+    const CliResult r = subvec(run + q(std::string(malformed)));
+    expect_failure(r, "expected four integers X,Y,W,H");
+    EXPECT_EQ(r.status, 105) << malformed;
+  }
+  expect_failure(subvec(run + "10,10,0,5"), "is empty");
+  expect_failure(subvec(run + "10,10,5,-3"), "is empty");
+  for (const char* outside : {"-1,0,10,10", "60,0,10,10", "0,40,10,10", "100,100,5,5"}) {
+    const CliResult r = subvec(run + outside);
+    expect_failure(r, "is not inside the 64x48 image");
+    EXPECT_EQ(r.status, 1) << outside;
+  }
+  expect_failure(subvec(run + "0,0,64,48"), "GrabCut needs background pixels");
+  expect_failure(subvec(run + "10,10,2,2"), "too small");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Runs `subvec <args...>` with stderr on a pseudo-terminal and stdout in a file; returns what the
+// terminal received and the exit status.
+std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args,
+                                            const fs::path& stdout_file,
+                                            const char* progress_delay) {
+  int master = -1;
+  const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
+  if (pid == 0) {
+    const int fd = ::open(stdout_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0 || ::dup2(fd, STDOUT_FILENO) < 0) _exit(126);
+    ::setenv("SUBVEC_PROGRESS_DELAY", progress_delay, 1);
+    std::vector<char*> argv{const_cast<char*>(SUBVEC_CLI)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(SUBVEC_CLI, argv.data());
+    _exit(127);
+  }
+  if (pid < 0) return {"forkpty failed", -1};
+  std::string terminal;
+  char buf[4096];
+  while (true) {
+    const ssize_t n = ::read(master, buf, sizeof buf);
+    if (n <= 0) break;  // EIO once the child has closed the terminal
+    terminal.append(buf, size_t(n));
+  }
+  int raw = 0;
+  ::waitpid(pid, &raw, 0);
+  ::close(master);
+  return {terminal, WIFEXITED(raw) ? WEXITSTATUS(raw) : -1};
+}
+
+TEST_F(Cli, VectorizeProgressOnlyOnATerminal) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec",
+                 summary = dir_ / "summary.txt";
+  write_test_photo(photo);
+  // On a terminal, with the delay at 0 so that even this short run shows it: a line redrawn with
+  // '\r' per stage, erased at the end (the last thing written is spaces and '\r').
+  const auto [terminal, status] = run_on_terminal(
+      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "0");
+  ASSERT_EQ(status, 0) << terminal;
+  EXPECT_NE(terminal.find("\rsubvec: vectorizing photo.png: "), std::string::npos) << terminal;
+  EXPECT_NE(terminal.find("%, 0 s"), std::string::npos) << terminal;
+  ASSERT_FALSE(terminal.empty());
+  EXPECT_EQ(terminal.back(), '\r') << terminal;
+  EXPECT_EQ(terminal.find('\n'), std::string::npos) << terminal;
+  EXPECT_NE(read_text(summary).find("mesh      "), std::string::npos);
+  // The default delay of a second hides it for a short run.
+  const auto [quiet, quiet_status] = run_on_terminal(
+      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "1");
+  ASSERT_EQ(quiet_status, 0) << quiet;
+  EXPECT_EQ(quiet, "");
+  // Not a terminal: nothing on stderr whatever the delay.
+  const CliResult piped = subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 60");
+  ASSERT_EQ(piped.status, 0);
+  EXPECT_EQ(piped.err, "");
+  // An error on a terminal: the progress line is erased before the one-line message.
+  const auto [failed, failed_status] = run_on_terminal(
+      {"vectorize", photo.string(), "-o", out.string(), "--segment", "0,0,64,48"}, summary, "0");
+  EXPECT_EQ(failed_status, 1);
+  const size_t message = failed.find("subvec: segment rectangle");
+  ASSERT_NE(message, std::string::npos) << failed;
+  EXPECT_TRUE(message == 0 || failed[message - 1] == '\r') << failed;
 }
 
 }  // namespace

@@ -4,9 +4,13 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -212,7 +216,11 @@ TEST_F(ImageIo, EmptyAndGarbageFiles) {
   std::string msg;
   EXPECT_EQ(error_of([&] { read_image(dir_ / "junk.png"); }, &msg), ErrorCode::kBadFile);
   EXPECT_EQ(msg, "cannot read image '" + (dir_ / "junk.png").string() +
-                     "': file is truncated or not an image");
+                     "': not a PNG, JPEG, WebP, TIFF or BMP file");
+  // Formats OpenCV could decode but subvec does not take (a binary PPM here).
+  const std::string ppm = "P6\n2 2\n255\n" + std::string(12, 'x');
+  write_bytes(dir_ / "a.ppm", std::vector<uint8_t>(ppm.begin(), ppm.end()));
+  EXPECT_EQ(error_of([&] { read_image(dir_ / "a.ppm"); }), ErrorCode::kBadFile);
 }
 
 TEST_F(ImageIo, TruncatedPng) {
@@ -273,6 +281,176 @@ TEST_F(ImageIo, WriteRejectsMalformedImages) {
 TEST_F(ImageIo, WriteIntoMissingDirectoryFails) {
   EXPECT_EQ(error_of([&] { write_png(dir_ / "no" / "such" / "a.png", pattern(2, 2, 3)); }),
             ErrorCode::kIo);
+}
+
+// ---- every format, through OpenCV's encoders ---------------------------------------------------
+
+// Encodes a BGR(A) / gray OpenCV image with imencode (extension picks the format).
+std::vector<uint8_t> encode(const std::string& ext, const cv::Mat& m,
+                            const std::vector<int>& params = {}) {
+  std::vector<uint8_t> bytes;
+  EXPECT_TRUE(cv::imencode(ext, m, bytes, params)) << ext;
+  return bytes;
+}
+
+// A smooth 24 x 16 BGR picture (JPEG keeps it close).
+cv::Mat3b smooth_bgr() {
+  cv::Mat3b m(16, 24);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 24; ++x)
+      m(y, x) = cv::Vec3b(uint8_t(40 + 6 * y), uint8_t(200 - 5 * x), uint8_t(60 + 3 * (x + y)));
+  return m;
+}
+
+// The same picture as we read it: RGB.
+std::vector<uint8_t> rgb_of(const cv::Mat3b& m) {
+  std::vector<uint8_t> out;
+  for (int y = 0; y < m.rows; ++y)
+    for (int x = 0; x < m.cols; ++x) out.insert(out.end(), {m(y, x)[2], m(y, x)[1], m(y, x)[0]});
+  return out;
+}
+
+TEST_F(ImageIo, EveryFormatReadsAsRgb) {
+  const cv::Mat3b bgr = smooth_bgr();
+  const std::vector<uint8_t> expected = rgb_of(bgr);
+  struct Case {
+    const char* name;
+    std::vector<uint8_t> bytes;
+    double max_error;  // largest sample difference
+  };
+  const Case cases[] = {
+      {"a.png", encode(".png", bgr), 0},
+      {"a.bmp", encode(".bmp", bgr), 0},
+      {"a.tif", encode(".tiff", bgr), 0},
+      {"a.webp", encode(".webp", bgr, {cv::IMWRITE_WEBP_QUALITY, 101}), 0},  // > 100: lossless
+      {"a.jpg", encode(".jpg", bgr, {cv::IMWRITE_JPEG_QUALITY, 98}), 12},
+  };
+  for (const Case& c : cases) {
+    write_bytes(dir_ / c.name, c.bytes);
+    const Image8 back = read_image(dir_ / c.name);
+    ASSERT_EQ(back.width, 24) << c.name;
+    ASSERT_EQ(back.height, 16) << c.name;
+    ASSERT_EQ(back.channels, 3) << c.name;
+    double worst = 0;
+    for (size_t i = 0; i < expected.size(); ++i)
+      worst = std::max(worst, std::abs(double(back.pixels[i]) - expected[i]));
+    EXPECT_LE(worst, c.max_error) << c.name;
+  }
+}
+
+TEST_F(ImageIo, GrayJpegBmpAndTiffAreExpanded) {
+  cv::Mat1b gray(8, 8, uint8_t{90});
+  for (const char* ext : {".jpg", ".bmp", ".tiff", ".webp"}) {
+    const std::string name = std::string("g") + ext;
+    write_bytes(dir_ / name, encode(ext, gray, {cv::IMWRITE_WEBP_QUALITY, 101}));
+    const Image8 back = read_image(dir_ / name);
+    ASSERT_EQ(back.pixels.size(), 8u * 8 * 3) << ext;
+    for (uint8_t v : back.pixels) EXPECT_NEAR(v, 90, 1) << ext;
+  }
+}
+
+TEST_F(ImageIo, SixteenBitTiffIsRoundedNotTruncated) {
+  // B, G, R = 1000, 32768, 65535: 3.89, 127.5 and 255 on the 8-bit scale.
+  const cv::Mat color(3, 2, CV_16UC3, cv::Scalar(1000, 32768, 65535));
+  write_bytes(dir_ / "c.tif", encode(".tiff", color));
+  const Image8 back = read_image(dir_ / "c.tif");
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(back.pixels[size_t(i) * 3 + 0], 255);
+    EXPECT_EQ(back.pixels[size_t(i) * 3 + 1], 128);
+    EXPECT_EQ(back.pixels[size_t(i) * 3 + 2], 4);
+  }
+  const cv::Mat gray(2, 2, CV_16UC1, cv::Scalar(40000));  // 155.65
+  write_bytes(dir_ / "g.tif", encode(".tiff", gray));
+  for (uint8_t v : read_image(dir_ / "g.tif").pixels) EXPECT_EQ(v, 156);
+}
+
+TEST_F(ImageIo, FloatTiffIsTakenAsZeroToOne) {
+  // One channel: OpenCV stores 3-channel float TIFFs with lossy LogLuv compression.
+  cv::Mat1f gray(2, 2);
+  gray << 0.25f, 0.4f, 1.0f, 2.0f;  // 63.75, 102, 255, and over-range clamped to 255
+  write_bytes(dir_ / "f.tif", encode(".tiff", gray));
+  const Image8 back = read_image(dir_ / "f.tif");
+  EXPECT_EQ(back.pixels,
+            (std::vector<uint8_t>{64, 64, 64, 102, 102, 102, 255, 255, 255, 255, 255, 255}));
+}
+
+TEST_F(ImageIo, AlphaInTiffAndWebpIsCompositedOverBlack) {
+  const cv::Mat4b bgra(4, 4, cv::Vec4b(50, 100, 200, 51));  // alpha 0.2
+  for (const char* ext : {".tiff", ".webp", ".png"}) {
+    const std::string name = std::string("a") + ext;
+    write_bytes(dir_ / name, encode(ext, bgra, {cv::IMWRITE_WEBP_QUALITY, 101}));
+    const Image8 back = read_image(dir_ / name);
+    ASSERT_EQ(back.channels, 3);
+    EXPECT_EQ(std::vector<uint8_t>(back.pixels.begin(), back.pixels.begin() + 3),
+              (std::vector<uint8_t>{40, 20, 10}))
+        << ext;
+  }
+}
+
+// OpenCV cannot write CMYK JPEGs: tests/data/images/cmyk.jpg comes from make_cmyk_jpeg.c there
+// (Adobe-style inverted CMYK, four flat 8 x 8 blocks).
+TEST_F(ImageIo, CmykJpegIsConvertedToRgb) {
+  const Image8 img =
+      read_image(fs::path(SUBVEC_SOURCE_DIR) / "tests" / "data" / "images" / "cmyk.jpg");
+  ASSERT_EQ(img.width, 16);
+  ASSERT_EQ(img.height, 16);
+  const struct {
+    int x, y;
+    std::array<int, 3> rgb;
+  } blocks[] = {
+      {4, 4, {255, 0, 0}}, {12, 4, {0, 255, 0}}, {4, 12, {0, 0, 255}}, {12, 12, {127, 127, 127}}};
+  for (const auto& b : blocks) {
+    const uint8_t* p = img.row(b.y) + 3 * b.x;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(p[k], b.rgb[k], 4) << "block at " << b.x << "," << b.y << " channel " << k;
+  }
+}
+
+TEST_F(ImageIo, TruncatedFilesInEveryFormat) {
+  cv::Mat3b noise(64, 64);
+  cv::RNG rng(5);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  for (const char* ext : {".png", ".jpg", ".bmp", ".tiff", ".webp"}) {
+    std::vector<uint8_t> bytes = encode(ext, noise);
+    for (const double keep : {0.5, 0.95}) {
+      std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + long(double(bytes.size()) * keep));
+      const std::string name = std::string("cut") + ext;
+      write_bytes(dir_ / name, cut);
+      std::string msg;
+      EXPECT_EQ(error_of([&] { read_image(dir_ / name); }, &msg), ErrorCode::kBadFile)
+          << ext << " " << keep;
+      EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+    }
+  }
+}
+
+TEST_F(ImageIo, PixelLimitIsCheckedFromBmpWebpAndTiffHeaders) {
+  // Headers only, each claiming 100000 x 100000 (or 100000 x 70000): refused before decoding.
+  const std::vector<uint8_t> bmp = {
+      'B', 'M', 0, 0, 0,    0,    0,    0, 0,    0,    54,   0,   0, 0,  // file header
+      40,  0,   0, 0, 0xa0, 0x86, 0x01, 0, 0x60, 0x79, 0xfe, 0xff};      // w, -h
+  const std::vector<uint8_t> webp = {
+      'R', 'I', 'F', 'F', 30, 0, 0, 0, 'W',  'E',  'B',  'P',  'V',  'P', '8', 'X',
+      10,  0,   0,   0,   0,  0, 0, 0, 0x9f, 0x86, 0x01, 0x9f, 0x86, 0x01};  // (w-1, h-1) 24-bit
+  const std::vector<uint8_t> tiff = {
+      'M', 'M', 0, 42, 0, 0, 0, 8, 0, 2,               // big-endian, IFD at 8 with 2 entries
+      1,   0,   0, 4,  0, 0, 0, 1, 0, 1, 0x86, 0xa0,   // ImageWidth LONG 100000
+      1,   1,   0, 4,  0, 0, 0, 1, 0, 1, 0x11, 0x70};  // ImageLength LONG 70000
+  for (const auto& [name, bytes] :
+       {std::pair{"huge.bmp", bmp}, std::pair{"huge.webp", webp}, std::pair{"huge.tif", tiff}}) {
+    write_bytes(dir_ / name, bytes);
+    std::string msg;
+    EXPECT_EQ(error_of([&] { read_image(dir_ / name); }, &msg), ErrorCode::kLimit) << name;
+    EXPECT_NE(msg.find("100000x"), std::string::npos) << msg;
+  }
+  // Real files of 24 x 16 = 384 pixels against a limit of 383.
+  const cv::Mat3b bgr = smooth_bgr();
+  for (const char* ext : {".bmp", ".tiff", ".webp"}) {
+    const std::string name = std::string("small") + ext;
+    write_bytes(dir_ / name, encode(ext, bgr));
+    EXPECT_EQ(error_of([&] { read_image(dir_ / name, 383); }), ErrorCode::kLimit) << ext;
+    EXPECT_NO_THROW(read_image(dir_ / name, 384)) << ext;
+  }
 }
 
 }  // namespace
