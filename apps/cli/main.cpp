@@ -32,6 +32,8 @@
 #include <chrono>
 #include <unistd.h>
 
+#include "edit_commands.h"
+
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
 #endif
@@ -383,7 +385,7 @@ std::string command_path(const CLI::App& app) {
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
-      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares raster images.",
+      "Vectorizes photographs; renders, edits, stylizes, inspects and converts .svec / .svec.json files; compares raster images.",
       "subvec");
   app.footer(
       "Examples:\n"
@@ -522,6 +524,8 @@ int run(int argc, char** argv) {
       "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
       "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json");
 
+  subvec_cli::add_edit_commands(app);  // edit, stylize
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -537,10 +541,10 @@ int run(int argc, char** argv) {
       // No command: either none was given or the first word is not one.
       const std::vector<std::string> extra = app.remaining();
       if (extra.empty()) {
-        message = "a command is required: vectorize, render, info, convert or compare";
+        message = "a command is required: vectorize, render, edit, stylize, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, render, info, convert or compare)";
+                  extra.front() + "' (expected a command: vectorize, render, edit, stylize, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }
