@@ -106,7 +106,7 @@ struct ArapDeformer::Impl {
   // Step 2 fit per triangle: (w_0, w_1) = F (v'_0, v'_1, v'_2), and the rest frame of vertex 2.
   std::vector<Eigen::Matrix<double, 4, 6>> fit;
   std::vector<std::array<double, 3>> frame;  // x, y, rest length of edge (0, 1)
-  std::vector<double> weight;                // per triangle, in step 2 (see the constructor)
+  std::vector<double> weight;                // per triangle, in step 2 (arap.h)
 
   void check_targets(std::span<const Vec2> targets, std::span<Vec2> out) const {
     if (targets.size() != rest.size() || out.size() != rest.size()) {
@@ -225,7 +225,7 @@ ArapDeformer::ArapDeformer(std::span<const Vec2> rest, std::span<const Tri> tria
       const Mat2 c[3] = {-((1 - x) * id - y * kR90), -(x * id + y * kR90), id};
       const int vs[3] = {i, j, k};
       const double base2 = squared_distance(rest[i], rest[j]);
-      const double w = base2 / (4 * area);  // (height of k over its base)^-2 times the area
+      const double w = base2 / (4 * area);  // = A / h_k^2, h_k the height of k (arap.h)
       sum += w;
       for (int a = 0; a < 3; ++a) {
         for (int b = 0; b < 3; ++b) {
@@ -297,11 +297,19 @@ void ArapDeformer::solve_similarity(std::span<const Vec2> targets, std::span<Vec
   }
 }
 
-void ArapDeformer::solve(std::span<const Vec2> targets, std::span<Vec2> out) const {
+void ArapDeformer::solve(std::span<const Vec2> targets, std::span<Vec2> out,
+                         std::span<Vec2> similarity) const {
   const Impl& m = *impl_;
   m.check_targets(targets, out);
   const Eigen::VectorXd s1 = m.step1(targets);
   const size_t n = m.rest.size();
+  if (!similarity.empty()) {
+    if (similarity.size() != n) invalid("the similarity output has the wrong size");
+    for (size_t v = 0; v < n; ++v) {
+      similarity[v] = {has(m.fixed[v], 0) ? targets[v].x : s1[2 * v],
+                       has(m.fixed[v], 1) ? targets[v].y : s1[2 * v + 1]};
+    }
+  }
 
   // Fit each rest triangle to the step-1 triangle by a similarity, scale it back to rest size, and
   // accumulate the right-hand sides of E2 from its edge vectors.

@@ -392,6 +392,10 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           }
           done += "; " + std::to_string(handles.vertices.size()) + " handle vertices, largest move " +
                   num(moved) + " px";
+          if (editor.scale_fraction() < 1) {
+            done += " (scale adjustment applied at " + num(editor.scale_fraction()) +
+                    " to avoid a flip)";
+          }
           break;
         }
         case EditOp::Kind::kColor: {

@@ -149,20 +149,51 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
   }
   const ArapDeformer& deformer = deformer_for(handles.vertices, handles.region);
   std::vector<Vec2> result(rest_.size());
-  deformer.solve(targets_, result);
-  for (size_t f = 0; f < triangles_.size(); ++f) {
-    const Tri& t = triangles_[f];
-    const Vec2 a = result[t[0]], b = result[t[1]], c = result[t[2]];
-    const double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    if (!(area2 > 0)) {
+  similarity_.resize(rest_.size());
+  deformer.solve(targets_, result, similarity_);
+  scale_fraction_ = 1;
+  if (first_flip(result) >= 0) {
+    // Repair: apply the scale adjustment only partly, v = s1 + lambda (s2 - s1), with the largest
+    // lambda (bisection, to 1/1024) that flips nothing. Refused when the similarity step flips.
+    const int f = first_flip(similarity_);
+    if (f >= 0) {
+      const Tri& t = triangles_[f];
       const Vec2 r = rest_[t[0]];
       invalid("the edit would flip control triangle " + std::to_string(f) + " (vertices " +
               std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
               " near (" + num(r.x) + ", " + num(r.y) +
               ")); refused: try a smaller displacement, a larger sigma or several smaller steps");
     }
+    std::vector<Vec2> blend(rest_.size());
+    auto mix = [&](double lambda) {
+      for (size_t v = 0; v < rest_.size(); ++v) {
+        blend[v] = {similarity_[v].x + lambda * (result[v].x - similarity_[v].x),
+                    similarity_[v].y + lambda * (result[v].y - similarity_[v].y)};
+        // Constrained coordinates are equal in both: keep them exact.
+        if (similarity_[v].x == result[v].x) blend[v].x = result[v].x;
+        if (similarity_[v].y == result[v].y) blend[v].y = result[v].y;
+      }
+    };
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 10; ++i) {
+      const double mid = (lo + hi) / 2;
+      mix(mid);
+      (first_flip(blend) < 0 ? lo : hi) = mid;
+    }
+    mix(lo);
+    result.swap(blend);
+    scale_fraction_ = lo;
   }
   out = std::move(result);
+}
+
+int ShapeEditor::first_flip(const std::vector<Vec2>& p) const {
+  for (size_t f = 0; f < triangles_.size(); ++f) {
+    const Tri& t = triangles_[f];
+    const Vec2 a = p[t[0]], b = p[t[1]], c = p[t[2]];
+    if (!((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0)) return static_cast<int>(f);
+  }
+  return -1;
 }
 
 }  // namespace subvec

@@ -12,6 +12,15 @@
 //      (a 4x4 least-squares problem per triangle, precomputed), scaled back to its rest size, and
 //      the mesh is solved to match the edge vectors of these fitted triangles:
 //      E2 = sum over triangles and edges |(v_b - v_a) - e_ab|^2 (x and y separate, same matrix).
+// Weights. Control meshes from vectorization have many thin triangles along features and near the
+// border, and the plain energies let such a triangle flip for a sub-pixel error. Each step-1 term
+// is therefore weighted by |e_k|^2 / (4 A), e_k the base edge opposite vertex k and A the rest
+// area: the squared residual divided by the squared height of k, times the area, so the energy
+// approximates the integral of the squared distortion over the mesh and a thin triangle resists
+// having its apex pushed through its base. Step 2 weights a triangle's edges by the mean of its
+// three step-1 weights. Weights change neither the exact reproduction of rigid motions nor the
+// constraints.
+//
 // Constrained coordinates are eliminated (fixed values moved to the right-hand side), so the
 // constraints are met exactly. The three matrices (step 1; step 2 for x; step 2 for y) depend only
 // on the rest mesh and on *which* coordinates are fixed: they are factored once per constraint set
@@ -53,9 +62,10 @@ class ArapDeformer {
 
   // Deforms the mesh: `targets` (#V) gives the value of every fixed coordinate (the others are
   // ignored); `out` (#V) receives the deformed positions, whose fixed coordinates are copied from
-  // `targets` bit for bit. Back-substitution only. Throws Error(kInvalidArgument) on a size
-  // mismatch or a non-finite target.
-  void solve(std::span<const Vec2> targets, std::span<Vec2> out) const;
+  // `targets` bit for bit. Back-substitution only. With `similarity` (#V), the step-1 result too.
+  // Throws Error(kInvalidArgument) on a size mismatch or a non-finite target.
+  void solve(std::span<const Vec2> targets, std::span<Vec2> out,
+             std::span<Vec2> similarity = {}) const;
   // Step 1 alone (the similarity solve), for tests and analysis.
   void solve_similarity(std::span<const Vec2> targets, std::span<Vec2> out) const;
 

@@ -8,10 +8,15 @@
 // creases and tears are kept and every feature curve stays a C^2 cubic B-spline by construction
 // (paper §3.2).
 //
-// Flips are refused, not repaired: when the deformed mesh would have a triangle with zero or
-// negative signed area, ShapeEditor::deform throws Error(kInvalidArgument) naming the triangle and
-// leaves nothing changed. The edit can then be retried with a smaller displacement, a larger
-// sigma, or in several steps (each step starts from the last result as its rest shape).
+// Flips are repaired when the ARAP solve allows it, refused otherwise. In practice it is the
+// scale-adjustment step (edit/arap.h) that flips, near thin triangles squeezed against the border
+// or a feature, while the similarity step s1 does not. A deformed mesh with a triangle of zero or
+// negative signed area is then replaced by s1 + lambda (s2 - s1), with the largest lambda in
+// [0, 1) that flips nothing (bisection to 1/1024): the handles still meet their targets exactly,
+// and the result is as rigid as a flip-free blend allows. When s1 itself flips, deform throws
+// Error(kInvalidArgument) naming the triangle and changes nothing; the edit can be retried with a
+// smaller displacement, a larger sigma, a region, or in several steps (each step starts from the
+// last result as its rest shape).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +61,8 @@ class ShapeEditor {
   ShapeEditor(const ControlMesh& mesh, int width, int height);
 
   const std::vector<Vec2>& rest() const { return rest_; }
+  // The lambda of the last deform: 1 when the scale adjustment was applied in full.
+  double scale_fraction() const { return scale_fraction_; }
 
   // Deformed positions (#V) with the handles at their targets (projected as described above).
   // The factorization depends only on the set of handle vertices and the region, and is cached
@@ -78,7 +85,10 @@ class ShapeEditor {
   std::vector<Tri> triangles_;
   std::vector<uint8_t> sides_;  // per vertex: bit 0 left, 1 right, 2 top, 3 bottom
   std::list<Cached> cache_;     // most recently used first
-  std::vector<Vec2> targets_;   // scratch
+  int first_flip(const std::vector<Vec2>& positions) const;
+
+  std::vector<Vec2> targets_, similarity_;  // scratch
+  double scale_fraction_ = 1;
 };
 
 }  // namespace subvec

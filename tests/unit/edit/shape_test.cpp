@@ -178,6 +178,39 @@ TEST(Shape, ARegionPinsTheRestOfTheMesh) {
   EXPECT_GT(moved, 5);
 }
 
+TEST(Shape, EveryResultIsFlipFreeOrRefused) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  ShapeEditor editor(mesh, image.width, image.height);
+  int refused = 0, repaired = 0;
+  for (const double size : {2.0, 8.0, 20.0, 40.0, 70.0}) {
+    for (size_t f = 0; f < mesh.features.size(); ++f) {
+      const Feature& feature = mesh.features[f];
+      const Vec2 click = mesh.positions[feature.vertices[feature.vertices.size() / 2]];
+      const Handles h = drag_feature(mesh, feature, click, {size, -0.5 * size}, 12);
+      try {
+        const std::vector<Vec2> out = editor.deform(h);
+        for (const Tri& t : mesh.triangles) {
+          const Vec2 a = out[t[0]], b = out[t[1]], c = out[t[2]];
+          ASSERT_GT((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x), 0);
+        }
+        for (size_t i = 0; i < h.vertices.size(); ++i) {
+          const Vec2 p = mesh.positions[h.vertices[i]];
+          if (p.x != 0 && p.x != image.width && p.y != 0 && p.y != image.height) {
+            EXPECT_EQ(out[h.vertices[i]], h.targets[i]);
+          }
+        }
+        repaired += editor.scale_fraction() < 1;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("would flip"), std::string::npos) << e.what();
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0);  // the large drags
+  RecordProperty("repaired", repaired);
+}
+
 TEST(Shape, AFlippingEditIsRefused) {
   const VectorImage image = image_with_features();
   const ControlMesh& mesh = image.levels[0];
