@@ -37,6 +37,8 @@
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 
+#include "edit_commands.h"
+
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
 #endif
@@ -536,8 +538,7 @@ std::string command_path(const CLI::App& app) {
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
-      "Vectorizes photographs; renders, inspects and converts .svec / .svec.json files; compares "
-      "raster images.",
+      "Vectorizes photographs; renders, edits, stylizes, inspects and converts .svec / .svec.json files; compares raster images.",
       "subvec");
   app.footer(
       "Examples:\n"
@@ -698,6 +699,8 @@ int run(int argc, char** argv) {
       "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 
+  subvec_cli::add_edit_commands(app);  // edit, stylize
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -713,11 +716,10 @@ int run(int argc, char** argv) {
       // No command: either none was given or the first word is not one.
       const std::vector<std::string> extra = app.remaining();
       if (extra.empty()) {
-        message = "a command is required: vectorize, render, info, convert or compare";
+        message = "a command is required: vectorize, render, edit, stylize, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() +
-                  "' (expected a command: vectorize, render, info, convert or compare)";
+                  extra.front() + "' (expected a command: vectorize, render, edit, stylize, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }

@@ -25,6 +25,7 @@
 #include "render/parallel_p.h"
 #include "render/raster_p.h"
 #include "render/renderer_p.h"
+#include "render/strokes_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/subdiv/subdivision.h"
@@ -344,6 +345,7 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
   if (options.overlay == Overlay::kFeatures)
     overlay = detail::feature_overlay(c.refined, plan.view);
   detail::rasterize_into(c.refined, plan.view, raster, overlay, &state.scratch, out);
+  detail::draw_strokes(image.strokes, options.level, plan.view, out);
 }
 
 }  // namespace

@@ -1,0 +1,53 @@
+// Edit operations as a mouse does them, in image coordinates: the `subvec edit --ops` file
+// (docs/editing.md has the format). Parsing checks the file's structure; applying checks what
+// needs the image (points inside it, something to select, no flipped triangle).
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+enum class EditSelect { kVertex, kFeature };
+enum class ColorMode { kBlend, kTransform };
+
+struct EditOp {
+  enum class Kind {
+    kDrag,         // from -> to, select vertex (one vertex) or feature (Gaussian falloff, sigma)
+    kMoveFeature,  // at; translate, rotate (degrees)
+    kColor,        // at; mode, select, radius, color, amount (blend)
+  };
+  Kind kind = Kind::kDrag;
+  int level = 0;
+  EditSelect select = EditSelect::kVertex;
+  Vec2 from, to;          // drag
+  double sigma = 20;      // drag of a feature, pixels
+  double region = 0;      // drag, move-feature: deform only within this distance of the handles
+  Vec2 at;                // move-feature, color
+  Vec2 translate;         // move-feature, pixels
+  double rotate = 0;      // move-feature, degrees, clockwise on screen
+  ColorMode mode = ColorMode::kBlend;
+  double radius = 0;      // color: propagation radius, pixels
+  Color color;            // color: the new color, 0-255
+  double amount = 0.5;    // color blend: 0 keeps the old color, 1 paints the new one
+
+  // "drag vertex", "drag feature", "move-feature", "color blend", "color transform".
+  std::string name() const;
+};
+
+// Parses an ops file: a JSON array of operation objects. Throws Error(kBadFile) with a one-line
+// message naming the operation and the key at fault ("ops[2] (drag): missing key \"to\"").
+std::vector<EditOp> parse_edit_ops(std::string_view json);
+
+// Applies the operations in order; returns one line per operation saying what it selected and did.
+// Throws Error(kInvalidArgument) naming the operation ("ops[1] (move-feature): ...") when a level
+// is out of range, a point lies outside the image, there is nothing to select, a shape edit would
+// flip a triangle or a color transform is impossible; `image` then holds the operations before the
+// failing one.
+std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const EditOp> ops);
+
+}  // namespace subvec

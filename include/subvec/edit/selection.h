@@ -1,0 +1,76 @@
+// Selection tools for editing (paper §6.1-6.2): the nearest control vertex or feature to a point,
+// feature curves as drawn, and color regions grown from a vertex or a feature.
+//
+// Distances. Picking is Euclidean in image pixels: the nearest control vertex to the point, or the
+// feature whose limit curve (the curve that is drawn, not its control polygon) passes nearest to
+// it. A propagation radius r selects a region of *color values*, not of vertices: starting from
+// the seed color values (those of the clicked side, see below), it grows across mesh triangles to
+// every color value whose vertex lies within Euclidean distance r of the seed (of the vertex, or of
+// the feature's control polygon), moving only through such values. Growing through triangles
+// never crosses a tear, because the two sides of a tear use different color values at its
+// vertices: the region is a Euclidean disk (or band) clipped to the side of the tears it started
+// on, and it passes a tear only around its end, where the color is continuous.
+//
+// Sides. A vertex on a tear has one color value per side. The seed is the value on the clicked
+// side: for a vertex, the wedge of triangles around it that contains the direction to the click;
+// for a feature, the side of its limit curve on which the click lies. So the two sides of a tear
+// can be edited separately.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+// One smooth piece of a feature's limit curve (mesh/curves.h): the feature chain split at its
+// corner vertices (junctions, a tear meeting a crease or the border), which the curve interpolates.
+// `vertices` follows the chain's direction; closed: a loop with no corner (first not repeated).
+struct CurvePiece {
+  std::vector<int32_t> vertices;
+  bool closed = false;
+};
+
+// The pieces of a feature of the mesh `topology` was built from, in chain order.
+std::vector<CurvePiece> feature_pieces(const MeshTopology& topology, const Feature& feature);
+
+// Control positions of a piece.
+std::vector<Vec2> piece_points(const ControlMesh& mesh, const CurvePiece& piece);
+
+// Index of the control vertex nearest to `p` (ties: the lowest index); -1 for an empty mesh.
+int nearest_vertex(const ControlMesh& mesh, Vec2 p);
+
+struct FeaturePick {
+  int feature = -1;       // index into mesh.features, -1: the level has no feature
+  double distance = 0;    // from the point to the feature's limit curve, pixels
+  Vec2 nearest;           // the nearest point of the curve
+  int side = 0;           // +1: the point is left of the chain direction in image coordinates
+                          // (cross(tangent, point - nearest) > 0), -1 right, 0 on the curve
+};
+
+// The feature whose limit curve passes nearest to `p` (ties: the lowest index).
+FeaturePick nearest_feature(const ControlMesh& mesh, const MeshTopology& topology, Vec2 p);
+
+// A selection of color values of one level, with the seed the region grew from.
+struct ColorSelection {
+  std::vector<int32_t> colors;  // ascending, unique
+  int32_t seed_color = -1;      // the color value nearest to the click on its side
+  int32_t seed_vertex = -1;
+};
+
+// Vertex selection: the color value of the nearest vertex on the side of the click, grown by
+// `radius` (pixels, >= 0; 0: the seed alone).
+ColorSelection select_vertex_colors(const ControlMesh& mesh, const MeshTopology& topology, Vec2 at,
+                                    double radius);
+
+// Feature selection: the color values on the clicked side of the nearest feature (all its
+// vertices), grown by `radius` around its control polygon. The seed is the clicked side's value at
+// the feature vertex nearest to the click. Throws Error(kInvalidArgument) when the level has no
+// feature.
+ColorSelection select_feature_colors(const ControlMesh& mesh, const MeshTopology& topology,
+                                     Vec2 at, double radius);
+
+}  // namespace subvec

@@ -1,0 +1,94 @@
+// Shape editing (paper §6.1): as-rigid-as-possible deformation of one level's control mesh under
+// the constraints a mouse gives: drag a vertex, drag part of a feature, move a whole feature.
+//
+// The image frame is part of every constraint set: the four image corners stay where they are and
+// the other border vertices slide along their side of the rectangle (the coordinate across the
+// side is fixed). A handle on the border is projected onto its side in the same way; a handle on
+// an image corner does not move. Only positions change, never the topology, so feature chains,
+// creases and tears are kept and every feature curve stays a C^2 cubic B-spline by construction
+// (paper §3.2).
+//
+// Flips are repaired when the ARAP solve allows it, refused otherwise. In practice it is the
+// scale-adjustment step (edit/arap.h) that flips, near thin triangles squeezed against the border
+// or a feature, while the similarity step s1 does not. A deformed mesh with a triangle of zero or
+// negative signed area is then replaced by s1 + lambda (s2 - s1), with the largest lambda in
+// [0, 1) that flips nothing (bisection to 1/1024): the handles still meet their targets exactly,
+// and the result is as rigid as a flip-free blend allows. When s1 itself flips, deform throws
+// Error(kInvalidArgument) naming the triangle and changes nothing; the edit can be retried with a
+// smaller displacement, a larger sigma, a region, or in several steps (each step starts from the
+// last result as its rest shape).
+#pragma once
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <vector>
+
+#include "subvec/edit/arap.h"
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+// Control vertices the user moves and their target positions (parallel arrays, no repeats), and
+// optionally the extent of the deformation.
+struct Handles {
+  std::vector<int32_t> vertices;
+  std::vector<Vec2> targets;
+  // > 0: only the part of the mesh within this Euclidean distance (pixels, rest positions) of a
+  // handle deforms; farther vertices are pinned. 0: the whole mesh, held by the image frame.
+  double region = 0;
+};
+
+// One vertex moved by `displacement`.
+Handles drag_vertex(const ControlMesh& mesh, int vertex, Vec2 displacement);
+
+// Part of a feature dragged from `center` by `displacement` (paper §6.1): every vertex of the
+// feature moves by g * displacement with g = exp(-d^2 / (2 sigma^2)), d the Euclidean distance from
+// its rest position to `center`. All the feature's vertices are handles (far ones barely move, so
+// the rest of the feature holds its place). sigma > 0, pixels.
+Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 center,
+                     Vec2 displacement, double sigma);
+
+// A whole feature rotated by `degrees` about the centroid of its control vertices, then translated
+// by `translate`. Positive angles turn from +x towards +y: clockwise on screen (y points down).
+Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 translate,
+                     double degrees);
+
+class ShapeEditor {
+ public:
+  // The rest shape is `mesh`'s positions now; `width` x `height` is the image. Throws
+  // Error(kInvalidArgument) for a mesh with a degenerate triangle.
+  ShapeEditor(const ControlMesh& mesh, int width, int height);
+
+  const std::vector<Vec2>& rest() const { return rest_; }
+  // The lambda of the last deform: 1 when the scale adjustment was applied in full.
+  double scale_fraction() const { return scale_fraction_; }
+
+  // Deformed positions (#V) with the handles at their targets (projected as described above).
+  // The factorization depends only on the set of handle vertices and the region, and is cached
+  // (the last few sets), so repeated calls with the same vertices and new targets, a drag, only
+  // back-substitute. Throws Error(kInvalidArgument) for an out-of-range or repeated handle vertex,
+  // a non-finite target or region, or a result that would flip a triangle (nothing is changed
+  // then).
+  std::vector<Vec2> deform(const Handles& handles);
+  void deform(const Handles& handles, std::vector<Vec2>& out);
+
+ private:
+  struct Cached {
+    std::vector<int32_t> handles;  // sorted
+    double region = 0;
+    std::shared_ptr<const ArapDeformer> deformer;
+  };
+  const ArapDeformer& deformer_for(std::vector<int32_t> handles, double region);
+
+  std::vector<Vec2> rest_;
+  std::vector<Tri> triangles_;
+  std::vector<uint8_t> sides_;  // per vertex: bit 0 left, 1 right, 2 top, 3 bottom
+  std::list<Cached> cache_;     // most recently used first
+  int first_flip(const std::vector<Vec2>& positions) const;
+
+  std::vector<Vec2> targets_, similarity_;  // scratch
+  double scale_fraction_ = 1;
+};
+
+}  // namespace subvec

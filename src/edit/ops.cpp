@@ -1,0 +1,431 @@
+// The ops file of `subvec edit` (edit/ops.h; format in docs/editing.md): a strict JSON reader and
+// the application of each operation through the shape, color and selection tools.
+#include "subvec/edit/ops.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "subvec/core/error.h"
+#include "subvec/edit/color.h"
+#include "subvec/edit/selection.h"
+#include "subvec/edit/shape.h"
+#include "subvec/mesh/validate.h"
+
+namespace subvec {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr int kMaxDepth = 16;
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string point(Vec2 p) { return "[" + num(p.x) + ", " + num(p.y) + "]"; }
+
+// Messages are one line: control characters become \xNN, long texts are cut.
+std::string printable(const std::string& s, size_t max = 60) {
+  std::string out;
+  for (size_t i = 0; i < s.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7F) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += s[i];
+    }
+  }
+  return s.size() > max ? out + "..." : out;
+}
+
+// Where a message points: "ops[2] (drag)" and a key.
+struct Place {
+  size_t index = 0;
+  std::string op;  // empty until known
+
+  std::string str() const {
+    return "ops[" + std::to_string(index) + "]" + (op.empty() ? "" : " (" + op + ")");
+  }
+  [[noreturn]] void fail(const std::string& message) const {
+    throw Error(ErrorCode::kBadFile, str() + ": " + message);
+  }
+  [[noreturn]] void fail(const char* key, const std::string& message) const {
+    fail(std::string("\"") + key + "\": " + message);
+  }
+};
+
+const char* type_name(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned:
+    case Json::value_t::number_float:
+      return "a number";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::null:
+      return "null";
+    case Json::value_t::array:
+      return "an array";
+    case Json::value_t::object:
+      return "an object";
+    default:
+      return "an unsupported value";
+  }
+}
+
+double number(const Json& j, const Place& at, const char* key) {
+  if (!j.is_number()) at.fail(key, std::string("expected a number, got ") + type_name(j));
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) at.fail(key, "the number is not finite");
+  return v;
+}
+
+Vec2 vec2(const Json& j, const Place& at, const char* key) {
+  if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number()) {
+    at.fail(key, std::string("expected [x, y] (two numbers), got ") +
+                     (j.is_array() ? "an array of " + std::to_string(j.size()) + " elements"
+                                   : type_name(j)));
+  }
+  return {number(j[0], at, key), number(j[1], at, key)};
+}
+
+Color color(const Json& j, const Place& at, const char* key) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() ||
+      !j[2].is_number()) {
+    at.fail(key, std::string("expected [r, g, b] (three numbers, 0 to 255), got ") +
+                     (j.is_array() ? "an array of " + std::to_string(j.size()) + " elements"
+                                   : type_name(j)));
+  }
+  float c[3];
+  for (int k = 0; k < 3; ++k) {
+    const double v = number(j[k], at, key);
+    if (v < 0 || v > 255) at.fail(key, "channel " + num(v) + " is outside 0 to 255");
+    c[k] = static_cast<float>(v);
+  }
+  return {c[0], c[1], c[2]};
+}
+
+std::string string_value(const Json& j, const Place& at, const char* key) {
+  if (!j.is_string()) at.fail(key, std::string("expected a string, got ") + type_name(j));
+  return j.get<std::string>();
+}
+
+// The parsed operation object: required and optional keys, each key used once, the rest rejected.
+class Fields {
+ public:
+  Fields(const Json& object, Place& at) : object_(object), at_(at) {}
+
+  const Json& required(const char* key) {
+    const Json* j = optional(key);
+    if (!j) at_.fail(std::string("missing key \"") + key + "\"");
+    return *j;
+  }
+  const Json* optional(const char* key) {
+    allowed_.insert(key);
+    auto it = object_.find(key);
+    return it == object_.end() ? nullptr : &*it;
+  }
+  // After all keys were asked for: rejects the others.
+  void finish() const {
+    for (const auto& [key, value] : object_.items()) {
+      if (allowed_.count(key)) continue;
+      std::string list;
+      for (const std::string& a : allowed_) list += (list.empty() ? "" : ", ") + a;
+      at_.fail("unknown key \"" + printable(key) + "\" (expected one of: " + list + ")");
+    }
+  }
+
+ private:
+  const Json& object_;
+  Place& at_;
+  std::set<std::string> allowed_;
+};
+
+EditOp parse_op(const Json& j, Place& at) {
+  if (!j.is_object()) at.fail(std::string("expected an operation object, got ") + type_name(j));
+  Fields fields(j, at);
+  EditOp op;
+  const std::string kind = string_value(fields.required("op"), at, "op");
+  if (kind == "drag") {
+    op.kind = EditOp::Kind::kDrag;
+  } else if (kind == "move-feature") {
+    op.kind = EditOp::Kind::kMoveFeature;
+  } else if (kind == "color") {
+    op.kind = EditOp::Kind::kColor;
+  } else {
+    at.fail("unknown op \"" + printable(kind) + "\" (expected drag, move-feature or color)");
+  }
+  at.op = kind;
+
+  if (const Json* level = fields.optional("level")) {
+    if (!level->is_number_integer() || level->get<int64_t>() < 0 ||
+        level->get<int64_t>() >= Limits::kMaxLevels) {
+      at.fail("level", "expected a level number, 0 to " + std::to_string(Limits::kMaxLevels - 1) +
+                           ", got " + (level->is_number() ? level->dump() : type_name(*level)));
+    }
+    op.level = static_cast<int>(level->get<int64_t>());
+  }
+  auto select = [&]() {
+    if (const Json* s = fields.optional("select")) {
+      const std::string v = string_value(*s, at, "select");
+      if (v == "vertex") return EditSelect::kVertex;
+      if (v == "feature") return EditSelect::kFeature;
+      at.fail("select", "expected \"vertex\" or \"feature\", got \"" + printable(v) + "\"");
+    }
+    return EditSelect::kVertex;
+  };
+
+  auto region = [&]() {
+    if (const Json* r = fields.optional("region")) {
+      op.region = number(*r, at, "region");
+      if (!(op.region > 0)) at.fail("region", "expected a positive number, got " + num(op.region));
+    }
+  };
+  switch (op.kind) {
+    case EditOp::Kind::kDrag:
+      region();
+      op.select = select();
+      op.from = vec2(fields.required("from"), at, "from");
+      op.to = vec2(fields.required("to"), at, "to");
+      if (op.select == EditSelect::kFeature) {
+        if (const Json* s = fields.optional("sigma")) {
+          op.sigma = number(*s, at, "sigma");
+          if (!(op.sigma > 0)) at.fail("sigma", "expected a positive number, got " + num(op.sigma));
+        }
+      }
+      break;
+    case EditOp::Kind::kMoveFeature: {
+      region();
+      op.select = EditSelect::kFeature;
+      op.at = vec2(fields.required("at"), at, "at");
+      const Json* translate = fields.optional("translate");
+      const Json* rotate = fields.optional("rotate");
+      if (!translate && !rotate) at.fail("missing key \"translate\" or \"rotate\" (give one or both)");
+      if (translate) op.translate = vec2(*translate, at, "translate");
+      if (rotate) op.rotate = number(*rotate, at, "rotate");
+      break;
+    }
+    case EditOp::Kind::kColor: {
+      const std::string mode = string_value(fields.required("mode"), at, "mode");
+      if (mode == "blend") {
+        op.mode = ColorMode::kBlend;
+      } else if (mode == "transform") {
+        op.mode = ColorMode::kTransform;
+      } else {
+        at.fail("mode", "expected \"blend\" or \"transform\", got \"" + printable(mode) + "\"");
+      }
+      at.op = "color " + mode;
+      op.select = select();
+      op.at = vec2(fields.required("at"), at, "at");
+      op.color = color(fields.required("color"), at, "color");
+      if (const Json* r = fields.optional("radius")) {
+        op.radius = number(*r, at, "radius");
+        if (op.radius < 0) at.fail("radius", "expected a number >= 0, got " + num(op.radius));
+      }
+      if (op.mode == ColorMode::kBlend) {
+        if (const Json* a = fields.optional("amount")) {
+          op.amount = number(*a, at, "amount");
+          if (!(op.amount >= 0 && op.amount <= 1)) {
+            at.fail("amount", "expected a number from 0 to 1, got " + num(op.amount));
+          }
+        }
+      }
+      break;
+    }
+  }
+  fields.finish();
+  return op;
+}
+
+// Duplicate keys and depth, checked while parsing (nlohmann keeps the last duplicate silently).
+struct DuplicateKeys {
+  std::vector<std::set<std::string>> keys;
+  int depth = 0;
+  bool operator()(int, Json::parse_event_t event, Json& parsed) {
+    using E = Json::parse_event_t;
+    if (event == E::object_start || event == E::array_start) {
+      if (++depth > kMaxDepth) {
+        throw Error(ErrorCode::kBadFile, "the ops file nests deeper than " + std::to_string(kMaxDepth) + " levels");
+      }
+      keys.emplace_back();
+    } else if (event == E::object_end || event == E::array_end) {
+      --depth;
+      keys.pop_back();
+    } else if (event == E::key && !keys.back().insert(parsed.get<std::string>()).second) {
+      throw Error(ErrorCode::kBadFile,
+                  "duplicate key \"" + printable(parsed.get<std::string>()) + "\" in the ops file");
+    }
+    return true;
+  }
+};
+
+// ---- applying --------------------------------------------------------------------------------
+
+[[noreturn]] void refuse(const std::string& where, const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, where + ": " + message);
+}
+
+std::string vertex_name(const ControlMesh& mesh, int v) {
+  return "vertex " + std::to_string(v) + " " + point(mesh.positions[v]);
+}
+
+std::string feature_name(const ControlMesh& mesh, int f) {
+  return "feature " + std::to_string(f) + " (id " + std::to_string(mesh.features[f].id) + ")";
+}
+
+}  // namespace
+
+std::string EditOp::name() const {
+  switch (kind) {
+    case Kind::kDrag:
+      return select == EditSelect::kVertex ? "drag vertex" : "drag feature";
+    case Kind::kMoveFeature:
+      return "move-feature";
+    case Kind::kColor:
+      return mode == ColorMode::kBlend ? "color blend" : "color transform";
+  }
+  return "?";
+}
+
+std::vector<EditOp> parse_edit_ops(std::string_view text) {
+  Json doc;
+  try {
+    DuplicateKeys check;
+    doc = Json::parse(text.begin(), text.end(),
+                      [&check](int depth, Json::parse_event_t event, Json& parsed) {
+                        return check(depth, event, parsed);
+                      });
+  } catch (const Json::parse_error& e) {
+    std::string what = e.what();
+    const size_t end = what.find("] ");
+    if (!what.empty() && what[0] == '[' && end != std::string::npos) what.erase(0, end + 2);
+    throw Error(ErrorCode::kBadFile, "invalid JSON in the ops file: " + printable(what, 200));
+  }
+  if (!doc.is_array()) {
+    throw Error(ErrorCode::kBadFile, std::string("the ops file must be a JSON array of operations, got ") +
+                                         type_name(doc));
+  }
+  std::vector<EditOp> ops;
+  for (size_t i = 0; i < doc.size(); ++i) {
+    Place at{i, {}};
+    ops.push_back(parse_op(doc[i], at));
+  }
+  return ops;
+}
+
+std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const EditOp> ops) {
+  std::vector<std::string> log;
+  const double w = image.width, h = image.height;
+  for (size_t i = 0; i < ops.size(); ++i) {
+    const EditOp& op = ops[i];
+    const std::string where = "ops[" + std::to_string(i) + "] (" + op.name() + ")";
+    const int num_levels = static_cast<int>(image.levels.size());
+    if (op.level < 0 || op.level >= num_levels) {
+      refuse(where, "level " + std::to_string(op.level) + " is out of range (the image has " +
+                        std::to_string(num_levels) + (num_levels == 1 ? " level)" : " levels)"));
+    }
+    auto inside = [&](const char* key, Vec2 p) {
+      if (!(p.x >= 0 && p.x <= w && p.y >= 0 && p.y <= h)) {
+        refuse(where, std::string("\"") + key + "\" " + point(p) + " is outside the image [0, " +
+                          num(w) + "] x [0, " + num(h) + "]");
+      }
+    };
+    ControlMesh mesh = image.levels[op.level];
+    const MeshTopology topology = validate_level(mesh, image.width, image.height, op.level);
+    auto pick_feature = [&](Vec2 p) {
+      const FeaturePick pick = nearest_feature(mesh, topology, p);
+      if (pick.feature < 0) {
+        refuse(where, "nothing to select: level " + std::to_string(op.level) + " has no features");
+      }
+      return pick;
+    };
+    std::string done;
+    try {
+      switch (op.kind) {
+        case EditOp::Kind::kDrag:
+        case EditOp::Kind::kMoveFeature: {
+          Handles handles;
+          if (op.kind == EditOp::Kind::kDrag) {
+            inside("from", op.from);
+            inside("to", op.to);
+            const Vec2 d{op.to.x - op.from.x, op.to.y - op.from.y};
+            if (op.select == EditSelect::kVertex) {
+              const int v = nearest_vertex(mesh, op.from);
+              const Vec2 p = mesh.positions[v];
+              if ((p.x == 0 || p.x == w) && (p.y == 0 || p.y == h)) {
+                refuse(where, "nothing to drag: the nearest control vertex to " + point(op.from) +
+                                  " is the image corner " + point(p) + ", which stays fixed");
+              }
+              handles = drag_vertex(mesh, v, d);
+              done = vertex_name(mesh, v) + " moved by " + point(d);
+            } else {
+              const FeaturePick pick = pick_feature(op.from);
+              handles = drag_feature(mesh, mesh.features[pick.feature], op.from, d, op.sigma);
+              done = feature_name(mesh, pick.feature) + " (" + num(pick.distance) +
+                     " px away) dragged by " + point(d) + ", sigma " + num(op.sigma);
+            }
+          } else {
+            inside("at", op.at);
+            const FeaturePick pick = pick_feature(op.at);
+            handles = move_feature(mesh, mesh.features[pick.feature], op.translate, op.rotate);
+            done = feature_name(mesh, pick.feature) + " (" + num(pick.distance) +
+                   " px away) rotated by " + num(op.rotate) + " degrees and moved by " +
+                   point(op.translate);
+          }
+          handles.region = op.region;
+          ShapeEditor editor(mesh, image.width, image.height);
+          mesh.positions = editor.deform(handles);
+          double moved = 0;
+          for (int v = 0; v < mesh.num_vertices(); ++v) {
+            moved = std::max(moved, std::hypot(mesh.positions[v].x - editor.rest()[v].x,
+                                               mesh.positions[v].y - editor.rest()[v].y));
+          }
+          done += "; " + std::to_string(handles.vertices.size()) + " handle vertices, largest move " +
+                  num(moved) + " px";
+          if (editor.scale_fraction() < 1) {
+            done += " (scale adjustment applied at " + num(editor.scale_fraction()) +
+                    " to avoid a flip)";
+          }
+          break;
+        }
+        case EditOp::Kind::kColor: {
+          inside("at", op.at);
+          const ColorSelection s = op.select == EditSelect::kVertex
+                                       ? select_vertex_colors(mesh, topology, op.at, op.radius)
+                                       : select_feature_colors(mesh, topology, op.at, op.radius);
+          if (s.colors.empty()) refuse(where, "nothing to select at " + point(op.at));
+          const Color seed = mesh.colors[s.seed_color];
+          if (op.mode == ColorMode::kBlend) {
+            blend_colors(mesh, s.colors, op.color, op.amount);
+          } else {
+            transform_colors(mesh, s.colors, seed, op.color);
+          }
+          done = std::to_string(s.colors.size()) + " color values from seed " +
+                 vertex_name(mesh, s.seed_vertex) + " (color " + num(seed.r) + ", " + num(seed.g) +
+                 ", " + num(seed.b) + ")";
+          break;
+        }
+      }
+      validate_level(mesh, image.width, image.height, op.level);
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      if (message.rfind(where, 0) == 0) throw;
+      refuse(where, message);
+    }
+    image.levels[op.level] = std::move(mesh);
+    log.push_back(where + ": " + done);
+  }
+  return log;
+}
+
+}  // namespace subvec

@@ -1,0 +1,199 @@
+// Shape editing (edit/shape.h).
+#include "subvec/edit/shape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "subvec/core/error.h"
+
+namespace subvec {
+namespace {
+
+constexpr size_t kCachedSets = 4;
+
+[[noreturn]] void invalid(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+}  // namespace
+
+Handles drag_vertex(const ControlMesh& mesh, int vertex, Vec2 displacement) {
+  if (vertex < 0 || vertex >= mesh.num_vertices()) {
+    invalid("vertex " + std::to_string(vertex) + " is out of range");
+  }
+  const Vec2 p = mesh.positions[vertex];
+  return {{vertex}, {{p.x + displacement.x, p.y + displacement.y}}};
+}
+
+namespace {
+
+// The feature's vertices once each (a closed chain repeats its first vertex).
+std::vector<int32_t> unique_vertices(const Feature& feature) {
+  std::vector<int32_t> vs = feature.vertices;
+  if (feature.closed()) vs.pop_back();
+  return vs;
+}
+
+}  // namespace
+
+Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 center,
+                     Vec2 displacement, double sigma) {
+  if (!(sigma > 0) || !std::isfinite(sigma)) invalid("sigma " + num(sigma) + " is not a positive number");
+  Handles h;
+  h.vertices = unique_vertices(feature);
+  for (int32_t v : h.vertices) {
+    const Vec2 p = mesh.positions[v];
+    const double d2 = (p.x - center.x) * (p.x - center.x) + (p.y - center.y) * (p.y - center.y);
+    const double g = std::exp(-d2 / (2 * sigma * sigma));
+    h.targets.push_back({p.x + g * displacement.x, p.y + g * displacement.y});
+  }
+  return h;
+}
+
+Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 translate,
+                     double degrees) {
+  Handles h;
+  h.vertices = unique_vertices(feature);
+  double cx = 0, cy = 0;
+  for (int32_t v : h.vertices) cx += mesh.positions[v].x, cy += mesh.positions[v].y;
+  cx /= double(h.vertices.size()), cy /= double(h.vertices.size());
+  const double a = degrees * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  for (int32_t v : h.vertices) {
+    const double x = mesh.positions[v].x - cx, y = mesh.positions[v].y - cy;
+    h.targets.push_back({cx + c * x - s * y + translate.x, cy + s * x + c * y + translate.y});
+  }
+  return h;
+}
+
+ShapeEditor::ShapeEditor(const ControlMesh& mesh, int width, int height)
+    : rest_(mesh.positions), triangles_(mesh.triangles) {
+  sides_.resize(rest_.size());
+  for (size_t v = 0; v < rest_.size(); ++v) {
+    const Vec2 p = rest_[v];
+    sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.x == width ? 2 : 0) |
+                                     (p.y == 0 ? 4 : 0) | (p.y == height ? 8 : 0));
+  }
+}
+
+const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, double region) {
+  std::sort(handles.begin(), handles.end());
+  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
+    if (it->handles == handles && it->region == region) {
+      cache_.splice(cache_.begin(), cache_, it);
+      return *cache_.front().deformer;
+    }
+  }
+  std::vector<FixedAxes> fixed(rest_.size(), FixedAxes::kNone);
+  for (size_t v = 0; v < rest_.size(); ++v) {
+    const unsigned s = sides_[v];
+    fixed[v] = static_cast<FixedAxes>(((s & 3u) ? 1u : 0u) | ((s & 12u) ? 2u : 0u));
+  }
+  if (region > 0) {
+    const double r2 = region * region;
+    for (size_t v = 0; v < rest_.size(); ++v) {
+      bool near = false;
+      for (int32_t h : handles) {
+        const double dx = rest_[v].x - rest_[h].x, dy = rest_[v].y - rest_[h].y;
+        if (dx * dx + dy * dy <= r2) {
+          near = true;
+          break;
+        }
+      }
+      if (!near) fixed[v] = FixedAxes::kXY;
+    }
+  }
+  for (int32_t v : handles) fixed[v] = FixedAxes::kXY;
+  auto deformer = std::make_shared<const ArapDeformer>(rest_, triangles_, fixed);
+  cache_.push_front({std::move(handles), region, std::move(deformer)});
+  if (cache_.size() > kCachedSets) cache_.pop_back();
+  return *cache_.front().deformer;
+}
+
+std::vector<Vec2> ShapeEditor::deform(const Handles& handles) {
+  std::vector<Vec2> out;
+  deform(handles, out);
+  return out;
+}
+
+void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
+  const int n = static_cast<int>(rest_.size());
+  if (handles.vertices.size() != handles.targets.size()) {
+    invalid(std::to_string(handles.vertices.size()) + " handle vertices but " +
+            std::to_string(handles.targets.size()) + " targets");
+  }
+  targets_ = rest_;
+  std::vector<uint8_t> seen(rest_.size(), 0);
+  for (size_t i = 0; i < handles.vertices.size(); ++i) {
+    const int v = handles.vertices[i];
+    if (v < 0 || v >= n) invalid("handle vertex " + std::to_string(v) + " is out of range");
+    if (seen[v]++) invalid("handle vertex " + std::to_string(v) + " is given twice");
+    const Vec2 t = handles.targets[i];
+    if (!std::isfinite(t.x) || !std::isfinite(t.y)) {
+      invalid("the target of vertex " + std::to_string(v) + " is not finite");
+    }
+    // Border handles slide along their side; corners stay.
+    const unsigned s = sides_[v];
+    targets_[v] = {(s & 3u) ? rest_[v].x : t.x, (s & 12u) ? rest_[v].y : t.y};
+  }
+  if (!(handles.region >= 0) || !std::isfinite(handles.region)) {
+    invalid("the region " + num(handles.region) + " is not a number >= 0");
+  }
+  const ArapDeformer& deformer = deformer_for(handles.vertices, handles.region);
+  std::vector<Vec2> result(rest_.size());
+  similarity_.resize(rest_.size());
+  deformer.solve(targets_, result, similarity_);
+  scale_fraction_ = 1;
+  if (first_flip(result) >= 0) {
+    // Repair: apply the scale adjustment only partly, v = s1 + lambda (s2 - s1), with the largest
+    // lambda (bisection, to 1/1024) that flips nothing. Refused when the similarity step flips.
+    const int f = first_flip(similarity_);
+    if (f >= 0) {
+      const Tri& t = triangles_[f];
+      const Vec2 r = rest_[t[0]];
+      invalid("the edit would flip control triangle " + std::to_string(f) + " (vertices " +
+              std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
+              " near (" + num(r.x) + ", " + num(r.y) +
+              ")); refused: try a smaller displacement, a larger sigma or several smaller steps");
+    }
+    std::vector<Vec2> blend(rest_.size());
+    auto mix = [&](double lambda) {
+      for (size_t v = 0; v < rest_.size(); ++v) {
+        blend[v] = {similarity_[v].x + lambda * (result[v].x - similarity_[v].x),
+                    similarity_[v].y + lambda * (result[v].y - similarity_[v].y)};
+        // Constrained coordinates are equal in both: keep them exact.
+        if (similarity_[v].x == result[v].x) blend[v].x = result[v].x;
+        if (similarity_[v].y == result[v].y) blend[v].y = result[v].y;
+      }
+    };
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 10; ++i) {
+      const double mid = (lo + hi) / 2;
+      mix(mid);
+      (first_flip(blend) < 0 ? lo : hi) = mid;
+    }
+    mix(lo);
+    result.swap(blend);
+    scale_fraction_ = lo;
+  }
+  out = std::move(result);
+}
+
+int ShapeEditor::first_flip(const std::vector<Vec2>& p) const {
+  for (size_t f = 0; f < triangles_.size(); ++f) {
+    const Tri& t = triangles_[f];
+    const Vec2 a = p[t[0]], b = p[t[1]], c = p[t[2]];
+    if (!((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0)) return static_cast<int>(f);
+  }
+  return -1;
+}
+
+}  // namespace subvec

@@ -1,0 +1,234 @@
+// Shape editing (edit/shape.h): drags meet their constraints, beat the Gaussian falloff alone in
+// rigidity, keep the image frame and the feature curves, and flips are refused.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "subvec/core/error.h"
+#include "subvec/edit/arap.h"
+#include "subvec/edit/selection.h"
+#include "subvec/edit/shape.h"
+#include "subvec/mesh/curves.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/subdiv/subdivision.h"
+#include "support/synthetic.h"
+
+namespace subvec {
+namespace {
+
+VectorImage image_with_features() {
+  test::SyntheticOptions o;
+  o.width = 160;
+  o.height = 128;
+  o.vertices = 900;
+  return test::make_synthetic_image(o);
+}
+
+double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+  const double u = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0;
+  return std::hypot(p.x - a.x - u * dx, p.y - a.y - u * dy);
+}
+
+// Every refined tear vertex of the limit surface lies on the B-spline of its feature's chain
+// (mesh/curves.h): the feature curves are the C^2 cubic B-splines of the edited control chains.
+void expect_feature_curves_are_bsplines(const VectorImage& image) {
+  const ControlMesh& mesh = image.levels[0];
+  const MeshTopology topology = validate_level(mesh, image.width, image.height);
+  std::vector<std::vector<Vec2>> curves;
+  for (const Feature& f : mesh.features)
+    for (const CurvePiece& piece : feature_pieces(topology, f))
+      curves.push_back(sample_bspline(piece_points(mesh, piece), piece.closed, 64));
+  const Subdivision subdivision(mesh, topology, 3);
+  RefinedMesh refined;
+  subdivision.evaluate(mesh.positions, mesh.colors, refined, 1);
+  ASSERT_FALSE(refined.tear_edges.empty());
+  double worst = 0;
+  for (const EdgeVerts& e : refined.tear_edges) {
+    for (const int v : e) {
+      const Vec2 p{refined.positions[2 * size_t(v)], refined.positions[2 * size_t(v) + 1]};
+      double d = std::numeric_limits<double>::infinity();
+      for (const auto& c : curves)
+        for (size_t i = 0; i + 1 < c.size(); ++i) d = std::min(d, segment_distance(p, c[i], c[i + 1]));
+      worst = std::max(worst, d);
+    }
+  }
+  EXPECT_LT(worst, 2e-3);
+}
+
+TEST(Shape, FeatureDragMeetsItsConstraintsAndIsMoreRigidThanTheFalloffAlone) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  const Feature& feature = mesh.features[0];
+  const Vec2 click = mesh.positions[feature.vertices[2]];
+  const Handles h = drag_feature(mesh, feature, click, {5, -4}, 10);
+  ShapeEditor editor(mesh, image.width, image.height);
+  const std::vector<Vec2> out = editor.deform(h);
+  for (size_t i = 0; i < h.vertices.size(); ++i) {
+    EXPECT_EQ(out[h.vertices[i]].x, h.targets[i].x);
+    EXPECT_EQ(out[h.vertices[i]].y, h.targets[i].y);
+  }
+  // The clicked vertex moves by the whole displacement, far ones by almost nothing.
+  EXPECT_EQ(out[feature.vertices[2]].x, click.x + 5);
+  std::vector<Vec2> falloff = mesh.positions;
+  for (size_t i = 0; i < h.vertices.size(); ++i) falloff[h.vertices[i]] = h.targets[i];
+  const double arap = rigidity_energy(mesh.positions, out, mesh.triangles);
+  const double alone = rigidity_energy(mesh.positions, falloff, mesh.triangles);
+  EXPECT_GT(arap, 0);
+  EXPECT_LT(arap, 0.5 * alone) << "ARAP " << arap << ", falloff alone " << alone;
+}
+
+TEST(Shape, TheImageFrameIsKept) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  ShapeEditor editor(mesh, image.width, image.height);
+  const int v = nearest_vertex(mesh, {80, 64});
+  const std::vector<Vec2> out = editor.deform(drag_vertex(mesh, v, {6, 3}));
+  for (int u = 0; u < mesh.num_vertices(); ++u) {
+    const Vec2 p = mesh.positions[u], q = out[u];
+    if (p.x == 0 || p.x == image.width) {
+      EXPECT_EQ(q.x, p.x) << "vertex " << u;
+    }
+    if (p.y == 0 || p.y == image.height) {
+      EXPECT_EQ(q.y, p.y) << "vertex " << u;
+    }
+  }
+  // A handle on the border slides along its side.
+  int border = -1;
+  for (int u = 0; u < mesh.num_vertices() && border < 0; ++u)
+    if (mesh.positions[u].y == 0 && mesh.positions[u].x > 20 && mesh.positions[u].x < 140) border = u;
+  ASSERT_GE(border, 0);
+  const std::vector<Vec2> slid = editor.deform(drag_vertex(mesh, border, {2, 5}));
+  EXPECT_EQ(slid[border].y, 0);
+  EXPECT_EQ(slid[border].x, mesh.positions[border].x + 2);
+}
+
+TEST(Shape, FeatureCurvesStayBSplinesAndTopologyIsUntouchedAfterEveryEdit) {
+  VectorImage image = image_with_features();
+  const ControlMesh before = image.levels[0];
+  const MeshTopology topology_before = validate_level(before, image.width, image.height);
+  expect_feature_curves_are_bsplines(image);
+
+  std::vector<Handles> edits;
+  edits.push_back(drag_vertex(before, nearest_vertex(before, {50, 40}), {3, 2}));
+  edits.push_back(drag_feature(before, before.features[1], before.positions[before.features[1].vertices[1]], {-3, 4}, 8));
+  edits.push_back(move_feature(before, before.features[0], {2, -1}, 6));
+  for (const Handles& h : edits) {
+    ControlMesh& mesh = image.levels[0];
+    ShapeEditor editor(mesh, image.width, image.height);
+    mesh.positions = editor.deform(h);
+    const MeshTopology topology = validate_level(mesh, image.width, image.height);
+    EXPECT_EQ(mesh.triangles, before.triangles);
+    EXPECT_EQ(mesh.triangle_colors, before.triangle_colors);
+    EXPECT_EQ(mesh.creases, before.creases);
+    ASSERT_EQ(mesh.features.size(), before.features.size());
+    for (size_t f = 0; f < mesh.features.size(); ++f)
+      EXPECT_EQ(mesh.features[f].vertices, before.features[f].vertices);
+    EXPECT_EQ(topology.vertex_tags, topology_before.vertex_tags);
+    EXPECT_EQ(topology.edge_tags, topology_before.edge_tags);
+    expect_feature_curves_are_bsplines(image);
+  }
+  EXPECT_NE(image.levels[0].positions, before.positions);
+}
+
+TEST(Shape, MoveFeatureRotatesAndTranslatesTheWholeFeature) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  const Feature& feature = mesh.features[0];
+  const Handles h = move_feature(mesh, feature, {3, 1}, 90);
+  ASSERT_EQ(h.vertices.size(), feature.vertices.size() - (feature.closed() ? 1 : 0));
+  double cx = 0, cy = 0;
+  for (int32_t v : h.vertices) cx += mesh.positions[v].x, cy += mesh.positions[v].y;
+  cx /= double(h.vertices.size()), cy /= double(h.vertices.size());
+  for (size_t i = 0; i < h.vertices.size(); ++i) {
+    const Vec2 p = mesh.positions[h.vertices[i]];
+    // 90 degrees: (x, y) -> (-y, x) about the centroid, clockwise on screen.
+    EXPECT_NEAR(h.targets[i].x, cx - (p.y - cy) + 3, 1e-9);
+    EXPECT_NEAR(h.targets[i].y, cy + (p.x - cx) + 1, 1e-9);
+  }
+  ShapeEditor editor(mesh, image.width, image.height);
+  const std::vector<Vec2> out = editor.deform(move_feature(mesh, feature, {3, 1}, 0));
+  for (int32_t v : h.vertices) {
+    EXPECT_DOUBLE_EQ(out[v].x, mesh.positions[v].x + 3);
+    EXPECT_DOUBLE_EQ(out[v].y, mesh.positions[v].y + 1);
+  }
+}
+
+TEST(Shape, ARegionPinsTheRestOfTheMesh) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  ShapeEditor editor(mesh, image.width, image.height);
+  const int v = nearest_vertex(mesh, {80, 64});
+  Handles h = drag_vertex(mesh, v, {3, 2});
+  h.region = 25;
+  const std::vector<Vec2> out = editor.deform(h);
+  int moved = 0;
+  for (int u = 0; u < mesh.num_vertices(); ++u) {
+    const Vec2 p = mesh.positions[u];
+    const double d = std::hypot(p.x - mesh.positions[v].x, p.y - mesh.positions[v].y);
+    if (d > 25) {
+      EXPECT_EQ(out[u], p) << "vertex " << u;
+    } else {
+      moved += out[u] != p;
+    }
+  }
+  EXPECT_GT(moved, 5);
+}
+
+TEST(Shape, EveryResultIsFlipFreeOrRefused) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  ShapeEditor editor(mesh, image.width, image.height);
+  int refused = 0, repaired = 0;
+  for (const double size : {2.0, 8.0, 20.0, 40.0, 70.0}) {
+    for (size_t f = 0; f < mesh.features.size(); ++f) {
+      const Feature& feature = mesh.features[f];
+      const Vec2 click = mesh.positions[feature.vertices[feature.vertices.size() / 2]];
+      const Handles h = drag_feature(mesh, feature, click, {size, -0.5 * size}, 12);
+      try {
+        const std::vector<Vec2> out = editor.deform(h);
+        for (const Tri& t : mesh.triangles) {
+          const Vec2 a = out[t[0]], b = out[t[1]], c = out[t[2]];
+          ASSERT_GT((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x), 0);
+        }
+        for (size_t i = 0; i < h.vertices.size(); ++i) {
+          const Vec2 p = mesh.positions[h.vertices[i]];
+          if (p.x != 0 && p.x != image.width && p.y != 0 && p.y != image.height) {
+            EXPECT_EQ(out[h.vertices[i]], h.targets[i]);
+          }
+        }
+        repaired += editor.scale_fraction() < 1;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("would flip"), std::string::npos) << e.what();
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0);  // the large drags
+  RecordProperty("repaired", repaired);
+}
+
+TEST(Shape, AFlippingEditIsRefused) {
+  const VectorImage image = image_with_features();
+  const ControlMesh& mesh = image.levels[0];
+  ShapeEditor editor(mesh, image.width, image.height);
+  const int v = nearest_vertex(mesh, {80, 64});
+  Handles h = drag_vertex(mesh, v, {300, 0});  // far past the right border
+  try {
+    editor.deform(h);
+    FAIL() << "expected a refusal";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("flip"), std::string::npos) << e.what();
+  }
+  // A repeated handle is an error too.
+  h.vertices.push_back(v);
+  h.targets.push_back({1, 1});
+  EXPECT_THROW(editor.deform(h), Error);
+}
+
+}  // namespace
+}  // namespace subvec
