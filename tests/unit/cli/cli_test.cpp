@@ -546,9 +546,10 @@ TEST_F(Cli, VectorizeProgressOnlyOnATerminal) {
   EXPECT_EQ(terminal.back(), '\r') << terminal;
   EXPECT_EQ(terminal.find('\n'), std::string::npos) << terminal;
   EXPECT_NE(read_text(summary).find("mesh      "), std::string::npos);
-  // The default delay of a second hides it for a short run.
+  // A delay longer than the run hides it (an hour here, so that a slow machine or a sanitizer
+  // build cannot make this run outlast it; the default is a second).
   const auto [quiet, quiet_status] = run_on_terminal(
-      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "1");
+      {"vectorize", photo.string(), "-o", out.string(), "--vertices", "60"}, summary, "3600");
   ASSERT_EQ(quiet_status, 0) << quiet;
   EXPECT_EQ(quiet, "");
   // Not a terminal: nothing on stderr whatever the delay.
