@@ -138,6 +138,157 @@ bool is_small(const TriangleSetup& t) {
 }
 #endif
 
+#if defined(__SSE2__)
+// ---- Small triangles, four at a time ------------------------------------------------------------
+// Most refined triangles have at most 4 x 2 candidate pixel centres (1-3 pixel edges), and their
+// cost is the per-triangle setup, so these are tested four triangles at a time with one triangle
+// per SSE2 lane: gather, candidate range, edge functions and the test of all 8 candidates run as
+// vector code without branches. Relative to its first candidate centre, such a triangle's corners
+// are below 5 pixels (2^11 fixed-point units) away, so its edge functions at the candidates are
+// integers below 2^24 in magnitude and float lanes compute them exactly: the test is the integer
+// test of the fill rule.
+
+// Coverage of up to four triangles. Candidate c of a lane is its pixel centre
+// (px0 + (c & 3), py0 + (c >> 2)); bit 4 c + lane of `bits` says that the lane's triangle owns it.
+struct QuadCoverage {
+  static constexpr int kCandidates = 8;
+  uint32_t bits = 0;
+  unsigned large = 0;                     // lanes (bits) with more candidates: for for_each_centre()
+  // Biased E_1, E_2 per candidate and lane (and a zero row for "no candidate").
+  alignas(16) int32_t h1[kCandidates + 1][4] = {};
+  alignas(16) int32_t h2[kCandidates + 1][4] = {};
+  alignas(16) int32_t bias1[4], bias2[4];  // E_k = h_k - bias_k
+  alignas(16) int32_t px0[4], py0[4];      // first candidate per lane
+  alignas(16) int32_t shape[4];            // 2 (columns - 1) + rows - 1, or 8: no candidate
+  alignas(16) float area2[4];              // twice the area per lane
+
+  // Candidates that lane `lane` owns, as bits 4 c.
+  uint32_t owned(int lane) const {
+    // Per shape: candidates c = 4 j + i with i < columns and j < rows, as bits 4 c.
+    static constexpr uint32_t kShapes[9] = {
+        0x1,     0x10001,     0x11,   0x110011,   0x111,
+        0x1110111, 0x1111, 0x11111111, 0};
+    return (bits >> lane) & kShapes[shape[lane]];
+  }
+};
+
+inline __m128i min_epi32(__m128i a, __m128i b) {
+  const __m128i gt = _mm_cmpgt_epi32(a, b);
+  return _mm_or_si128(_mm_and_si128(gt, b), _mm_andnot_si128(gt, a));
+}
+inline __m128i max_epi32(__m128i a, __m128i b) {
+  const __m128i gt = _mm_cmpgt_epi32(a, b);
+  return _mm_or_si128(_mm_and_si128(gt, a), _mm_andnot_si128(gt, b));
+}
+
+// Covers the pixel centres in columns [0, last_x] and rows [first_y, last_y] with triangles
+// tris[0 .. n), n in 1..4 (lanes n..3 own nothing). Lanes with more than 4 x 2 candidates in
+// that window are flagged in q.large and own nothing here.
+void cover_quad(const Fixed* fixed, const Tri* tris, int n, int last_x, int first_y, int last_y,
+                QuadCoverage& q) {
+  // Corners k of the four triangles as (x, y) vectors over the lanes.
+  __m128i xs[3], ys[3];
+  for (int k = 0; k < 3; ++k) {
+    auto corner = [&](int lane) {
+      return _mm_loadl_epi64(
+          reinterpret_cast<const __m128i*>(&fixed[tris[lane < n ? lane : 0][k]]));
+    };
+    const __m128i lo = _mm_unpacklo_epi32(corner(0), corner(1));  // x0 x1 y0 y1
+    const __m128i hi = _mm_unpacklo_epi32(corner(2), corner(3));  // x2 x3 y2 y3
+    xs[k] = _mm_unpacklo_epi64(lo, hi);
+    ys[k] = _mm_unpackhi_epi64(lo, hi);
+  }
+  // Candidate range: first_centre() of the minimum, last_centre() of the maximum.
+  const __m128i cx0 = _mm_srai_epi32(
+      _mm_add_epi32(min_epi32(min_epi32(xs[0], xs[1]), xs[2]), _mm_set1_epi32(kHalf - 1)),
+      kSubpixelBits);
+  const __m128i cy0 = _mm_srai_epi32(
+      _mm_add_epi32(min_epi32(min_epi32(ys[0], ys[1]), ys[2]), _mm_set1_epi32(kHalf - 1)),
+      kSubpixelBits);
+  const __m128i cx1 = _mm_srai_epi32(
+      _mm_sub_epi32(max_epi32(max_epi32(xs[0], xs[1]), xs[2]), _mm_set1_epi32(kHalf)),
+      kSubpixelBits);
+  const __m128i cy1 = _mm_srai_epi32(
+      _mm_sub_epi32(max_epi32(max_epi32(ys[0], ys[1]), ys[2]), _mm_set1_epi32(kHalf)),
+      kSubpixelBits);
+  // Small: at most 4 x 2 candidates before clipping to the window. The triangle is then less than
+  // 5 x 3 pixels across, and its corners less than 5 pixels from any of its candidates.
+  const __m128i small =
+      _mm_and_si128(_mm_cmplt_epi32(_mm_sub_epi32(cx1, cx0), _mm_set1_epi32(4)),
+                    _mm_cmplt_epi32(_mm_sub_epi32(cy1, cy0), _mm_set1_epi32(2)));
+  const __m128i px0 = max_epi32(cx0, _mm_setzero_si128());
+  const __m128i py0 = max_epi32(cy0, _mm_set1_epi32(first_y));
+  const __m128i columns = _mm_sub_epi32(min_epi32(cx1, _mm_set1_epi32(last_x)), px0);  // - 1
+  const __m128i rows = _mm_sub_epi32(min_epi32(cy1, _mm_set1_epi32(last_y)), py0);     // - 1
+  const __m128i present = _mm_cmplt_epi32(_mm_set1_epi32(3 - n), _mm_setr_epi32(3, 2, 1, 0));
+  const __m128i any = _mm_and_si128(
+      present, _mm_cmpgt_epi32(_mm_or_si128(columns, rows), _mm_set1_epi32(-1)));
+  q.large = unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(small, any))));
+  // Shape 2 (columns - 1) + rows - 1 for the lanes drawn here, 8 (nothing) for the others.
+  const __m128i used = _mm_and_si128(small, any);
+  const __m128i shape = _mm_add_epi32(_mm_add_epi32(columns, columns), rows);
+  _mm_store_si128(reinterpret_cast<__m128i*>(q.shape),
+                  _mm_or_si128(_mm_and_si128(used, shape),
+                               _mm_andnot_si128(used, _mm_set1_epi32(8))));
+  _mm_store_si128(reinterpret_cast<__m128i*>(q.px0), px0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(q.py0), py0);
+
+  // Corners relative to the first candidate (small integers in the lanes that are used).
+  const __m128i ox = _mm_add_epi32(_mm_slli_epi32(px0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  const __m128i oy = _mm_add_epi32(_mm_slli_epi32(py0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  for (int k = 0; k < 3; ++k) {
+    xs[k] = _mm_sub_epi32(xs[k], ox);
+    ys[k] = _mm_sub_epi32(ys[k], oy);
+  }
+  // Edge k runs from corner k+1 to corner k+2; its function at the first candidate is
+  // dy_k x_{k+1} - dx_k y_{k+1} (products in float: exact below 2^24), and it steps by -dy_k per
+  // column and dx_k per row (in pixels). The fill rule's bias (TriangleSetup) is added, so a
+  // candidate is inside iff the three biased values are >= 0: iff their OR has no sign bit.
+  const __m128i ones = _mm_set1_epi32(-1), zero = _mm_setzero_si128();
+  __m128i h[3], step_x[3], step_y[3], bias[3];
+  __m128 area2 = _mm_setzero_ps();
+  for (int k = 0; k < 3; ++k) {
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    const __m128i dx = _mm_sub_epi32(xs[b], xs[a]), dy = _mm_sub_epi32(ys[b], ys[a]);
+    const __m128 e = _mm_sub_ps(_mm_mul_ps(_mm_cvtepi32_ps(dy), _mm_cvtepi32_ps(xs[a])),
+                                _mm_mul_ps(_mm_cvtepi32_ps(dx), _mm_cvtepi32_ps(ys[a])));
+    area2 = _mm_add_ps(area2, e);
+    const __m128i owns = _mm_or_si128(
+        _mm_cmpgt_epi32(dy, zero), _mm_and_si128(_mm_cmpeq_epi32(dy, zero), _mm_cmpgt_epi32(dx, zero)));
+    bias[k] = _mm_andnot_si128(owns, ones);
+    h[k] = _mm_add_epi32(_mm_cvttps_epi32(e), bias[k]);
+    step_x[k] = _mm_slli_epi32(_mm_sub_epi32(zero, dy), kSubpixelBits);
+    step_y[k] = _mm_slli_epi32(dx, kSubpixelBits);
+  }
+  _mm_store_ps(q.area2, area2);
+  _mm_store_si128(reinterpret_cast<__m128i*>(q.bias1), bias[1]);
+  _mm_store_si128(reinterpret_cast<__m128i*>(q.bias2), bias[2]);
+
+  uint32_t bits = 0;
+  for (int j = 0; j < 2; ++j) {
+    __m128i f0 = h[0], f1 = h[1], f2 = h[2];
+    for (int i = 0; i < 4; ++i) {
+      const int c = 4 * j + i;
+      const __m128i outside = _mm_or_si128(_mm_or_si128(f0, f1), f2);
+      bits |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(outside))) << (4 * c);
+      _mm_store_si128(reinterpret_cast<__m128i*>(q.h1[c]), f1);
+      _mm_store_si128(reinterpret_cast<__m128i*>(q.h2[c]), f2);
+      if (i < 3) {
+        f0 = _mm_add_epi32(f0, step_x[0]);
+        f1 = _mm_add_epi32(f1, step_x[1]);
+        f2 = _mm_add_epi32(f2, step_x[2]);
+      }
+    }
+    if (j == 0) {
+      h[0] = _mm_add_epi32(h[0], step_y[0]);
+      h[1] = _mm_add_epi32(h[1], step_y[1]);
+      h[2] = _mm_add_epi32(h[2], step_y[2]);
+    }
+  }
+  q.bits = ~bits;
+}
+#endif
+
 // The pixel centres of rows [py0, py1] x columns [px0, px1] (a non-empty range inside the
 // triangle's bounding box) that the triangle owns: visit(px, py, e1, e2). Sets t.area2.
 template <class Visit>
@@ -242,12 +393,16 @@ struct Shader {
   __m128 base = _mm_setzero_ps(), d1 = base, d2 = base;  // c0 + 0.5 (rounding), c1 - c0, c2 - c0
   float inv_area = 0;
 
-  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
-    const __m128 a = _mm_setr_ps(c0[0], c0[1], c0[2], 0.f);
+  static __m128 load_rgb(const float* c) {  // (r, g, b, 0)
+    return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(c)),
+                         _mm_load_ss(c + 2));
+  }
+  void init(const float* c0, const float* c1, const float* c2, float area2) {
+    const __m128 a = load_rgb(c0);
     base = _mm_add_ps(a, _mm_set1_ps(0.5f));
-    d1 = _mm_sub_ps(_mm_setr_ps(c1[0], c1[1], c1[2], 0.f), a);
-    d2 = _mm_sub_ps(_mm_setr_ps(c2[0], c2[1], c2[2], 0.f), a);
-    inv_area = 1.f / float(area2);
+    d1 = _mm_sub_ps(load_rgb(c1), a);
+    d2 = _mm_sub_ps(load_rgb(c2), a);
+    inv_area = 1.f / area2;
   }
   uint32_t shade(float e1, float e2) const {
     const __m128 w1 = _mm_set1_ps(e1 * inv_area), w2 = _mm_set1_ps(e2 * inv_area);
@@ -263,13 +418,13 @@ struct Shader {
   float base[3] = {}, d1[3] = {}, d2[3] = {};
   float inv_area = 0;
 
-  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
+  void init(const float* c0, const float* c1, const float* c2, float area2) {
     for (int c = 0; c < 3; ++c) {
       base[c] = c0[c] + 0.5f;
       d1[c] = c1[c] - c0[c];
       d2[c] = c2[c] - c0[c];
     }
-    inv_area = 1.f / float(area2);
+    inv_area = 1.f / area2;
   }
   uint32_t shade(float e1, float e2) const {
     const float w1 = e1 * inv_area, w2 = e2 * inv_area;
@@ -286,7 +441,7 @@ struct Shader {
 };
 
 // Sets up `shader` for triangle ti (at its first covered sample: many tiny triangles cover none).
-void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, int64_t area2) {
+void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, float area2) {
   const Tri& tc = mesh.triangle_colors[ti];
   const float* colors = mesh.colors.data();
   shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3,
@@ -453,34 +608,83 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
   const size_t stride = size_t(out.width) * kChannels;
   TriangleSetup t;
   Shader shader;
+  auto draw = [&](uint8_t* p, uint32_t rgb) {
+    p[0] = static_cast<uint8_t>(rgb);
+    p[1] = static_cast<uint8_t>(rgb >> 8);
+    p[2] = static_cast<uint8_t>(rgb >> 16);
+    if constexpr (kChannels == 4) p[3] = 255;
+  };
+  // Any triangle, through for_each_centre().
+  auto draw_triangle = [&](int32_t ti) {
+    const Tri& tri = tris[ti];
+    t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+    const int px0 = std::max(first_centre(t.min_x), 0),
+              px1 = std::min(last_centre(t.max_x), last_x);
+    const int py0 = std::max(first_centre(t.min_y), band_y0),
+              py1 = std::min(last_centre(t.max_y), last_y);
+    if ((px0 > px1) | (py0 > py1)) return;
+    bool shaded = false;
+    for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
+      if (!shaded) init_shader(shader, mesh, ti, float(t.area2)), shaded = true;
+      draw(pixels + size_t(py) * stride + size_t(px) * kChannels, shader.shade(e1, e2));
+    });
+  };
+#if defined(__SSE2__)
+  QuadCoverage q;
+  uint8_t dummy[4];
+  // Candidate c relative to the first; the last entry (no candidate) leads to `dummy`.
+  uintptr_t offsets[QuadCoverage::kCandidates + 1];
+  for (int c = 0; c < QuadCoverage::kCandidates; ++c)
+    offsets[c] = uintptr_t(c >> 2) * stride + uintptr_t(c & 3) * kChannels;
+#endif
   for (const int32_t u : units) {
     const Unit& unit = unit_data[u];
-    const bool near_unit = near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0),
-                                                     std::min(unit.y1, last_y));
-    for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
-      const Tri& tri = tris[ti];
-      t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
-      if (near_unit && f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x),
-                                         std::max(pixel_floor(t.min_y), band_y0),
-                                         std::min(pixel_floor(t.max_y), last_y))) {
-        near->push_back(ti);
+    if (near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0),
+                                  std::min(unit.y1, last_y))) {
+      for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
+        const Tri& tri = tris[ti];
+        t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+        if (f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x),
+                              std::max(pixel_floor(t.min_y), band_y0),
+                              std::min(pixel_floor(t.max_y), last_y))) {
+          near->push_back(ti);
+        }
       }
-      const int px0 = std::max(first_centre(t.min_x), 0),
-                px1 = std::min(last_centre(t.max_x), last_x);
-      const int py0 = std::max(first_centre(t.min_y), band_y0),
-                py1 = std::min(last_centre(t.max_y), last_y);
-      if ((px0 > px1) | (py0 > py1)) continue;
-      bool shaded = false;
-      for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
-        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
-        const uint32_t rgb = shader.shade(e1, e2);
-        uint8_t* p = pixels + size_t(py) * stride + size_t(px) * kChannels;
-        p[0] = static_cast<uint8_t>(rgb);
-        p[1] = static_cast<uint8_t>(rgb >> 8);
-        p[2] = static_cast<uint8_t>(rgb >> 16);
-        if constexpr (kChannels == 4) p[3] = 255;
-      });
     }
+#if defined(__SSE2__)
+    for (int32_t ti = unit.begin; ti < unit.end; ti += 4) {
+      const int n = std::min(4, unit.end - ti);
+      cover_quad(f.fixed, tris + ti, n, last_x, band_y0, last_y, q);
+      for (int lane = 0; lane < n; ++lane) {
+        if ((q.large >> lane) & 1) {
+          draw_triangle(ti + lane);
+          continue;
+        }
+        // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first two are drawn
+        // without branches (a missing one, candidate 8, to a dummy pixel), only the rare others
+        // in a loop.
+        uint64_t owned = q.owned(lane);
+        init_shader(shader, mesh, ti + lane, q.area2[lane]);
+        // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
+        const uintptr_t origin = uintptr_t(pixels) + uintptr_t(q.py0[lane]) * stride +
+                                 uintptr_t(q.px0[lane]) * kChannels;
+        offsets[QuadCoverage::kCandidates] = uintptr_t(dummy) - origin;
+        const int32_t b1 = q.bias1[lane], b2 = q.bias2[lane];
+        auto draw_candidate = [&](int bit) {  // bit 4 c
+          const int c = bit >> 2;
+          draw(reinterpret_cast<uint8_t*>(origin + offsets[c]),
+               shader.shade(float(q.h1[c][lane] - b1), float(q.h2[c][lane] - b2)));
+        };
+        draw_candidate(std::countr_zero(owned | uint64_t{1} << 32));
+        owned &= owned - 1;
+        draw_candidate(std::countr_zero(owned | uint64_t{1} << 32));
+        owned &= owned - 1;
+        for (; owned; owned &= owned - 1) draw_candidate(std::countr_zero(owned));
+      }
+    }
+#else
+    for (int32_t ti = unit.begin; ti < unit.end; ++ti) draw_triangle(ti);
+#endif
   }
 }
 
@@ -502,7 +706,7 @@ void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int ban
     bool shaded = false;
     marks.for_each_marked(ax0, ax1, ay0, ay1, [&](int px, int py, uint32_t* samples) {
       for_each_subsample(t, px, py, [&](int k, float e1, float e2) {
-        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
+        if (!shaded) init_shader(shader, mesh, ti, float(t.area2)), shaded = true;
         samples[k] = shader.shade(e1, e2) | 0xff000000u;
       });
     });
@@ -762,18 +966,38 @@ std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransfor
   snap_vertices(mesh, view, 1, fixed);
   std::vector<int32_t> counts(size_t(width) * height * (subsamples ? kSubsamples : 1), 0);
   TriangleSetup t;
+  auto count_centres = [&](const Tri& tri) {
+    t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
+    const int px0 = std::max(first_centre(t.min_x), 0),
+              px1 = std::min(last_centre(t.max_x), width - 1);
+    const int py0 = std::max(first_centre(t.min_y), 0),
+              py1 = std::min(last_centre(t.max_y), height - 1);
+    if (px0 > px1 || py0 > py1) return;
+    for_each_centre(t, px0, px1, py0, py1,
+                    [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
+  };
+  if (!subsamples) {  // the traversal of draw_centres()
+    const Tri* tris = mesh.triangles.data();
+    for (int ti = 0; ti < mesh.num_triangles(); ti += 4) {
+      const int n = std::min(4, mesh.num_triangles() - ti);
+#if defined(__SSE2__)
+      QuadCoverage q;
+      cover_quad(fixed.data(), tris + ti, n, width - 1, 0, height - 1, q);
+      for (int lane = 0; lane < n; ++lane) {
+        if ((q.large >> lane) & 1) count_centres(tris[ti + lane]);
+        for (uint32_t owned = q.owned(lane); owned; owned &= owned - 1) {
+          const int c = std::countr_zero(owned) >> 2;
+          ++counts[size_t(q.py0[lane] + (c >> 2)) * width + size_t(q.px0[lane] + (c & 3))];
+        }
+      }
+#else
+      for (int lane = 0; lane < n; ++lane) count_centres(tris[ti + lane]);
+#endif
+    }
+    return counts;
+  }
   for (const Tri& tri : mesh.triangles) {
     t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
-    if (!subsamples) {
-      const int px0 = std::max(first_centre(t.min_x), 0),
-                px1 = std::min(last_centre(t.max_x), width - 1);
-      const int py0 = std::max(first_centre(t.min_y), 0),
-                py1 = std::min(last_centre(t.max_y), height - 1);
-      if (px0 > px1 || py0 > py1) continue;
-      for_each_centre(t, px0, px1, py0, py1,
-                      [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
-      continue;
-    }
     if (!t.init_edges()) continue;
     const int ax0 = std::max(pixel_floor(t.min_x), 0),
               ax1 = std::min(pixel_floor(t.max_x), width - 1);
