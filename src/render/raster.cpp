@@ -140,58 +140,77 @@ bool is_small(const TriangleSetup& t) {
 
 #if defined(__SSE2__)
 // ---- Small triangles, four at a time ------------------------------------------------------------
-// Most refined triangles have at most 4 x 2 candidate pixel centres (1-3 pixel edges), and their
-// cost is the per-triangle setup, so these are tested four triangles at a time with one triangle
-// per SSE2 lane: gather, candidate range, edge functions and the test of all 8 candidates run as
-// vector code without branches. Relative to its first candidate centre, such a triangle's corners
-// are below 5 pixels (2^11 fixed-point units) away, so its edge functions at the candidates are
-// integers below 2^24 in magnitude and float lanes compute them exactly: the test is the integer
-// test of the fill rule.
+// Nearly all refined triangles have at most 4 x 2 candidate pixel centres (1-3 pixel edges), and
+// their cost is the per-triangle work, so these run four at a time with one triangle per SSE2
+// lane: gather, candidate range, edge functions, the fill-rule test of all 8 candidates, the choice
+// of the owned ones and the shading of the first two, without data-dependent branches. Relative
+// to its first candidate centre, such a triangle's corners are less than 5 pixels (2^11 fixed-point
+// units) away, so its edge functions at the candidates are integers below 2^24 in magnitude:
+// exact in int32 lanes and in float lanes alike, so the test is the integer test of the fill rule
+// and the shading gets the same floats as Shader::shade() does.
 
-// Coverage of up to four triangles. Candidate c of a lane is its pixel centre
-// (px0 + (c & 3), py0 + (c >> 2)); bit 4 c + lane of `bits` says that the lane's triangle owns it.
+// Coverage of four triangles, one per lane. Candidate c = 4 j + i (i < 4, j < 2) of a lane is its
+// pixel centre (px0 + i, py0 + j).
 struct QuadCoverage {
-  static constexpr int kCandidates = 8;
-  uint32_t bits = 0;
-  unsigned large = 0;                     // lanes (bits) with more candidates: for for_each_centre()
-  // Biased E_1, E_2 per candidate and lane (and a zero row for "no candidate").
-  alignas(16) int32_t h1[kCandidates + 1][4] = {};
-  alignas(16) int32_t h2[kCandidates + 1][4] = {};
-  alignas(16) int32_t bias1[4], bias2[4];  // E_k = h_k - bias_k
-  alignas(16) int32_t px0[4], py0[4];      // first candidate per lane
-  alignas(16) int32_t shape[4];            // 2 (columns - 1) + rows - 1, or 8: no candidate
-  alignas(16) float area2[4];              // twice the area per lane
+  static constexpr int kNone = 8;  // candidate index meaning "none"
+  __m128i owned;                   // per lane: bit c set for each owned candidate
+  __m128i px0, py0;                // first candidate per lane
+  __m128 e1, e2;                   // unbiased E_1, E_2 at the first candidate
+  __m128 e1_x, e1_y, e2_x, e2_y;   // their steps per column and per row
+  __m128 area2;                    // twice the area
+  unsigned large;                  // lanes (bits) with more candidates: for for_each_centre()
 
-  // Candidates that lane `lane` owns, as bits 4 c.
-  uint32_t owned(int lane) const {
-    // Per shape: candidates c = 4 j + i with i < columns and j < rows, as bits 4 c.
-    static constexpr uint32_t kShapes[9] = {
-        0x1,     0x10001,     0x11,   0x110011,   0x111,
-        0x1110111, 0x1111, 0x11111111, 0};
-    return (bits >> lane) & kShapes[shape[lane]];
+  // E_1 and E_2 at candidate c of every lane (any finite value for kNone).
+  void edges_at(__m128i c, __m128& f1, __m128& f2) const {
+    const __m128 i = _mm_cvtepi32_ps(_mm_and_si128(c, _mm_set1_epi32(3)));
+    const __m128 j = _mm_cvtepi32_ps(_mm_srli_epi32(c, 2));
+    f1 = _mm_add_ps(_mm_add_ps(e1, _mm_mul_ps(i, e1_x)), _mm_mul_ps(j, e1_y));
+    f2 = _mm_add_ps(_mm_add_ps(e2, _mm_mul_ps(i, e2_x)), _mm_mul_ps(j, e2_y));
   }
 };
 
+template <class T>
+T lane_of(__m128i v, int lane) {
+  alignas(16) T a[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(a), v);
+  return a[lane];
+}
+inline float lane_of(__m128 v, int lane) {
+  alignas(16) float a[4];
+  _mm_store_ps(a, v);
+  return a[lane];
+}
+
+// min and max of int32 lanes whose difference is below 2^31 (SSE2 has neither).
 inline __m128i min_epi32(__m128i a, __m128i b) {
-  const __m128i gt = _mm_cmpgt_epi32(a, b);
-  return _mm_or_si128(_mm_and_si128(gt, b), _mm_andnot_si128(gt, a));
+  const __m128i d = _mm_sub_epi32(a, b);
+  return _mm_add_epi32(b, _mm_and_si128(d, _mm_srai_epi32(d, 31)));
 }
 inline __m128i max_epi32(__m128i a, __m128i b) {
-  const __m128i gt = _mm_cmpgt_epi32(a, b);
-  return _mm_or_si128(_mm_and_si128(gt, a), _mm_andnot_si128(gt, b));
+  const __m128i d = _mm_sub_epi32(a, b);
+  return _mm_sub_epi32(a, _mm_and_si128(d, _mm_srai_epi32(d, 31)));
+}
+
+// Index of the lowest set bit of each lane (lanes of at most 24 bits, not zero): the exponent of
+// the lowest bit converted to float.
+inline __m128i lowest_bit(__m128i v) {
+  const __m128i low = _mm_and_si128(v, _mm_sub_epi32(_mm_setzero_si128(), v));
+  return _mm_sub_epi32(_mm_srli_epi32(_mm_castps_si128(_mm_cvtepi32_ps(low)), 23),
+                       _mm_set1_epi32(127));
 }
 
 // Covers the pixel centres in columns [0, last_x] and rows [first_y, last_y] with triangles
-// tris[0 .. n), n in 1..4 (lanes n..3 own nothing). Lanes with more than 4 x 2 candidates in
-// that window are flagged in q.large and own nothing here.
-void cover_quad(const Fixed* fixed, const Tri* tris, int n, int last_x, int first_y, int last_y,
-                QuadCoverage& q) {
+// tris[0 .. 4), of which the first n in 1..4 count (lanes n..3 own nothing). Lanes with more than
+// 4 x 2 candidates in that window are flagged in q.large and own nothing here. Coordinates are
+// within the +-2^29 guard band of to_fixed(), so differences fit in int32.
+[[gnu::always_inline]] inline void cover_quad(const Fixed* fixed, const Tri* tris, int n,
+                                              int last_x, int first_y, int last_y,
+                                              QuadCoverage& q) {
   // Corners k of the four triangles as (x, y) vectors over the lanes.
   __m128i xs[3], ys[3];
   for (int k = 0; k < 3; ++k) {
     auto corner = [&](int lane) {
-      return _mm_loadl_epi64(
-          reinterpret_cast<const __m128i*>(&fixed[tris[lane < n ? lane : 0][k]]));
+      return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(&fixed[tris[lane][k]]));
     };
     const __m128i lo = _mm_unpacklo_epi32(corner(0), corner(1));  // x0 x1 y0 y1
     const __m128i hi = _mm_unpacklo_epi32(corner(2), corner(3));  // x2 x3 y2 y3
@@ -199,80 +218,77 @@ void cover_quad(const Fixed* fixed, const Tri* tris, int n, int last_x, int firs
     ys[k] = _mm_unpackhi_epi64(lo, hi);
   }
   // Candidate range: first_centre() of the minimum, last_centre() of the maximum.
-  const __m128i cx0 = _mm_srai_epi32(
-      _mm_add_epi32(min_epi32(min_epi32(xs[0], xs[1]), xs[2]), _mm_set1_epi32(kHalf - 1)),
-      kSubpixelBits);
-  const __m128i cy0 = _mm_srai_epi32(
-      _mm_add_epi32(min_epi32(min_epi32(ys[0], ys[1]), ys[2]), _mm_set1_epi32(kHalf - 1)),
-      kSubpixelBits);
-  const __m128i cx1 = _mm_srai_epi32(
-      _mm_sub_epi32(max_epi32(max_epi32(xs[0], xs[1]), xs[2]), _mm_set1_epi32(kHalf)),
-      kSubpixelBits);
-  const __m128i cy1 = _mm_srai_epi32(
-      _mm_sub_epi32(max_epi32(max_epi32(ys[0], ys[1]), ys[2]), _mm_set1_epi32(kHalf)),
-      kSubpixelBits);
+  auto first = [](const __m128i* v) {
+    return _mm_srai_epi32(
+        _mm_add_epi32(min_epi32(min_epi32(v[0], v[1]), v[2]), _mm_set1_epi32(kHalf - 1)),
+        kSubpixelBits);
+  };
+  auto last = [](const __m128i* v) {
+    return _mm_srai_epi32(
+        _mm_sub_epi32(max_epi32(max_epi32(v[0], v[1]), v[2]), _mm_set1_epi32(kHalf)),
+        kSubpixelBits);
+  };
+  const __m128i cx0 = first(xs), cx1 = last(xs), cy0 = first(ys), cy1 = last(ys);
   // Small: at most 4 x 2 candidates before clipping to the window. The triangle is then less than
   // 5 x 3 pixels across, and its corners less than 5 pixels from any of its candidates.
   const __m128i small =
       _mm_and_si128(_mm_cmplt_epi32(_mm_sub_epi32(cx1, cx0), _mm_set1_epi32(4)),
                     _mm_cmplt_epi32(_mm_sub_epi32(cy1, cy0), _mm_set1_epi32(2)));
-  const __m128i px0 = max_epi32(cx0, _mm_setzero_si128());
-  const __m128i py0 = max_epi32(cy0, _mm_set1_epi32(first_y));
-  const __m128i columns = _mm_sub_epi32(min_epi32(cx1, _mm_set1_epi32(last_x)), px0);  // - 1
-  const __m128i rows = _mm_sub_epi32(min_epi32(cy1, _mm_set1_epi32(last_y)), py0);     // - 1
+  q.px0 = max_epi32(cx0, _mm_setzero_si128());
+  q.py0 = max_epi32(cy0, _mm_set1_epi32(first_y));
+  const __m128i columns = _mm_sub_epi32(min_epi32(cx1, _mm_set1_epi32(last_x)), q.px0);  // - 1
+  const __m128i rows = _mm_sub_epi32(min_epi32(cy1, _mm_set1_epi32(last_y)), q.py0);     // - 1
   const __m128i present = _mm_cmplt_epi32(_mm_set1_epi32(3 - n), _mm_setr_epi32(3, 2, 1, 0));
   const __m128i any = _mm_and_si128(
       present, _mm_cmpgt_epi32(_mm_or_si128(columns, rows), _mm_set1_epi32(-1)));
   q.large = unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(small, any))));
-  // Shape 2 (columns - 1) + rows - 1 for the lanes drawn here, 8 (nothing) for the others.
-  const __m128i used = _mm_and_si128(small, any);
-  const __m128i shape = _mm_add_epi32(_mm_add_epi32(columns, columns), rows);
-  _mm_store_si128(reinterpret_cast<__m128i*>(q.shape),
-                  _mm_or_si128(_mm_and_si128(used, shape),
-                               _mm_andnot_si128(used, _mm_set1_epi32(8))));
-  _mm_store_si128(reinterpret_cast<__m128i*>(q.px0), px0);
-  _mm_store_si128(reinterpret_cast<__m128i*>(q.py0), py0);
+  // The candidates in the clipped range, in the lanes drawn here: 2^(columns + 1) - 1 (from the
+  // exponent of a float) in row 0, the same in row 1 if there are two rows.
+  const __m128i row_bits = _mm_sub_epi32(
+      _mm_cvttps_epi32(_mm_castsi128_ps(
+          _mm_slli_epi32(_mm_add_epi32(columns, _mm_set1_epi32(128)), 23))),
+      _mm_set1_epi32(1));
+  const __m128i valid = _mm_and_si128(
+      _mm_and_si128(small, any),
+      _mm_or_si128(row_bits, _mm_and_si128(_mm_slli_epi32(row_bits, 4),
+                                           _mm_cmpgt_epi32(rows, _mm_setzero_si128()))));
 
   // Corners relative to the first candidate (small integers in the lanes that are used).
-  const __m128i ox = _mm_add_epi32(_mm_slli_epi32(px0, kSubpixelBits), _mm_set1_epi32(kHalf));
-  const __m128i oy = _mm_add_epi32(_mm_slli_epi32(py0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  const __m128i ox = _mm_add_epi32(_mm_slli_epi32(q.px0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  const __m128i oy = _mm_add_epi32(_mm_slli_epi32(q.py0, kSubpixelBits), _mm_set1_epi32(kHalf));
   for (int k = 0; k < 3; ++k) {
     xs[k] = _mm_sub_epi32(xs[k], ox);
     ys[k] = _mm_sub_epi32(ys[k], oy);
   }
   // Edge k runs from corner k+1 to corner k+2; its function at the first candidate is
-  // dy_k x_{k+1} - dx_k y_{k+1} (products in float: exact below 2^24), and it steps by -dy_k per
-  // column and dx_k per row (in pixels). The fill rule's bias (TriangleSetup) is added, so a
-  // candidate is inside iff the three biased values are >= 0: iff their OR has no sign bit.
-  const __m128i ones = _mm_set1_epi32(-1), zero = _mm_setzero_si128();
-  __m128i h[3], step_x[3], step_y[3], bias[3];
-  __m128 area2 = _mm_setzero_ps();
+  // dy_k x_{k+1} - dx_k y_{k+1} (products in float: exact), and it steps by -dy_k per column and
+  // dx_k per row (in pixels). With the fill rule's bias (TriangleSetup) added, a candidate is inside
+  // iff the three biased values are >= 0: iff their OR has no sign bit.
+  const __m128i zero = _mm_setzero_si128();
+  __m128i h[3], step_x[3], step_y[3];
+  __m128 e[3];
   for (int k = 0; k < 3; ++k) {
     const int a = (k + 1) % 3, b = (k + 2) % 3;
     const __m128i dx = _mm_sub_epi32(xs[b], xs[a]), dy = _mm_sub_epi32(ys[b], ys[a]);
-    const __m128 e = _mm_sub_ps(_mm_mul_ps(_mm_cvtepi32_ps(dy), _mm_cvtepi32_ps(xs[a])),
-                                _mm_mul_ps(_mm_cvtepi32_ps(dx), _mm_cvtepi32_ps(ys[a])));
-    area2 = _mm_add_ps(area2, e);
+    e[k] = _mm_sub_ps(_mm_mul_ps(_mm_cvtepi32_ps(dy), _mm_cvtepi32_ps(xs[a])),
+                      _mm_mul_ps(_mm_cvtepi32_ps(dx), _mm_cvtepi32_ps(ys[a])));
     const __m128i owns = _mm_or_si128(
         _mm_cmpgt_epi32(dy, zero), _mm_and_si128(_mm_cmpeq_epi32(dy, zero), _mm_cmpgt_epi32(dx, zero)));
-    bias[k] = _mm_andnot_si128(owns, ones);
-    h[k] = _mm_add_epi32(_mm_cvttps_epi32(e), bias[k]);
+    h[k] = _mm_add_epi32(_mm_cvttps_epi32(e[k]), _mm_andnot_si128(owns, _mm_set1_epi32(-1)));
     step_x[k] = _mm_slli_epi32(_mm_sub_epi32(zero, dy), kSubpixelBits);
     step_y[k] = _mm_slli_epi32(dx, kSubpixelBits);
   }
-  _mm_store_ps(q.area2, area2);
-  _mm_store_si128(reinterpret_cast<__m128i*>(q.bias1), bias[1]);
-  _mm_store_si128(reinterpret_cast<__m128i*>(q.bias2), bias[2]);
+  q.e1 = e[1], q.e2 = e[2];
+  q.e1_x = _mm_cvtepi32_ps(step_x[1]), q.e1_y = _mm_cvtepi32_ps(step_y[1]);
+  q.e2_x = _mm_cvtepi32_ps(step_x[2]), q.e2_y = _mm_cvtepi32_ps(step_y[2]);
+  q.area2 = _mm_add_ps(_mm_add_ps(e[0], e[1]), e[2]);
 
-  uint32_t bits = 0;
+  __m128i owned = zero;
   for (int j = 0; j < 2; ++j) {
     __m128i f0 = h[0], f1 = h[1], f2 = h[2];
     for (int i = 0; i < 4; ++i) {
-      const int c = 4 * j + i;
-      const __m128i outside = _mm_or_si128(_mm_or_si128(f0, f1), f2);
-      bits |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(outside))) << (4 * c);
-      _mm_store_si128(reinterpret_cast<__m128i*>(q.h1[c]), f1);
-      _mm_store_si128(reinterpret_cast<__m128i*>(q.h2[c]), f2);
+      const __m128i outside = _mm_srai_epi32(_mm_or_si128(_mm_or_si128(f0, f1), f2), 31);
+      owned = _mm_or_si128(owned, _mm_andnot_si128(outside, _mm_set1_epi32(1 << (4 * j + i))));
       if (i < 3) {
         f0 = _mm_add_epi32(f0, step_x[0]);
         f1 = _mm_add_epi32(f1, step_x[1]);
@@ -285,7 +301,7 @@ void cover_quad(const Fixed* fixed, const Tri* tris, int n, int last_x, int firs
       h[2] = _mm_add_epi32(h[2], step_y[2]);
     }
   }
-  q.bits = ~bits;
+  q.owned = _mm_and_si128(owned, valid);
 }
 #endif
 
@@ -447,6 +463,45 @@ void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, float area
   shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3,
               area2);
 }
+
+#if defined(__SSE2__)
+// The Gouraud colors of candidates c[r] (any color for kNone) of the four lanes of `q`, packed as
+// Shader::shade() packs them and computed with the same operations in the same order, so they
+// are the same bytes; the four triangles share the vector instructions. `corners`: the color
+// indices of the four triangles.
+template <int kRounds>
+[[gnu::always_inline]] inline void shade_quad(const float* colors, const Tri* corners,
+                                              const QuadCoverage& q, const __m128i (&c)[kRounds],
+                                              __m128i (&rgb)[kRounds]) {
+  __m128 base[3], d1[3], d2[3];  // per channel, over the lanes
+  {
+    __m128 v[3][4];  // corner k: (r, g, b, 0) per lane, then transposed to r, g, b, 0
+    for (int k = 0; k < 3; ++k) {
+      for (int lane = 0; lane < 4; ++lane)
+        v[k][lane] = Shader::load_rgb(colors + size_t(corners[lane][k]) * 3);
+      _MM_TRANSPOSE4_PS(v[k][0], v[k][1], v[k][2], v[k][3]);
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+      base[ch] = _mm_add_ps(v[0][ch], _mm_set1_ps(0.5f));
+      d1[ch] = _mm_sub_ps(v[1][ch], v[0][ch]);
+      d2[ch] = _mm_sub_ps(v[2][ch], v[0][ch]);
+    }
+  }
+  const __m128 inv_area = _mm_div_ps(_mm_set1_ps(1.f), q.area2);
+  for (int r = 0; r < kRounds; ++r) {
+    __m128 e1, e2;
+    q.edges_at(c[r], e1, e2);
+    const __m128 w1 = _mm_mul_ps(e1, inv_area), w2 = _mm_mul_ps(e2, inv_area);
+    __m128i packed = _mm_setzero_si128();
+    for (int ch = 0; ch < 3; ++ch) {
+      __m128 v = _mm_add_ps(base[ch], _mm_add_ps(_mm_mul_ps(w1, d1[ch]), _mm_mul_ps(w2, d2[ch])));
+      v = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(255.25f));
+      packed = _mm_or_si128(packed, _mm_slli_epi32(_mm_cvttps_epi32(v), 8 * ch));
+    }
+    rgb[r] = packed;
+  }
+}
+#endif
 
 // ---- Pixels marked for supersampling ----------------------------------------------------------
 
@@ -632,9 +687,9 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
 #if defined(__SSE2__)
   QuadCoverage q;
   uint8_t dummy[4];
-  // Candidate c relative to the first; the last entry (no candidate) leads to `dummy`.
-  uintptr_t offsets[QuadCoverage::kCandidates + 1];
-  for (int c = 0; c < QuadCoverage::kCandidates; ++c)
+  // Candidate c relative to the first; the last entry (kNone) leads to `dummy`.
+  uintptr_t offsets[QuadCoverage::kNone + 1];
+  for (int c = 0; c < QuadCoverage::kNone; ++c)
     offsets[c] = uintptr_t(c >> 2) * stride + uintptr_t(c & 3) * kChannels;
 #endif
   for (const int32_t u : units) {
@@ -654,32 +709,71 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
 #if defined(__SSE2__)
     for (int32_t ti = unit.begin; ti < unit.end; ti += 4) {
       const int n = std::min(4, unit.end - ti);
-      cover_quad(f.fixed, tris + ti, n, last_x, band_y0, last_y, q);
-      for (int lane = 0; lane < n; ++lane) {
-        if ((q.large >> lane) & 1) {
-          draw_triangle(ti + lane);
-          continue;
+      const Tri* quad = tris + ti;
+      const Tri* quad_colors = mesh.triangle_colors.data() + ti;
+      Tri tail[4], tail_colors[4];
+      if (n < 4) {  // pad with the first triangle
+        for (int lane = 0; lane < 4; ++lane) {
+          tail[lane] = quad[lane < n ? lane : 0];
+          tail_colors[lane] = quad_colors[lane < n ? lane : 0];
         }
-        // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first two are drawn
-        // without branches (a missing one, candidate 8, to a dummy pixel), only the rare others
-        // in a loop.
-        uint64_t owned = q.owned(lane);
-        init_shader(shader, mesh, ti + lane, q.area2[lane]);
+        quad = tail;
+        quad_colors = tail_colors;
+      }
+      cover_quad(f.fixed, quad, n, last_x, band_y0, last_y, q);
+      // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first two are shaded and
+      // drawn without branches (a missing one, kNone, to a dummy pixel), only the rare others
+      // one by one.
+      const __m128i none = _mm_set1_epi32(1 << QuadCoverage::kNone);
+      const __m128i second = _mm_and_si128(q.owned, _mm_sub_epi32(q.owned, _mm_set1_epi32(1)));
+      const __m128i which[2] = {lowest_bit(_mm_or_si128(q.owned, none)),
+                                lowest_bit(_mm_or_si128(second, none))};
+      __m128i rgb_v[2];
+      shade_quad<2>(mesh.colors.data(), quad_colors, q, which, rgb_v);
+      const __m128i rest = _mm_and_si128(second, _mm_sub_epi32(second, _mm_set1_epi32(1)));
+      const unsigned more = ~unsigned(_mm_movemask_ps(
+                                _mm_castsi128_ps(_mm_cmpeq_epi32(rest, _mm_setzero_si128())))) &
+                            0xfu;
+      alignas(16) int32_t px0[4], py0[4], c0[4], c1[4];
+      alignas(16) uint32_t rgb0[4], rgb1[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(px0), q.px0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(py0), q.py0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(c0), which[0]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(c1), which[1]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(rgb0), rgb_v[0]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(rgb1), rgb_v[1]);
+      auto draw_lane = [&](int lane) {
         // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
-        const uintptr_t origin = uintptr_t(pixels) + uintptr_t(q.py0[lane]) * stride +
-                                 uintptr_t(q.px0[lane]) * kChannels;
-        offsets[QuadCoverage::kCandidates] = uintptr_t(dummy) - origin;
-        const int32_t b1 = q.bias1[lane], b2 = q.bias2[lane];
-        auto draw_candidate = [&](int bit) {  // bit 4 c
-          const int c = bit >> 2;
-          draw(reinterpret_cast<uint8_t*>(origin + offsets[c]),
-               shader.shade(float(q.h1[c][lane] - b1), float(q.h2[c][lane] - b2)));
-        };
-        draw_candidate(std::countr_zero(owned | uint64_t{1} << 32));
-        owned &= owned - 1;
-        draw_candidate(std::countr_zero(owned | uint64_t{1} << 32));
-        owned &= owned - 1;
-        for (; owned; owned &= owned - 1) draw_candidate(std::countr_zero(owned));
+        const uintptr_t origin = uintptr_t(pixels) + uintptr_t(py0[lane]) * stride +
+                                 uintptr_t(px0[lane]) * kChannels;
+        offsets[QuadCoverage::kNone] = uintptr_t(dummy) - origin;
+        draw(reinterpret_cast<uint8_t*>(origin + offsets[c0[lane]]), rgb0[lane]);
+        draw(reinterpret_cast<uint8_t*>(origin + offsets[c1[lane]]), rgb1[lane]);
+      };
+      if ((n == 4) & (q.large == 0)) {
+        draw_lane(0), draw_lane(1), draw_lane(2), draw_lane(3);
+      } else {
+        for (int lane = 0; lane < n; ++lane) {
+          if ((q.large >> lane) & 1) {
+            draw_triangle(ti + lane);
+          } else {
+            draw_lane(lane);
+          }
+        }
+      }
+      for (unsigned lanes = more; lanes; lanes &= lanes - 1) {  // owning 3 or more
+        const int lane = std::countr_zero(lanes);
+        init_shader(shader, mesh, ti + lane, lane_of(q.area2, lane));
+        const float e1 = lane_of(q.e1, lane), e1_x = lane_of(q.e1_x, lane),
+                    e1_y = lane_of(q.e1_y, lane), e2 = lane_of(q.e2, lane),
+                    e2_x = lane_of(q.e2_x, lane), e2_y = lane_of(q.e2_y, lane);
+        for (uint32_t owned = lane_of<uint32_t>(rest, lane); owned; owned &= owned - 1) {
+          const int c = std::countr_zero(owned);
+          const float i = float(c & 3), j = float(c >> 2);
+          draw(pixels + size_t(py0[lane] + (c >> 2)) * stride +
+                   size_t(px0[lane] + (c & 3)) * kChannels,
+               shader.shade(e1 + i * e1_x + j * e1_y, e2 + i * e2_x + j * e2_y));
+        }
       }
     }
 #else
@@ -851,11 +945,11 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
 void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                     std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out) {
   const int width = view.width, height = view.height, threads = std::max(options.threads, 1);
-  if (out.width != width || out.height != height || out.channels != options.channels) {
-    out = Image8(width, height, options.channels);
-  } else {
-    std::fill(out.pixels.begin(), out.pixels.end(), uint8_t{0});
-  }
+  // A reused frame is cleared band by band just before the band is drawn, so that the drawing
+  // finds its rows in cache (clearing a 4K frame up front costs a cache miss per line later).
+  const bool reused =
+      out.width == width && out.height == height && out.channels == options.channels;
+  if (!reused) out = Image8(width, height, options.channels);
   RasterScratch local;
   RasterScratch& work = scratch ? *scratch : local;
   Frame f{&mesh, nullptr, width, height, nullptr};
@@ -937,6 +1031,7 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   parallel_for(num_bands, threads, [&](int job) {
     const int band = order[job].second;
     const int y0 = band * band_h, y1 = std::min(height, y0 + band_h);
+    if (reused) std::fill(out.row(y0), out.row(y0) + size_t(y1 - y0) * width * out.channels, 0);
     const std::span<const int32_t> list(work.binned.data() + work.band_begin[band],
                                         work.binned.data() + work.band_begin[band + 1]);
     thread_local std::vector<int32_t> near_list;
@@ -981,13 +1076,16 @@ std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransfor
     for (int ti = 0; ti < mesh.num_triangles(); ti += 4) {
       const int n = std::min(4, mesh.num_triangles() - ti);
 #if defined(__SSE2__)
+      Tri quad[4];
+      for (int lane = 0; lane < 4; ++lane) quad[lane] = tris[ti + (lane < n ? lane : 0)];
       QuadCoverage q;
-      cover_quad(fixed.data(), tris + ti, n, width - 1, 0, height - 1, q);
+      cover_quad(fixed.data(), quad, n, width - 1, 0, height - 1, q);
       for (int lane = 0; lane < n; ++lane) {
         if ((q.large >> lane) & 1) count_centres(tris[ti + lane]);
-        for (uint32_t owned = q.owned(lane); owned; owned &= owned - 1) {
-          const int c = std::countr_zero(owned) >> 2;
-          ++counts[size_t(q.py0[lane] + (c >> 2)) * width + size_t(q.px0[lane] + (c & 3))];
+        const int px0 = lane_of<int32_t>(q.px0, lane), py0 = lane_of<int32_t>(q.py0, lane);
+        for (uint32_t owned = lane_of<uint32_t>(q.owned, lane); owned; owned &= owned - 1) {
+          const int c = std::countr_zero(owned);
+          ++counts[size_t(py0 + (c >> 2)) * width + size_t(px0 + (c & 3))];
         }
       }
 #else
