@@ -37,7 +37,8 @@ constexpr int64_t kSubOffset = kSubStep / 2;
 constexpr int kTileBits = 3;
 constexpr int kTile = 1 << kTileBits;
 
-int32_t to_fixed(double v) {
+// Output pixels to fixed point (snap_range() does the same two coordinates at a time).
+[[maybe_unused]] int32_t to_fixed(double v) {
   v *= double(kOne);
   v = v > -kGuard ? v : -kGuard;  // also maps NaN to the guard band
   v = v < kGuard ? v : kGuard;
@@ -872,18 +873,41 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
 
 // ---- Frame setup -------------------------------------------------------------------------------
 
+// Snaps vertices [begin, end) to fixed point: to_fixed(view.to_output(...)), two at a time.
+void snap_range(const RefinedMesh& mesh, const ViewTransform& view, int begin, int end,
+                Fixed* fixed) {
+  const float* positions = mesh.positions.data();
+#if defined(__SSE2__)
+  // The same double operations as to_output() and to_fixed(), with x and y in the two lanes:
+  // max() and min() are the clamps (NaN, the first operand, goes to the lower bound) and the
+  // biased value truncates to int32 (it lies in [0.5, 2^30 + 0.5]).
+  const __m128d origin = _mm_setr_pd(view.x0, view.y0), scale = _mm_setr_pd(view.sx, view.sy);
+  const __m128d one = _mm_set1_pd(double(kOne)), lo = _mm_set1_pd(-kGuard),
+                hi = _mm_set1_pd(kGuard), bias = _mm_set1_pd(kGuard + 0.5);
+  const __m128i guard = _mm_set1_epi32(static_cast<int32_t>(kGuard));
+  for (int i = begin; i < end; ++i) {
+    const __m128 p =
+        _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(positions + 2 * size_t(i)));
+    __m128d v = _mm_mul_pd(_mm_mul_pd(_mm_sub_pd(_mm_cvtps_pd(p), origin), scale), one);
+    v = _mm_add_pd(_mm_min_pd(_mm_max_pd(v, lo), hi), bias);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(fixed + i),
+                     _mm_sub_epi32(_mm_cvttpd_epi32(v), guard));
+  }
+#else
+  for (int i = begin; i < end; ++i) {
+    const auto o = view.to_output(positions[2 * size_t(i)], positions[2 * size_t(i) + 1]);
+    fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
+  }
+#endif
+}
+
 void snap_vertices(const RefinedMesh& mesh, const ViewTransform& view, int threads,
                    std::vector<Fixed>& fixed) {
   const int n = mesh.num_vertices();
   fixed.resize(n);
   constexpr int kChunk = 1 << 16;
   parallel_for((n + kChunk - 1) / kChunk, threads, [&](int chunk) {
-    const int end = std::min(n, (chunk + 1) * kChunk);
-    for (int i = chunk * kChunk; i < end; ++i) {
-      const auto o =
-          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
-      fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
-    }
+    snap_range(mesh, view, chunk * kChunk, std::min(n, (chunk + 1) * kChunk), fixed.data());
   });
 }
 
@@ -974,12 +998,8 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   };
   parallel_for(vertex_jobs + (given ? unit_jobs : 0), threads, [&](int job) {
     if (job >= vertex_jobs) return bound_units(job - vertex_jobs);
-    const int end = std::min(num_vertices, (job + 1) * kVerticesPerJob);
-    for (int i = job * kVerticesPerJob; i < end; ++i) {
-      const auto o =
-          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
-      work.fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
-    }
+    snap_range(mesh, view, job * kVerticesPerJob,
+               std::min(num_vertices, (job + 1) * kVerticesPerJob), work.fixed.data());
   });
   if (!given) parallel_for(unit_jobs, threads, bound_units);
 
