@@ -37,7 +37,8 @@ constexpr int64_t kSubOffset = kSubStep / 2;
 constexpr int kTileBits = 3;
 constexpr int kTile = 1 << kTileBits;
 
-int32_t to_fixed(double v) {
+// Output pixels to fixed point (snap_range() does the same two coordinates at a time).
+[[maybe_unused]] int32_t to_fixed(double v) {
   v *= double(kOne);
   v = v > -kGuard ? v : -kGuard;  // also maps NaN to the guard band
   v = v < kGuard ? v : kGuard;
@@ -135,6 +136,173 @@ bool is_small(const TriangleSetup& t) {
     e2 = _mm_add_ps(e2, s2);
   }
   return mask;
+}
+#endif
+
+#if defined(__SSE2__)
+// ---- Small triangles, four at a time ------------------------------------------------------------
+// Nearly all refined triangles have at most 4 x 2 candidate pixel centres (1-3 pixel edges), and
+// their cost is the per-triangle work, so these run four at a time with one triangle per SSE2
+// lane: gather, candidate range, edge functions, the fill-rule test of all 8 candidates, the choice
+// of the owned ones and the shading of the first two, without data-dependent branches. Relative
+// to its first candidate centre, such a triangle's corners are less than 5 pixels (2^11 fixed-point
+// units) away, so its edge functions at the candidates are integers below 2^24 in magnitude:
+// exact in int32 lanes and in float lanes alike, so the test is the integer test of the fill rule
+// and the shading gets the same floats as Shader::shade() does.
+
+// Coverage of four triangles, one per lane. Candidate c = 4 j + i (i < 4, j < 2) of a lane is its
+// pixel centre (px0 + i, py0 + j).
+struct QuadCoverage {
+  static constexpr int kNone = 8;  // candidate index meaning "none"
+  __m128i owned;                   // per lane: bit c set for each owned candidate
+  __m128i px0, py0;                // first candidate per lane
+  __m128 e1, e2;                   // unbiased E_1, E_2 at the first candidate
+  __m128 e1_x, e1_y, e2_x, e2_y;   // their steps per column and per row
+  __m128 area2;                    // twice the area
+  unsigned large;                  // lanes (bits) with more candidates: for for_each_centre()
+
+  // E_1 and E_2 at candidate c of every lane (any finite value for kNone).
+  void edges_at(__m128i c, __m128& f1, __m128& f2) const {
+    const __m128 i = _mm_cvtepi32_ps(_mm_and_si128(c, _mm_set1_epi32(3)));
+    const __m128 j = _mm_cvtepi32_ps(_mm_srli_epi32(c, 2));
+    f1 = _mm_add_ps(_mm_add_ps(e1, _mm_mul_ps(i, e1_x)), _mm_mul_ps(j, e1_y));
+    f2 = _mm_add_ps(_mm_add_ps(e2, _mm_mul_ps(i, e2_x)), _mm_mul_ps(j, e2_y));
+  }
+};
+
+template <class T>
+T lane_of(__m128i v, int lane) {
+  alignas(16) T a[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(a), v);
+  return a[lane];
+}
+inline float lane_of(__m128 v, int lane) {
+  alignas(16) float a[4];
+  _mm_store_ps(a, v);
+  return a[lane];
+}
+
+// min and max of int32 lanes whose difference is below 2^31 (SSE2 has neither).
+inline __m128i min_epi32(__m128i a, __m128i b) {
+  const __m128i d = _mm_sub_epi32(a, b);
+  return _mm_add_epi32(b, _mm_and_si128(d, _mm_srai_epi32(d, 31)));
+}
+inline __m128i max_epi32(__m128i a, __m128i b) {
+  const __m128i d = _mm_sub_epi32(a, b);
+  return _mm_sub_epi32(a, _mm_and_si128(d, _mm_srai_epi32(d, 31)));
+}
+
+// Index of the lowest set bit of each lane (lanes of at most 24 bits, not zero): the exponent of
+// the lowest bit converted to float.
+inline __m128i lowest_bit(__m128i v) {
+  const __m128i low = _mm_and_si128(v, _mm_sub_epi32(_mm_setzero_si128(), v));
+  return _mm_sub_epi32(_mm_srli_epi32(_mm_castps_si128(_mm_cvtepi32_ps(low)), 23),
+                       _mm_set1_epi32(127));
+}
+
+// Covers the pixel centres in columns [0, last_x] and rows [first_y, last_y] with triangles
+// tris[0 .. 4), of which the first n in 1..4 count (lanes n..3 own nothing). Lanes with more than
+// 4 x 2 candidates in that window are flagged in q.large and own nothing here. Coordinates are
+// within the +-2^29 guard band of to_fixed(), so differences fit in int32.
+[[gnu::always_inline]] inline void cover_quad(const Fixed* fixed, const Tri* tris, int n,
+                                              int last_x, int first_y, int last_y,
+                                              QuadCoverage& q) {
+  // Corners k of the four triangles as (x, y) vectors over the lanes.
+  __m128i xs[3], ys[3];
+  for (int k = 0; k < 3; ++k) {
+    auto corner = [&](int lane) {
+      return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(&fixed[tris[lane][k]]));
+    };
+    const __m128i lo = _mm_unpacklo_epi32(corner(0), corner(1));  // x0 x1 y0 y1
+    const __m128i hi = _mm_unpacklo_epi32(corner(2), corner(3));  // x2 x3 y2 y3
+    xs[k] = _mm_unpacklo_epi64(lo, hi);
+    ys[k] = _mm_unpackhi_epi64(lo, hi);
+  }
+  // Candidate range: first_centre() of the minimum, last_centre() of the maximum.
+  auto first = [](const __m128i* v) {
+    return _mm_srai_epi32(
+        _mm_add_epi32(min_epi32(min_epi32(v[0], v[1]), v[2]), _mm_set1_epi32(kHalf - 1)),
+        kSubpixelBits);
+  };
+  auto last = [](const __m128i* v) {
+    return _mm_srai_epi32(
+        _mm_sub_epi32(max_epi32(max_epi32(v[0], v[1]), v[2]), _mm_set1_epi32(kHalf)),
+        kSubpixelBits);
+  };
+  const __m128i cx0 = first(xs), cx1 = last(xs), cy0 = first(ys), cy1 = last(ys);
+  // Small: at most 4 x 2 candidates before clipping to the window. The triangle is then less than
+  // 5 x 3 pixels across, and its corners less than 5 pixels from any of its candidates.
+  const __m128i small =
+      _mm_and_si128(_mm_cmplt_epi32(_mm_sub_epi32(cx1, cx0), _mm_set1_epi32(4)),
+                    _mm_cmplt_epi32(_mm_sub_epi32(cy1, cy0), _mm_set1_epi32(2)));
+  q.px0 = max_epi32(cx0, _mm_setzero_si128());
+  q.py0 = max_epi32(cy0, _mm_set1_epi32(first_y));
+  const __m128i columns = _mm_sub_epi32(min_epi32(cx1, _mm_set1_epi32(last_x)), q.px0);  // - 1
+  const __m128i rows = _mm_sub_epi32(min_epi32(cy1, _mm_set1_epi32(last_y)), q.py0);     // - 1
+  const __m128i present = _mm_cmplt_epi32(_mm_set1_epi32(3 - n), _mm_setr_epi32(3, 2, 1, 0));
+  const __m128i any = _mm_and_si128(
+      present, _mm_cmpgt_epi32(_mm_or_si128(columns, rows), _mm_set1_epi32(-1)));
+  q.large = unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(small, any))));
+  // The candidates in the clipped range, in the lanes drawn here: 2^(columns + 1) - 1 (from the
+  // exponent of a float) in row 0, the same in row 1 if there are two rows.
+  const __m128i row_bits = _mm_sub_epi32(
+      _mm_cvttps_epi32(_mm_castsi128_ps(
+          _mm_slli_epi32(_mm_add_epi32(columns, _mm_set1_epi32(128)), 23))),
+      _mm_set1_epi32(1));
+  const __m128i valid = _mm_and_si128(
+      _mm_and_si128(small, any),
+      _mm_or_si128(row_bits, _mm_and_si128(_mm_slli_epi32(row_bits, 4),
+                                           _mm_cmpgt_epi32(rows, _mm_setzero_si128()))));
+
+  // Corners relative to the first candidate (small integers in the lanes that are used).
+  const __m128i ox = _mm_add_epi32(_mm_slli_epi32(q.px0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  const __m128i oy = _mm_add_epi32(_mm_slli_epi32(q.py0, kSubpixelBits), _mm_set1_epi32(kHalf));
+  for (int k = 0; k < 3; ++k) {
+    xs[k] = _mm_sub_epi32(xs[k], ox);
+    ys[k] = _mm_sub_epi32(ys[k], oy);
+  }
+  // Edge k runs from corner k+1 to corner k+2; its function at the first candidate is
+  // dy_k x_{k+1} - dx_k y_{k+1} (products in float: exact), and it steps by -dy_k per column and
+  // dx_k per row (in pixels). With the fill rule's bias (TriangleSetup) added, a candidate is inside
+  // iff the three biased values are >= 0: iff their OR has no sign bit.
+  const __m128i zero = _mm_setzero_si128();
+  __m128i h[3], step_x[3], step_y[3];
+  __m128 e[3];
+  for (int k = 0; k < 3; ++k) {
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    const __m128i dx = _mm_sub_epi32(xs[b], xs[a]), dy = _mm_sub_epi32(ys[b], ys[a]);
+    e[k] = _mm_sub_ps(_mm_mul_ps(_mm_cvtepi32_ps(dy), _mm_cvtepi32_ps(xs[a])),
+                      _mm_mul_ps(_mm_cvtepi32_ps(dx), _mm_cvtepi32_ps(ys[a])));
+    const __m128i owns = _mm_or_si128(
+        _mm_cmpgt_epi32(dy, zero), _mm_and_si128(_mm_cmpeq_epi32(dy, zero), _mm_cmpgt_epi32(dx, zero)));
+    h[k] = _mm_add_epi32(_mm_cvttps_epi32(e[k]), _mm_andnot_si128(owns, _mm_set1_epi32(-1)));
+    step_x[k] = _mm_slli_epi32(_mm_sub_epi32(zero, dy), kSubpixelBits);
+    step_y[k] = _mm_slli_epi32(dx, kSubpixelBits);
+  }
+  q.e1 = e[1], q.e2 = e[2];
+  q.e1_x = _mm_cvtepi32_ps(step_x[1]), q.e1_y = _mm_cvtepi32_ps(step_y[1]);
+  q.e2_x = _mm_cvtepi32_ps(step_x[2]), q.e2_y = _mm_cvtepi32_ps(step_y[2]);
+  q.area2 = _mm_add_ps(_mm_add_ps(e[0], e[1]), e[2]);
+
+  __m128i owned = zero;
+  for (int j = 0; j < 2; ++j) {
+    __m128i f0 = h[0], f1 = h[1], f2 = h[2];
+    for (int i = 0; i < 4; ++i) {
+      const __m128i outside = _mm_srai_epi32(_mm_or_si128(_mm_or_si128(f0, f1), f2), 31);
+      owned = _mm_or_si128(owned, _mm_andnot_si128(outside, _mm_set1_epi32(1 << (4 * j + i))));
+      if (i < 3) {
+        f0 = _mm_add_epi32(f0, step_x[0]);
+        f1 = _mm_add_epi32(f1, step_x[1]);
+        f2 = _mm_add_epi32(f2, step_x[2]);
+      }
+    }
+    if (j == 0) {
+      h[0] = _mm_add_epi32(h[0], step_y[0]);
+      h[1] = _mm_add_epi32(h[1], step_y[1]);
+      h[2] = _mm_add_epi32(h[2], step_y[2]);
+    }
+  }
+  q.owned = _mm_and_si128(owned, valid);
 }
 #endif
 
@@ -242,12 +410,16 @@ struct Shader {
   __m128 base = _mm_setzero_ps(), d1 = base, d2 = base;  // c0 + 0.5 (rounding), c1 - c0, c2 - c0
   float inv_area = 0;
 
-  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
-    const __m128 a = _mm_setr_ps(c0[0], c0[1], c0[2], 0.f);
+  static __m128 load_rgb(const float* c) {  // (r, g, b, 0)
+    return _mm_movelh_ps(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(c)),
+                         _mm_load_ss(c + 2));
+  }
+  void init(const float* c0, const float* c1, const float* c2, float area2) {
+    const __m128 a = load_rgb(c0);
     base = _mm_add_ps(a, _mm_set1_ps(0.5f));
-    d1 = _mm_sub_ps(_mm_setr_ps(c1[0], c1[1], c1[2], 0.f), a);
-    d2 = _mm_sub_ps(_mm_setr_ps(c2[0], c2[1], c2[2], 0.f), a);
-    inv_area = 1.f / float(area2);
+    d1 = _mm_sub_ps(load_rgb(c1), a);
+    d2 = _mm_sub_ps(load_rgb(c2), a);
+    inv_area = 1.f / area2;
   }
   uint32_t shade(float e1, float e2) const {
     const __m128 w1 = _mm_set1_ps(e1 * inv_area), w2 = _mm_set1_ps(e2 * inv_area);
@@ -263,13 +435,13 @@ struct Shader {
   float base[3] = {}, d1[3] = {}, d2[3] = {};
   float inv_area = 0;
 
-  void init(const float* c0, const float* c1, const float* c2, int64_t area2) {
+  void init(const float* c0, const float* c1, const float* c2, float area2) {
     for (int c = 0; c < 3; ++c) {
       base[c] = c0[c] + 0.5f;
       d1[c] = c1[c] - c0[c];
       d2[c] = c2[c] - c0[c];
     }
-    inv_area = 1.f / float(area2);
+    inv_area = 1.f / area2;
   }
   uint32_t shade(float e1, float e2) const {
     const float w1 = e1 * inv_area, w2 = e2 * inv_area;
@@ -286,12 +458,51 @@ struct Shader {
 };
 
 // Sets up `shader` for triangle ti (at its first covered sample: many tiny triangles cover none).
-void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, int64_t area2) {
+void init_shader(Shader& shader, const RefinedMesh& mesh, int32_t ti, float area2) {
   const Tri& tc = mesh.triangle_colors[ti];
   const float* colors = mesh.colors.data();
   shader.init(colors + size_t(tc[0]) * 3, colors + size_t(tc[1]) * 3, colors + size_t(tc[2]) * 3,
               area2);
 }
+
+#if defined(__SSE2__)
+// The Gouraud colors of candidates c[r] (any color for kNone) of the four lanes of `q`, packed as
+// Shader::shade() packs them and computed with the same operations in the same order, so they
+// are the same bytes; the four triangles share the vector instructions. `corners`: the color
+// indices of the four triangles.
+template <int kRounds>
+[[gnu::always_inline]] inline void shade_quad(const float* colors, const Tri* corners,
+                                              const QuadCoverage& q, const __m128i (&c)[kRounds],
+                                              __m128i (&rgb)[kRounds]) {
+  __m128 base[3], d1[3], d2[3];  // per channel, over the lanes
+  {
+    __m128 v[3][4];  // corner k: (r, g, b, 0) per lane, then transposed to r, g, b, 0
+    for (int k = 0; k < 3; ++k) {
+      for (int lane = 0; lane < 4; ++lane)
+        v[k][lane] = Shader::load_rgb(colors + size_t(corners[lane][k]) * 3);
+      _MM_TRANSPOSE4_PS(v[k][0], v[k][1], v[k][2], v[k][3]);
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+      base[ch] = _mm_add_ps(v[0][ch], _mm_set1_ps(0.5f));
+      d1[ch] = _mm_sub_ps(v[1][ch], v[0][ch]);
+      d2[ch] = _mm_sub_ps(v[2][ch], v[0][ch]);
+    }
+  }
+  const __m128 inv_area = _mm_div_ps(_mm_set1_ps(1.f), q.area2);
+  for (int r = 0; r < kRounds; ++r) {
+    __m128 e1, e2;
+    q.edges_at(c[r], e1, e2);
+    const __m128 w1 = _mm_mul_ps(e1, inv_area), w2 = _mm_mul_ps(e2, inv_area);
+    __m128i packed = _mm_setzero_si128();
+    for (int ch = 0; ch < 3; ++ch) {
+      __m128 v = _mm_add_ps(base[ch], _mm_add_ps(_mm_mul_ps(w1, d1[ch]), _mm_mul_ps(w2, d2[ch])));
+      v = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(255.25f));
+      packed = _mm_or_si128(packed, _mm_slli_epi32(_mm_cvttps_epi32(v), 8 * ch));
+    }
+    rgb[r] = packed;
+  }
+}
+#endif
 
 // ---- Pixels marked for supersampling ----------------------------------------------------------
 
@@ -453,34 +664,122 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
   const size_t stride = size_t(out.width) * kChannels;
   TriangleSetup t;
   Shader shader;
+  auto draw = [&](uint8_t* p, uint32_t rgb) {
+    p[0] = static_cast<uint8_t>(rgb);
+    p[1] = static_cast<uint8_t>(rgb >> 8);
+    p[2] = static_cast<uint8_t>(rgb >> 16);
+    if constexpr (kChannels == 4) p[3] = 255;
+  };
+  // Any triangle, through for_each_centre().
+  auto draw_triangle = [&](int32_t ti) {
+    const Tri& tri = tris[ti];
+    t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+    const int px0 = std::max(first_centre(t.min_x), 0),
+              px1 = std::min(last_centre(t.max_x), last_x);
+    const int py0 = std::max(first_centre(t.min_y), band_y0),
+              py1 = std::min(last_centre(t.max_y), last_y);
+    if ((px0 > px1) | (py0 > py1)) return;
+    bool shaded = false;
+    for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
+      if (!shaded) init_shader(shader, mesh, ti, float(t.area2)), shaded = true;
+      draw(pixels + size_t(py) * stride + size_t(px) * kChannels, shader.shade(e1, e2));
+    });
+  };
+#if defined(__SSE2__)
+  QuadCoverage q;
+  uint8_t dummy[4];
+  // Candidate c relative to the first; the last entry (kNone) leads to `dummy`.
+  uintptr_t offsets[QuadCoverage::kNone + 1];
+  for (int c = 0; c < QuadCoverage::kNone; ++c)
+    offsets[c] = uintptr_t(c >> 2) * stride + uintptr_t(c & 3) * kChannels;
+#endif
   for (const int32_t u : units) {
     const Unit& unit = unit_data[u];
-    const bool near_unit = near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0),
-                                                     std::min(unit.y1, last_y));
-    for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
-      const Tri& tri = tris[ti];
-      t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
-      if (near_unit && f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x),
-                                         std::max(pixel_floor(t.min_y), band_y0),
-                                         std::min(pixel_floor(t.max_y), last_y))) {
-        near->push_back(ti);
+    if (near && f.marks->any_tile(unit.x0, unit.x1, std::max(unit.y0, band_y0),
+                                  std::min(unit.y1, last_y))) {
+      for (int32_t ti = unit.begin; ti < unit.end; ++ti) {
+        const Tri& tri = tris[ti];
+        t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
+        if (f.marks->any_tile(pixel_floor(t.min_x), pixel_floor(t.max_x),
+                              std::max(pixel_floor(t.min_y), band_y0),
+                              std::min(pixel_floor(t.max_y), last_y))) {
+          near->push_back(ti);
+        }
       }
-      const int px0 = std::max(first_centre(t.min_x), 0),
-                px1 = std::min(last_centre(t.max_x), last_x);
-      const int py0 = std::max(first_centre(t.min_y), band_y0),
-                py1 = std::min(last_centre(t.max_y), last_y);
-      if ((px0 > px1) | (py0 > py1)) continue;
-      bool shaded = false;
-      for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
-        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
-        const uint32_t rgb = shader.shade(e1, e2);
-        uint8_t* p = pixels + size_t(py) * stride + size_t(px) * kChannels;
-        p[0] = static_cast<uint8_t>(rgb);
-        p[1] = static_cast<uint8_t>(rgb >> 8);
-        p[2] = static_cast<uint8_t>(rgb >> 16);
-        if constexpr (kChannels == 4) p[3] = 255;
-      });
     }
+#if defined(__SSE2__)
+    for (int32_t ti = unit.begin; ti < unit.end; ti += 4) {
+      const int n = std::min(4, unit.end - ti);
+      const Tri* quad = tris + ti;
+      const Tri* quad_colors = mesh.triangle_colors.data() + ti;
+      Tri tail[4], tail_colors[4];
+      if (n < 4) {  // pad with the first triangle
+        for (int lane = 0; lane < 4; ++lane) {
+          tail[lane] = quad[lane < n ? lane : 0];
+          tail_colors[lane] = quad_colors[lane < n ? lane : 0];
+        }
+        quad = tail;
+        quad_colors = tail_colors;
+      }
+      cover_quad(f.fixed, quad, n, last_x, band_y0, last_y, q);
+      // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first two are shaded and
+      // drawn without branches (a missing one, kNone, to a dummy pixel), only the rare others
+      // one by one.
+      const __m128i none = _mm_set1_epi32(1 << QuadCoverage::kNone);
+      const __m128i second = _mm_and_si128(q.owned, _mm_sub_epi32(q.owned, _mm_set1_epi32(1)));
+      const __m128i which[2] = {lowest_bit(_mm_or_si128(q.owned, none)),
+                                lowest_bit(_mm_or_si128(second, none))};
+      __m128i rgb_v[2];
+      shade_quad<2>(mesh.colors.data(), quad_colors, q, which, rgb_v);
+      const __m128i rest = _mm_and_si128(second, _mm_sub_epi32(second, _mm_set1_epi32(1)));
+      const unsigned more = ~unsigned(_mm_movemask_ps(
+                                _mm_castsi128_ps(_mm_cmpeq_epi32(rest, _mm_setzero_si128())))) &
+                            0xfu;
+      alignas(16) int32_t px0[4], py0[4], c0[4], c1[4];
+      alignas(16) uint32_t rgb0[4], rgb1[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(px0), q.px0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(py0), q.py0);
+      _mm_store_si128(reinterpret_cast<__m128i*>(c0), which[0]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(c1), which[1]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(rgb0), rgb_v[0]);
+      _mm_store_si128(reinterpret_cast<__m128i*>(rgb1), rgb_v[1]);
+      auto draw_lane = [&](int lane) {
+        // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
+        const uintptr_t origin = uintptr_t(pixels) + uintptr_t(py0[lane]) * stride +
+                                 uintptr_t(px0[lane]) * kChannels;
+        offsets[QuadCoverage::kNone] = uintptr_t(dummy) - origin;
+        draw(reinterpret_cast<uint8_t*>(origin + offsets[c0[lane]]), rgb0[lane]);
+        draw(reinterpret_cast<uint8_t*>(origin + offsets[c1[lane]]), rgb1[lane]);
+      };
+      if ((n == 4) & (q.large == 0)) {
+        draw_lane(0), draw_lane(1), draw_lane(2), draw_lane(3);
+      } else {
+        for (int lane = 0; lane < n; ++lane) {
+          if ((q.large >> lane) & 1) {
+            draw_triangle(ti + lane);
+          } else {
+            draw_lane(lane);
+          }
+        }
+      }
+      for (unsigned lanes = more; lanes; lanes &= lanes - 1) {  // owning 3 or more
+        const int lane = std::countr_zero(lanes);
+        init_shader(shader, mesh, ti + lane, lane_of(q.area2, lane));
+        const float e1 = lane_of(q.e1, lane), e1_x = lane_of(q.e1_x, lane),
+                    e1_y = lane_of(q.e1_y, lane), e2 = lane_of(q.e2, lane),
+                    e2_x = lane_of(q.e2_x, lane), e2_y = lane_of(q.e2_y, lane);
+        for (uint32_t owned = lane_of<uint32_t>(rest, lane); owned; owned &= owned - 1) {
+          const int c = std::countr_zero(owned);
+          const float i = float(c & 3), j = float(c >> 2);
+          draw(pixels + size_t(py0[lane] + (c >> 2)) * stride +
+                   size_t(px0[lane] + (c & 3)) * kChannels,
+               shader.shade(e1 + i * e1_x + j * e1_y, e2 + i * e2_x + j * e2_y));
+        }
+      }
+    }
+#else
+    for (int32_t ti = unit.begin; ti < unit.end; ++ti) draw_triangle(ti);
+#endif
   }
 }
 
@@ -502,7 +801,7 @@ void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int ban
     bool shaded = false;
     marks.for_each_marked(ax0, ax1, ay0, ay1, [&](int px, int py, uint32_t* samples) {
       for_each_subsample(t, px, py, [&](int k, float e1, float e2) {
-        if (!shaded) init_shader(shader, mesh, ti, t.area2), shaded = true;
+        if (!shaded) init_shader(shader, mesh, ti, float(t.area2)), shaded = true;
         samples[k] = shader.shade(e1, e2) | 0xff000000u;
       });
     });
@@ -574,18 +873,41 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
 
 // ---- Frame setup -------------------------------------------------------------------------------
 
+// Snaps vertices [begin, end) to fixed point: to_fixed(view.to_output(...)), two at a time.
+void snap_range(const RefinedMesh& mesh, const ViewTransform& view, int begin, int end,
+                Fixed* fixed) {
+  const float* positions = mesh.positions.data();
+#if defined(__SSE2__)
+  // The same double operations as to_output() and to_fixed(), with x and y in the two lanes:
+  // max() and min() are the clamps (NaN, the first operand, goes to the lower bound) and the
+  // biased value truncates to int32 (it lies in [0.5, 2^30 + 0.5]).
+  const __m128d origin = _mm_setr_pd(view.x0, view.y0), scale = _mm_setr_pd(view.sx, view.sy);
+  const __m128d one = _mm_set1_pd(double(kOne)), lo = _mm_set1_pd(-kGuard),
+                hi = _mm_set1_pd(kGuard), bias = _mm_set1_pd(kGuard + 0.5);
+  const __m128i guard = _mm_set1_epi32(static_cast<int32_t>(kGuard));
+  for (int i = begin; i < end; ++i) {
+    const __m128 p =
+        _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(positions + 2 * size_t(i)));
+    __m128d v = _mm_mul_pd(_mm_mul_pd(_mm_sub_pd(_mm_cvtps_pd(p), origin), scale), one);
+    v = _mm_add_pd(_mm_min_pd(_mm_max_pd(v, lo), hi), bias);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(fixed + i),
+                     _mm_sub_epi32(_mm_cvttpd_epi32(v), guard));
+  }
+#else
+  for (int i = begin; i < end; ++i) {
+    const auto o = view.to_output(positions[2 * size_t(i)], positions[2 * size_t(i) + 1]);
+    fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
+  }
+#endif
+}
+
 void snap_vertices(const RefinedMesh& mesh, const ViewTransform& view, int threads,
                    std::vector<Fixed>& fixed) {
   const int n = mesh.num_vertices();
   fixed.resize(n);
   constexpr int kChunk = 1 << 16;
   parallel_for((n + kChunk - 1) / kChunk, threads, [&](int chunk) {
-    const int end = std::min(n, (chunk + 1) * kChunk);
-    for (int i = chunk * kChunk; i < end; ++i) {
-      const auto o =
-          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
-      fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
-    }
+    snap_range(mesh, view, chunk * kChunk, std::min(n, (chunk + 1) * kChunk), fixed.data());
   });
 }
 
@@ -647,11 +969,11 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
 void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                     std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out) {
   const int width = view.width, height = view.height, threads = std::max(options.threads, 1);
-  if (out.width != width || out.height != height || out.channels != options.channels) {
-    out = Image8(width, height, options.channels);
-  } else {
-    std::fill(out.pixels.begin(), out.pixels.end(), uint8_t{0});
-  }
+  // A reused frame is cleared band by band just before the band is drawn, so that the drawing
+  // finds its rows in cache (clearing a 4K frame up front costs a cache miss per line later).
+  const bool reused =
+      out.width == width && out.height == height && out.channels == options.channels;
+  if (!reused) out = Image8(width, height, options.channels);
   RasterScratch local;
   RasterScratch& work = scratch ? *scratch : local;
   Frame f{&mesh, nullptr, width, height, nullptr};
@@ -676,12 +998,8 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   };
   parallel_for(vertex_jobs + (given ? unit_jobs : 0), threads, [&](int job) {
     if (job >= vertex_jobs) return bound_units(job - vertex_jobs);
-    const int end = std::min(num_vertices, (job + 1) * kVerticesPerJob);
-    for (int i = job * kVerticesPerJob; i < end; ++i) {
-      const auto o =
-          view.to_output(mesh.positions[2 * size_t(i)], mesh.positions[2 * size_t(i) + 1]);
-      work.fixed[i] = {to_fixed(o[0]), to_fixed(o[1])};
-    }
+    snap_range(mesh, view, job * kVerticesPerJob,
+               std::min(num_vertices, (job + 1) * kVerticesPerJob), work.fixed.data());
   });
   if (!given) parallel_for(unit_jobs, threads, bound_units);
 
@@ -733,6 +1051,7 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   parallel_for(num_bands, threads, [&](int job) {
     const int band = order[job].second;
     const int y0 = band * band_h, y1 = std::min(height, y0 + band_h);
+    if (reused) std::fill(out.row(y0), out.row(y0) + size_t(y1 - y0) * width * out.channels, 0);
     const std::span<const int32_t> list(work.binned.data() + work.band_begin[band],
                                         work.binned.data() + work.band_begin[band + 1]);
     thread_local std::vector<int32_t> near_list;
@@ -762,18 +1081,41 @@ std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransfor
   snap_vertices(mesh, view, 1, fixed);
   std::vector<int32_t> counts(size_t(width) * height * (subsamples ? kSubsamples : 1), 0);
   TriangleSetup t;
+  auto count_centres = [&](const Tri& tri) {
+    t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
+    const int px0 = std::max(first_centre(t.min_x), 0),
+              px1 = std::min(last_centre(t.max_x), width - 1);
+    const int py0 = std::max(first_centre(t.min_y), 0),
+              py1 = std::min(last_centre(t.max_y), height - 1);
+    if (px0 > px1 || py0 > py1) return;
+    for_each_centre(t, px0, px1, py0, py1,
+                    [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
+  };
+  if (!subsamples) {  // the traversal of draw_centres()
+    const Tri* tris = mesh.triangles.data();
+    for (int ti = 0; ti < mesh.num_triangles(); ti += 4) {
+      const int n = std::min(4, mesh.num_triangles() - ti);
+#if defined(__SSE2__)
+      Tri quad[4];
+      for (int lane = 0; lane < 4; ++lane) quad[lane] = tris[ti + (lane < n ? lane : 0)];
+      QuadCoverage q;
+      cover_quad(fixed.data(), quad, n, width - 1, 0, height - 1, q);
+      for (int lane = 0; lane < n; ++lane) {
+        if ((q.large >> lane) & 1) count_centres(tris[ti + lane]);
+        const int px0 = lane_of<int32_t>(q.px0, lane), py0 = lane_of<int32_t>(q.py0, lane);
+        for (uint32_t owned = lane_of<uint32_t>(q.owned, lane); owned; owned &= owned - 1) {
+          const int c = std::countr_zero(owned);
+          ++counts[size_t(py0 + (c >> 2)) * width + size_t(px0 + (c & 3))];
+        }
+      }
+#else
+      for (int lane = 0; lane < n; ++lane) count_centres(tris[ti + lane]);
+#endif
+    }
+    return counts;
+  }
   for (const Tri& tri : mesh.triangles) {
     t.init(fixed[tri[0]], fixed[tri[1]], fixed[tri[2]]);
-    if (!subsamples) {
-      const int px0 = std::max(first_centre(t.min_x), 0),
-                px1 = std::min(last_centre(t.max_x), width - 1);
-      const int py0 = std::max(first_centre(t.min_y), 0),
-                py1 = std::min(last_centre(t.max_y), height - 1);
-      if (px0 > px1 || py0 > py1) continue;
-      for_each_centre(t, px0, px1, py0, py1,
-                      [&](int px, int py, float, float) { ++counts[size_t(py) * width + px]; });
-      continue;
-    }
     if (!t.init_edges()) continue;
     const int ax0 = std::max(pixel_floor(t.min_x), 0),
               ax1 = std::min(pixel_floor(t.max_x), width - 1);
