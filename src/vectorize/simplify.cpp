@@ -17,7 +17,10 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <string>
 #include <unordered_set>
 
@@ -124,32 +127,35 @@ struct FeatureState {
   double saliency = 0;
 };
 
-// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries), which
-// halves the depth and the cache misses of a binary heap; the lazy collapse queue is dominated by
-// them.
+// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries, the
+// array offset by three slots so that every group of four siblings starts on a 64-byte boundary),
+// which halves the depth and the cache misses of a binary heap; the lazy collapse queue is
+// dominated by them.
 template <class T>
 class QuadHeap {
+  static_assert(sizeof(T) == 16);
+  static constexpr size_t kPad = 3;
+
  public:
-  bool empty() const { return v_.empty(); }
-  size_t size() const { return v_.size(); }
-  const T& top() const { return v_.front(); }
-  void clear() { v_.clear(); }
+  bool empty() const { return size_ == 0; }
+  size_t size() const { return size_; }
+  const T& top() const { return at(0); }
+  void clear() { size_ = 0; }
   void push(const T& x) {
-    size_t i = v_.size();
-    v_.push_back(x);
+    if (size_ == capacity_) grow();
+    size_t i = size_++;
     while (i > 0) {
       const size_t parent = (i - 1) / 4;
-      if (!(x < v_[parent])) break;
-      v_[i] = v_[parent];
+      if (!(x < at(parent))) break;
+      at(i) = at(parent);
       i = parent;
     }
-    v_[i] = x;
+    at(i) = x;
   }
   void pop() {
-    const T x = v_.back();
-    v_.pop_back();
-    if (v_.empty()) return;
-    const size_t n = v_.size();
+    const T x = at(--size_);
+    if (size_ == 0) return;
+    const size_t n = size_;
     size_t i = 0;
     while (true) {
       const size_t first = 4 * i + 1;
@@ -157,16 +163,29 @@ class QuadHeap {
       size_t best = first;
       const size_t last = std::min(first + 4, n);
       for (size_t c = first + 1; c < last; ++c)
-        if (v_[c] < v_[best]) best = c;
-      if (!(v_[best] < x)) break;
-      v_[i] = v_[best];
+        if (at(c) < at(best)) best = c;
+      if (!(at(best) < x)) break;
+      at(i) = at(best);
       i = best;
     }
-    v_[i] = x;
+    at(i) = x;
   }
 
  private:
-  std::vector<T> v_;
+  struct alignas(64) Line {
+    unsigned char bytes[64];
+  };
+  T& at(size_t i) { return reinterpret_cast<T*>(storage_.get())[i + kPad]; }
+  const T& at(size_t i) const { return reinterpret_cast<const T*>(storage_.get())[i + kPad]; }
+  void grow() {
+    const size_t capacity = std::max<size_t>(1024, 2 * capacity_);
+    std::unique_ptr<Line[]> storage(new Line[(capacity + kPad) * sizeof(T) / sizeof(Line) + 1]);
+    if (size_) std::memcpy(reinterpret_cast<T*>(storage.get()) + kPad, &at(0), size_ * sizeof(T));
+    storage_ = std::move(storage);
+    capacity_ = capacity;
+  }
+  std::unique_ptr<Line[]> storage_;
+  size_t size_ = 0, capacity_ = 0;
 };
 
 class Simplifier {
@@ -183,17 +202,16 @@ class Simplifier {
     Vec2 position;
   };
   // A heap entry: 16 bytes, so that the lazy heap (stale entries are skipped when popped) stays
-  // cache friendly. Versions are truncated: an entry that survives a wrap-around is still fully
-  // re-planned and checked before it collapses anything.
+  // cache friendly. Ordered by cost, then the removed and the kept vertex (determinism); the cost
+  // is a non-negative float, so its bits order like the value and cost and removed vertex compare
+  // as one 64-bit key. Versions are truncated: an entry that survives a wrap-around is still
+  // fully re-planned and checked before it collapses anything.
   struct Entry {
-    float cost;
-    int32_t remove, keep;
+    uint64_t key;  // cost bits << 32 | remove
+    int32_t keep;
     uint16_t version_remove, version_keep;
-    bool operator<(const Entry& o) const {  // cheaper first, ties by indices (determinism)
-      if (cost != o.cost) return cost < o.cost;
-      if (remove != o.remove) return remove < o.remove;
-      return keep < o.keep;
-    }
+    int32_t remove() const { return static_cast<int32_t>(key & 0xffffffffu); }
+    bool operator<(const Entry& o) const { return key != o.key ? key < o.key : keep < o.keep; }
   };
 
   void setup();
@@ -204,6 +222,11 @@ class Simplifier {
   void push(const Plan& p);
   void rebuild_heap();
   void neighbours(int32_t v, std::vector<int32_t>& out) const;
+  uint32_t next_stamp() const {
+    if (++stamp_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), stamp_ = 1;
+    return stamp_;
+  }
+  bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
   bool link_condition(int32_t u, int32_t v) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
@@ -229,6 +252,9 @@ class Simplifier {
   std::vector<int32_t> node_of_;   // node of tear vertices, else -1
   std::vector<Node> nodes_;
   std::unordered_set<int64_t> tear_edges_;  // (min << 32 | max) of every feature edge
+  std::vector<int32_t> only_color_;  // the color of a vertex with one color value, else -1
+  mutable std::vector<uint32_t> mark_;  // neighbourhood scratch: vertices marked with a stamp
+  mutable uint32_t stamp_ = 0;
   std::vector<uint32_t> version_;
   std::vector<Quadric> quadric_;   // per color index
   std::vector<FeatureState> features_;
@@ -249,6 +275,16 @@ void Simplifier::setup() {
   for (int f = 0; f < nf; ++f)
     for (int v : tri_[f]) vfaces_[v].push_back(f);
   version_.assign(nv, 0);
+  mark_.assign(nv, 0);
+  only_color_.assign(nv, -1);
+  std::vector<uint8_t> seen(nv, 0);
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = tri_[f][k], c = tcol_[f][k];
+      if (!seen[v]) only_color_[v] = c, seen[v] = 1;
+      else if (only_color_[v] != c) only_color_[v] = -1;
+    }
+  }
 
   kind_.resize(nv);
   sides_.assign(nv, 0);
@@ -306,13 +342,17 @@ void Simplifier::setup() {
   }
 }
 
+// The distinct neighbours of v, in no particular order.
 void Simplifier::neighbours(int32_t v, std::vector<int32_t>& out) const {
   out.clear();
-  for (int32_t f : vfaces_[v])
-    for (int32_t w : tri_[f])
-      if (w != v) out.push_back(w);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  const uint32_t stamp = next_stamp();
+  for (int32_t f : vfaces_[v]) {
+    for (int32_t w : tri_[f]) {
+      if (w == v || mark_[w] == stamp) continue;
+      mark_[w] = stamp;
+      out.push_back(w);
+    }
+  }
 }
 
 int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
@@ -339,39 +379,46 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
   Plan p;
   const Kind ku = kind_[u], kv = kind_[v];
   if (ku == Kind::kCorner) return p;
+  // A smooth vertex into a vertex with one color: the edge (which exists: u and v are neighbours)
+  // merges one pair of quadrics whatever its faces.
   int32_t faces[2];
-  const int nfaces = faces_with_edge(u, v, faces);
-  if (nfaces < 1 || nfaces > 2) return p;
-  switch (ku) {
-    case Kind::kSmooth:
-      break;
-    case Kind::kBorder:
-      if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
-      break;
-    case Kind::kFeature:
-      if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
-      if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
-      break;
-    case Kind::kCorner:
-      return p;
-  }
-  if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
-
-  // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
-  Quadric2 r;
   int32_t pairs[2][2];
   int npairs = 0;
-  for (int i = 0; i < nfaces; ++i) {
-    const Tri& t = tri_[faces[i]];
-    int32_t cu = -1, cv = -1;
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] == u) cu = tcol_[faces[i]][k];
-      if (t[k] == v) cv = tcol_[faces[i]][k];
+  if (ku == Kind::kSmooth && only_color_[u] >= 0 && only_color_[v] >= 0) {
+    pairs[0][0] = only_color_[u], pairs[0][1] = only_color_[v];
+    npairs = 1;
+  } else {
+    const int nfaces = faces_with_edge(u, v, faces);
+    if (nfaces < 1 || nfaces > 2) return p;
+    switch (ku) {
+      case Kind::kSmooth:
+        break;
+      case Kind::kBorder:
+        if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
+        break;
+      case Kind::kFeature:
+        if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
+        if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
+        break;
+      case Kind::kCorner:
+        return p;
     }
-    if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
-    pairs[npairs][0] = cu, pairs[npairs][1] = cv;
-    ++npairs;
+    if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
+
+    // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
+    for (int i = 0; i < nfaces; ++i) {
+      const Tri& t = tri_[faces[i]];
+      int32_t cu = -1, cv = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] == u) cu = tcol_[faces[i]][k];
+        if (t[k] == v) cv = tcol_[faces[i]][k];
+      }
+      if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
+      pairs[npairs][0] = cu, pairs[npairs][1] = cv;
+      ++npairs;
+    }
   }
+  Quadric2 r;
   for (int i = 0; i < npairs; ++i) {
     Quadric q = quadric_[pairs[i][0]];
     q += quadric_[pairs[i][1]];
@@ -409,7 +456,8 @@ void Simplifier::push_edges(int32_t v) {
 
 void Simplifier::push(const Plan& p) {
   if (p.remove < 0 || !std::isfinite(p.cost)) return;
-  heap_.push({static_cast<float>(p.cost), p.remove, p.keep, static_cast<uint16_t>(version_[p.remove]),
+  const uint64_t cost_bits = std::bit_cast<uint32_t>(static_cast<float>(p.cost));
+  heap_.push({cost_bits << 32 | static_cast<uint32_t>(p.remove), p.keep, static_cast<uint16_t>(version_[p.remove]),
               static_cast<uint16_t>(version_[p.keep])});
 }
 
@@ -426,14 +474,17 @@ void Simplifier::rebuild_heap() {
 }
 
 bool Simplifier::link_condition(int32_t u, int32_t v) const {
-  thread_local std::vector<int32_t> ru, rv;
-  neighbours(u, ru);
-  neighbours(v, rv);
+  // Mark u's neighbours, then count v's marked ones, each once.
+  const uint32_t of_u = next_stamp(), counted = next_stamp();
+  for (int32_t f : vfaces_[u])
+    for (int32_t w : tri_[f]) mark_[w] = of_u;
   int common = 0;
-  for (size_t i = 0, j = 0; i < ru.size() && j < rv.size();) {
-    if (ru[i] < rv[j]) ++i;
-    else if (ru[i] > rv[j]) ++j;
-    else ++common, ++i, ++j;
+  for (int32_t f : vfaces_[v]) {
+    for (int32_t w : tri_[f]) {
+      if (w == u || w == v || mark_[w] != of_u) continue;
+      mark_[w] = counted;
+      ++common;
+    }
   }
   int32_t faces[2];
   return common == faces_with_edge(u, v, faces);
@@ -613,7 +664,8 @@ bool Simplifier::try_collapse(const Plan& e) {
     const int nfaces = faces_with_edge(u, v, faces);
     for (int i = 0; i < std::min(nfaces, 2); ++i) {
       for (int32_t w : tri_[faces[i]]) {
-        if (w != u && w != v && tear_edges_.count(edge_key(u, w)) && tear_edges_.count(edge_key(v, w))) {
+        if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edges_.count(edge_key(u, w)) &&
+            tear_edges_.count(edge_key(v, w))) {
           ++stats_.rejected_topology;
           return false;
         }
@@ -730,12 +782,13 @@ SimplifyStats Simplifier::run() {
   while (alive_vertices_ > options_.target_vertices && !heap_.empty()) {
     const Entry e = heap_.top();
     heap_.pop();
-    if (!vertex_alive_[e.remove] || !vertex_alive_[e.keep]) continue;
-    if (static_cast<uint16_t>(version_[e.remove]) != e.version_remove ||
+    const int32_t remove = e.remove();
+    if (!vertex_alive_[remove] || !vertex_alive_[e.keep]) continue;
+    if (static_cast<uint16_t>(version_[remove]) != e.version_remove ||
         static_cast<uint16_t>(version_[e.keep]) != e.version_keep) {
       continue;
     }
-    const Plan p = plan_direction(e.remove, e.keep);
+    const Plan p = plan_direction(remove, e.keep);
     if (p.remove < 0) continue;
     try_collapse(p);
     if (heap_.size() > rebuild_at) {
