@@ -35,13 +35,17 @@ namespace {
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 
-// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b).
-struct Quadric {
-  Mat5 a = Mat5::Zero();
-  Vec5 b = Vec5::Zero();
+// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b). A is symmetric and kept as its upper
+// triangle, row by row (xx xy xr xg xb | yy yr yg yb | rr rg rb | gg gb | bb): 21 doubles, padded
+// to three cache lines, so that merging and reducing two quadrics touch six lines.
+struct alignas(64) Quadric {
+  std::array<double, 15> a{};
+  std::array<double, 5> b{};
   double c = 0;
   Quadric& operator+=(const Quadric& o) {
-    a += o.a, b += o.b, c += o.c;
+    for (int i = 0; i < 15; ++i) a[i] += o.a[i];
+    for (int i = 0; i < 5; ++i) b[i] += o.b[i];
+    c += o.c;
     return *this;
   }
 };
@@ -60,39 +64,79 @@ Quadric triangle_quadric(const Vec5& p, const Vec5& q, const Vec5& r) {
   e2 /= l2;
   const double area = 0.5 * std::abs((q(0) - p(0)) * (r(1) - p(1)) - (q(1) - p(1)) * (r(0) - p(0)));
   const double pe1 = p.dot(e1), pe2 = p.dot(e2);
-  out.a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
-  out.b = area * (pe1 * e1 + pe2 * e2 - p);
+  const Mat5 a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
+  for (int i = 0, n = 0; i < 5; ++i)
+    for (int j = i; j < 5; ++j) out.a[n++] = a(i, j);
+  const Vec5 b = area * (pe1 * e1 + pe2 * e2 - p);
+  for (int i = 0; i < 5; ++i) out.b[i] = b(i);
   out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
   return out;
 }
 
-// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p.
+// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p, with M
+// symmetric (m00, m01, m11).
 struct Quadric2 {
-  Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d g = Eigen::Vector2d::Zero();
-  double k = 0;
-  double operator()(const Eigen::Vector2d& p) const { return p.dot(m * p) + 2 * g.dot(p) + k; }
+  double m00 = 0, m01 = 0, m11 = 0, g0 = 0, g1 = 0, k = 0;
+  double operator()(double x, double y) const {
+    return x * (m00 * x + m01 * y) + y * (m01 * x + m11 * y) + 2 * (g0 * x + g1 * y) + k;
+  }
   Quadric2& operator+=(const Quadric2& o) {
-    m += o.m, g += o.g, k += o.k;
+    m00 += o.m00, m01 += o.m01, m11 += o.m11, g0 += o.g0, g1 += o.g1, k += o.k;
     return *this;
   }
 };
 
+// The color block of a quadric, regularized, as the adjugate C (symmetric: c00 c01 c02 c11 c12
+// c22) and determinant of Acc + 1e-9 I: (Acc + 1e-9 I)^-1 = C / det.
+struct ColorInverse {
+  double c00, c01, c02, c11, c12, c22, det;
+};
+ColorInverse color_inverse(const std::array<double, 15>& a) {
+  constexpr double kEps = 1e-9;
+  const double rr = a[9] + kEps, rg = a[10], rb = a[11], gg = a[12] + kEps, gb = a[13], bb = a[14] + kEps;
+  ColorInverse v;
+  v.c00 = gg * bb - gb * gb;
+  v.c01 = rb * gb - rg * bb;
+  v.c02 = rg * gb - rb * gg;
+  v.c11 = rr * bb - rb * rb;
+  v.c12 = rg * rb - rr * gb;
+  v.c22 = rr * gg - rg * rg;
+  v.det = rr * v.c00 + rg * v.c01 + rb * v.c02;
+  return v;
+}
+
+// Schur complement of the color block: min over colors of Q(p, colors).
 Quadric2 reduce(const Quadric& q) {
-  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix<double, 3, 2> acp = q.a.block<3, 2>(2, 0);
-  const Eigen::Matrix3d inv = acc.inverse();
+  const auto& a = q.a;
+  const ColorInverse ci = color_inverse(a);
+  // Columns x and y of the color-position block, and the color part of b.
+  const double xr = a[2], xg = a[3], xb = a[4], yr = a[6], yg = a[7], yb = a[8];
+  const double br = q.b[2], bg = q.b[3], bb = q.b[4];
+  // C times (x column, y column, b colors).
+  const double wx0 = ci.c00 * xr + ci.c01 * xg + ci.c02 * xb, wx1 = ci.c01 * xr + ci.c11 * xg + ci.c12 * xb,
+               wx2 = ci.c02 * xr + ci.c12 * xg + ci.c22 * xb;
+  const double wy0 = ci.c00 * yr + ci.c01 * yg + ci.c02 * yb, wy1 = ci.c01 * yr + ci.c11 * yg + ci.c12 * yb,
+               wy2 = ci.c02 * yr + ci.c12 * yg + ci.c22 * yb;
+  const double wb0 = ci.c00 * br + ci.c01 * bg + ci.c02 * bb, wb1 = ci.c01 * br + ci.c11 * bg + ci.c12 * bb,
+               wb2 = ci.c02 * br + ci.c12 * bg + ci.c22 * bb;
+  const double inv_det = 1 / ci.det;
   Quadric2 r;
-  r.m = q.a.block<2, 2>(0, 0) - acp.transpose() * inv * acp;
-  r.g = q.b.head<2>() - acp.transpose() * inv * q.b.tail<3>();
-  r.k = q.c - q.b.tail<3>().dot(inv * q.b.tail<3>());
+  r.m00 = a[0] - (xr * wx0 + xg * wx1 + xb * wx2) * inv_det;
+  r.m01 = a[1] - (xr * wy0 + xg * wy1 + xb * wy2) * inv_det;
+  r.m11 = a[5] - (yr * wy0 + yg * wy1 + yb * wy2) * inv_det;
+  r.g0 = q.b[0] - (xr * wb0 + xg * wb1 + xb * wb2) * inv_det;
+  r.g1 = q.b[1] - (yr * wb0 + yg * wb1 + yb * wb2) * inv_det;
+  r.k = q.c - (br * wb0 + bg * wb1 + bb * wb2) * inv_det;
   return r;
 }
 
-// Colors minimizing q at position p.
-Eigen::Vector3d best_color(const Quadric& q, const Eigen::Vector2d& p) {
-  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
-  return -acc.inverse() * (q.a.block<3, 2>(2, 0) * p + q.b.tail<3>());
+// Colors minimizing q at position (x, y).
+std::array<double, 3> best_color(const Quadric& q, double x, double y) {
+  const auto& a = q.a;
+  const ColorInverse ci = color_inverse(a);
+  const double r = a[2] * x + a[6] * y + q.b[2], g = a[3] * x + a[7] * y + q.b[3], b = a[4] * x + a[8] * y + q.b[4];
+  return {-(ci.c00 * r + ci.c01 * g + ci.c02 * b) / ci.det, -(ci.c01 * r + ci.c11 * g + ci.c12 * b) / ci.det,
+          -(ci.c02 * r + ci.c12 * g + ci.c22 * b) / ci.det};
 }
 
 int64_t edge_key(int32_t a, int32_t b) {
@@ -188,6 +232,76 @@ class QuadHeap {
   size_t size_ = 0, capacity_ = 0;
 };
 
+// A queue entry: the collapse of `remove` into `keep`, planned when the two vertices had these
+// versions. 16 bytes. Ordered by cost, then the removed and the kept vertex (determinism); the cost
+// is a non-negative float, so its bits order like the value and cost and removed vertex compare as
+// one 64-bit key. Versions are truncated: an entry that survives a wrap-around is still fully
+// re-planned and checked before it collapses anything.
+struct Entry {
+  uint64_t key;  // cost bits << 32 | remove
+  int32_t keep;
+  uint16_t version_remove, version_keep;
+  int32_t remove() const { return static_cast<int32_t>(key & 0xffffffffu); }
+  bool operator<(const Entry& o) const { return key != o.key ? key < o.key : keep < o.keep; }
+};
+
+// The lazy collapse queue: entries are never updated in place; a re-planned edge gets a new entry
+// and the old one goes stale, to be skipped when it comes out. Most entries go stale long before
+// they would reach the front, so only the front lives in a heap: entries are binned by the high
+// bits of their cost (1/16 of an octave per bin), the heap holds every entry of the bins up to
+// `front_`, and the bins above wait unsorted until the heap runs dry, when the next non-empty bin
+// is moved into the heap with its stale entries dropped. Entries come out in exactly the order of
+// one big heap, at the cost of a heap that stays small enough for the cache.
+class CollapseQueue {
+ public:
+  size_t size() const { return size_; }
+  void clear() {
+    heap_.clear();
+    for (auto& bin : bins_) std::vector<Entry>().swap(bin);
+    front_ = 0;
+    size_ = 0;
+  }
+  void push(const Entry& e) {
+    const uint32_t b = bin(e);
+    if (b <= front_) {
+      heap_.push(e);
+    } else {
+      bins_[b].push_back(e);
+    }
+    ++size_;
+  }
+  // Takes the smallest entry into `out`; false when the queue is empty. `live(e)` says whether an
+  // entry is still current; entries that are not may be dropped unseen.
+  template <class Live>
+  bool pop(Entry& out, const Live& live) {
+    while (heap_.empty()) {
+      uint32_t b = front_ + 1;
+      while (b < kBins && bins_[b].empty()) ++b;
+      if (b == kBins) return false;
+      front_ = b;
+      std::vector<Entry> entries;
+      entries.swap(bins_[b]);
+      for (const Entry& e : entries) {
+        if (live(e)) heap_.push(e);
+        else --size_;
+      }
+    }
+    out = heap_.top();
+    heap_.pop();
+    --size_;
+    return true;
+  }
+
+ private:
+  static constexpr int kShift = 32 + 19;  // float bits above the 4 leading mantissa bits
+  static constexpr uint32_t kBins = uint32_t{1} << (63 - kShift);
+  static uint32_t bin(const Entry& e) { return static_cast<uint32_t>(e.key >> kShift); }
+  QuadHeap<Entry> heap_;
+  std::vector<std::vector<Entry>> bins_ = std::vector<std::vector<Entry>>(kBins);
+  uint32_t front_ = 0;
+  size_t size_ = 0;
+};
+
 class Simplifier {
  public:
   Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options)
@@ -201,19 +315,6 @@ class Simplifier {
     int32_t remove = -1, keep = -1;
     Vec2 position;
   };
-  // A heap entry: 16 bytes, so that the lazy heap (stale entries are skipped when popped) stays
-  // cache friendly. Ordered by cost, then the removed and the kept vertex (determinism); the cost
-  // is a non-negative float, so its bits order like the value and cost and removed vertex compare
-  // as one 64-bit key. Versions are truncated: an entry that survives a wrap-around is still
-  // fully re-planned and checked before it collapses anything.
-  struct Entry {
-    uint64_t key;  // cost bits << 32 | remove
-    int32_t keep;
-    uint16_t version_remove, version_keep;
-    int32_t remove() const { return static_cast<int32_t>(key & 0xffffffffu); }
-    bool operator<(const Entry& o) const { return key != o.key ? key < o.key : keep < o.keep; }
-  };
-
   void setup();
   Plan plan(int32_t a, int32_t b) const;
   Plan plan_direction(int32_t u, int32_t v) const;
@@ -258,7 +359,7 @@ class Simplifier {
   std::vector<uint32_t> version_;
   std::vector<Quadric> quadric_;   // per color index
   std::vector<FeatureState> features_;
-  QuadHeap<Entry> heap_;
+  CollapseQueue heap_;
   int alive_vertices_ = 0;
 };
 
@@ -424,18 +525,19 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
     q += quadric_[pairs[i][1]];
     r += reduce(q);
   }
-  const Eigen::Vector2d pu(pos_[u].x, pos_[u].y), pv(pos_[v].x, pos_[v].y);
-  Eigen::Vector2d best = pv;
+  const Vec2 pu = pos_[u], pv = pos_[v];
+  Vec2 best = pv;
   if (ku == Kind::kSmooth && kv == Kind::kSmooth) {
     // Best point on the segment: R(pu + t (pv - pu)) is quadratic in t.
-    const Eigen::Vector2d d = pv - pu;
-    const double a = d.dot(r.m * d), b = 2 * (d.dot(r.m * pu) + r.g.dot(d));
+    const double dx = pv.x - pu.x, dy = pv.y - pu.y;
+    const double mdx = r.m00 * dx + r.m01 * dy, mdy = r.m01 * dx + r.m11 * dy;
+    const double a = dx * mdx + dy * mdy, b = 2 * (pu.x * mdx + pu.y * mdy + r.g0 * dx + r.g1 * dy);
     const double t = a > 1e-12 ? std::clamp(-b / (2 * a), 0.0, 1.0) : 0.5;
-    best = pu + t * d;
+    best = {pu.x + t * dx, pu.y + t * dy};
   }
-  p.cost = std::max(0.0, r(best));
+  p.cost = std::max(0.0, r(best.x, best.y));
   p.remove = u, p.keep = v;
-  p.position = {best.x(), best.y()};
+  p.position = best;
   return p;
 }
 
@@ -779,15 +881,16 @@ SimplifyStats Simplifier::run() {
   setup();
   rebuild_heap();
   size_t rebuild_at = 4 * heap_.size();
-  while (alive_vertices_ > options_.target_vertices && !heap_.empty()) {
-    const Entry e = heap_.top();
-    heap_.pop();
+  auto live = [&](const Entry& e) {
     const int32_t remove = e.remove();
-    if (!vertex_alive_[remove] || !vertex_alive_[e.keep]) continue;
-    if (static_cast<uint16_t>(version_[remove]) != e.version_remove ||
-        static_cast<uint16_t>(version_[e.keep]) != e.version_keep) {
-      continue;
-    }
+    return vertex_alive_[remove] && vertex_alive_[e.keep] &&
+           static_cast<uint16_t>(version_[remove]) == e.version_remove &&
+           static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
+  };
+  Entry e;
+  while (alive_vertices_ > options_.target_vertices && heap_.pop(e, live)) {
+    if (!live(e)) continue;
+    const int32_t remove = e.remove();
     const Plan p = plan_direction(remove, e.keep);
     if (p.remove < 0) continue;
     try_collapse(p);
@@ -819,8 +922,10 @@ void Simplifier::write_back() {
         ci = static_cast<int32_t>(color_vertex.size());
         color_vertex.push_back(tri_[f][k]);
         const Vec2 p = pos_[tri_[f][k]];
-        const Eigen::Vector3d rgb = best_color(quadric_[tcol_[f][k]], {p.x, p.y}) / options_.color_scale;
-        out.colors.push_back({static_cast<float>(rgb(0)), static_cast<float>(rgb(1)), static_cast<float>(rgb(2))});
+        const auto rgb = best_color(quadric_[tcol_[f][k]], p.x, p.y);
+        const double scale = 1 / options_.color_scale;
+        out.colors.push_back({static_cast<float>(rgb[0] * scale), static_cast<float>(rgb[1] * scale),
+                              static_cast<float>(rgb[2] * scale)});
       }
       c[k] = ci;
     }
