@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <unordered_set>
 
@@ -345,6 +346,7 @@ class Simplifier {
 
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
+  std::vector<int32_t> face_order_;  // input face of each face
   std::vector<uint8_t> face_alive_, vertex_alive_;
   std::vector<std::vector<int32_t>> vfaces_;
   std::vector<Kind> kind_;
@@ -367,14 +369,37 @@ void Simplifier::setup() {
   const MeshTopology topo = MeshTopology::build(mesh_, w_, h_);
   const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   pos_ = mesh_.positions;
-  tri_ = mesh_.triangles;
-  tcol_ = mesh_.triangle_colors;
+  // Faces and color values are renumbered to follow the vertex order, which is spatially coherent,
+  // so that a vertex's neighbourhood and its quadrics share cache lines: faces by their smallest
+  // vertex, color values by their vertex. Everything that depends on an order (incidence lists,
+  // quadric sums, the output) still follows the input order.
+  face_order_.resize(nf);
+  std::iota(face_order_.begin(), face_order_.end(), 0);
+  auto min_vertex = [&](int32_t f) { return std::min({mesh_.triangles[f][0], mesh_.triangles[f][1], mesh_.triangles[f][2]}); };
+  std::stable_sort(face_order_.begin(), face_order_.end(), [&](int32_t a, int32_t b) { return min_vertex(a) < min_vertex(b); });
+  std::vector<int32_t> face_of(nf);
+  for (int i = 0; i < nf; ++i) face_of[face_order_[i]] = i;
+  std::vector<int32_t> color_vertex(mesh_.num_colors(), 0);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) color_vertex[mesh_.triangle_colors[f][k]] = mesh_.triangles[f][k];
+  std::vector<int32_t> color_order(mesh_.num_colors());
+  std::iota(color_order.begin(), color_order.end(), 0);
+  std::stable_sort(color_order.begin(), color_order.end(),
+                   [&](int32_t a, int32_t b) { return color_vertex[a] < color_vertex[b]; });
+  std::vector<int32_t> color_of(mesh_.num_colors());
+  for (int i = 0; i < mesh_.num_colors(); ++i) color_of[color_order[i]] = i;
+  tri_.resize(nf);
+  tcol_.resize(nf);
+  for (int i = 0; i < nf; ++i) {
+    tri_[i] = mesh_.triangles[face_order_[i]];
+    for (int k = 0; k < 3; ++k) tcol_[i][k] = color_of[mesh_.triangle_colors[face_order_[i]][k]];
+  }
   face_alive_.assign(nf, 1);
   vertex_alive_.assign(nv, 1);
   alive_vertices_ = nv;
   vfaces_.assign(nv, {});
   for (int f = 0; f < nf; ++f)
-    for (int v : tri_[f]) vfaces_[v].push_back(f);
+    for (int v : mesh_.triangles[f]) vfaces_[v].push_back(face_of[f]);
   version_.assign(nv, 0);
   mark_.assign(nv, 0);
   only_color_.assign(nv, -1);
@@ -434,12 +459,12 @@ void Simplifier::setup() {
   for (int f = 0; f < nf; ++f) {
     Vec5 p[3];
     for (int k = 0; k < 3; ++k) {
-      const Vec2 x = pos_[tri_[f][k]];
-      const Color c = mesh_.colors[tcol_[f][k]];
+      const Vec2 x = pos_[mesh_.triangles[f][k]];
+      const Color c = mesh_.colors[mesh_.triangle_colors[f][k]];
       p[k] << x.x, x.y, cs * c.r, cs * c.g, cs * c.b;
     }
     const Quadric q = triangle_quadric(p[0], p[1], p[2]);
-    for (int k = 0; k < 3; ++k) quadric_[tcol_[f][k]] += q;
+    for (int k = 0; k < 3; ++k) quadric_[color_of[mesh_.triangle_colors[f][k]]] += q;
   }
 }
 
@@ -551,6 +576,13 @@ Simplifier::Plan Simplifier::plan(int32_t a, int32_t b) const {
 void Simplifier::push_edges(int32_t v) {
   thread_local std::vector<int32_t> ring;
   neighbours(v, ring);
+  // Planning is bound by fetching the neighbours' quadrics: request them all first.
+  for (int32_t w : ring) {
+    const int32_t c = only_color_[w];
+    if (c < 0) continue;
+    const char* q = reinterpret_cast<const char*>(&quadric_[c]);
+    __builtin_prefetch(q), __builtin_prefetch(q + 64), __builtin_prefetch(q + 128);
+  }
   for (int32_t w : ring) {
     push(plan(v, w));
   }
@@ -911,8 +943,9 @@ void Simplifier::write_back() {
     vmap[v] = out.num_vertices();
     out.positions.push_back(pos_[v]);
   }
-  std::vector<int32_t> color_vertex;
-  for (size_t f = 0; f < tri_.size(); ++f) {
+  std::vector<int32_t> color_vertex, face_of(tri_.size());
+  for (size_t i = 0; i < tri_.size(); ++i) face_of[face_order_[i]] = static_cast<int32_t>(i);
+  for (const int32_t f : face_of) {
     if (!face_alive_[f]) continue;
     Tri t, c;
     for (int k = 0; k < 3; ++k) {
