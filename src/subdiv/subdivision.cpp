@@ -448,6 +448,18 @@ void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<
       out);
 }
 
+void Subdivision::evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const {
+  if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
+    throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
+  }
+  impl_->refine_and_limit<2, false>(
+      [&](int i, double* v) {
+        v[0] = positions[i].x;
+        v[1] = positions[i].y;
+      },
+      out);
+}
+
 void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
   if (static_cast<int>(colors.size()) != impl_->num_control_colors) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: color count does not match the mesh");
