@@ -22,6 +22,7 @@
 #include <cstring>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <string>
 #include <unordered_set>
 
@@ -303,6 +304,49 @@ class CollapseQueue {
   size_t size_ = 0;
 };
 
+// The faces incident to each vertex, as lists in one pool (no allocation per vertex): each vertex
+// owns a slot; a list that outgrows it moves to a slot twice as large at the end of the pool. Lists
+// keep their order. Growing the pool invalidates views of every list.
+class IncidenceLists {
+ public:
+  // `counts[v]` entries will be pushed for each vertex v first.
+  void reserve(const std::vector<int32_t>& counts) {
+    start_.resize(counts.size());
+    size_.assign(counts.size(), 0);
+    capacity_.resize(counts.size());
+    size_t total = 0;
+    for (size_t v = 0; v < counts.size(); ++v) {
+      start_[v] = static_cast<int64_t>(total);
+      capacity_[v] = std::max(8, counts[v] + 2);
+      total += capacity_[v];
+    }
+    pool_.assign(total, -1);
+  }
+  std::span<const int32_t> operator[](int32_t v) const { return {pool_.data() + start_[v], size_t(size_[v])}; }
+  void push_back(int32_t v, int32_t f) {
+    if (size_[v] == capacity_[v]) {
+      const int64_t start = static_cast<int64_t>(pool_.size());
+      pool_.resize(pool_.size() + 2 * size_t(capacity_[v]));
+      std::copy_n(pool_.begin() + start_[v], size_[v], pool_.begin() + start);
+      start_[v] = start;
+      capacity_[v] *= 2;
+    }
+    pool_[start_[v] + size_[v]++] = f;
+  }
+  void erase(int32_t v, int32_t f) {
+    int32_t* first = pool_.data() + start_[v];
+    int32_t* last = first + size_[v];
+    std::copy(std::find(first, last, f) + 1, last, std::find(first, last, f));
+    --size_[v];
+  }
+  void clear(int32_t v) { size_[v] = 0; }
+
+ private:
+  std::vector<int32_t> pool_;
+  std::vector<int64_t> start_;
+  std::vector<int32_t> size_, capacity_;
+};
+
 class Simplifier {
  public:
   Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options)
@@ -348,7 +392,7 @@ class Simplifier {
   std::vector<Tri> tri_, tcol_;
   std::vector<int32_t> face_order_;  // input face of each face
   std::vector<uint8_t> face_alive_, vertex_alive_;
-  std::vector<std::vector<int32_t>> vfaces_;
+  IncidenceLists vfaces_;
   std::vector<Kind> kind_;
   std::vector<uint8_t> sides_;     // bit mask: 1 x=0, 2 y=0, 4 x=W, 8 y=H
   std::vector<int32_t> feature_;   // feature index of tear vertices, else -1
@@ -373,19 +417,23 @@ void Simplifier::setup() {
   // so that a vertex's neighbourhood and its quadrics share cache lines: faces by their smallest
   // vertex, color values by their vertex. Everything that depends on an order (incidence lists,
   // quadric sums, the output) still follows the input order.
-  face_order_.resize(nf);
-  std::iota(face_order_.begin(), face_order_.end(), 0);
-  auto min_vertex = [&](int32_t f) { return std::min({mesh_.triangles[f][0], mesh_.triangles[f][1], mesh_.triangles[f][2]}); };
-  std::stable_sort(face_order_.begin(), face_order_.end(), [&](int32_t a, int32_t b) { return min_vertex(a) < min_vertex(b); });
+  // (Stable counting sorts by vertex.)
+  auto stable_order = [nv](const std::vector<int32_t>& key) {
+    std::vector<int32_t> start(size_t(nv) + 1, 0), order(key.size());
+    for (int32_t k : key) ++start[k + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    for (size_t i = 0; i < key.size(); ++i) order[start[key[i]]++] = static_cast<int32_t>(i);
+    return order;
+  };
+  std::vector<int32_t> min_vertex(nf);
+  for (int f = 0; f < nf; ++f) min_vertex[f] = std::min({mesh_.triangles[f][0], mesh_.triangles[f][1], mesh_.triangles[f][2]});
+  face_order_ = stable_order(min_vertex);
   std::vector<int32_t> face_of(nf);
   for (int i = 0; i < nf; ++i) face_of[face_order_[i]] = i;
   std::vector<int32_t> color_vertex(mesh_.num_colors(), 0);
   for (int f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) color_vertex[mesh_.triangle_colors[f][k]] = mesh_.triangles[f][k];
-  std::vector<int32_t> color_order(mesh_.num_colors());
-  std::iota(color_order.begin(), color_order.end(), 0);
-  std::stable_sort(color_order.begin(), color_order.end(),
-                   [&](int32_t a, int32_t b) { return color_vertex[a] < color_vertex[b]; });
+  const std::vector<int32_t> color_order = stable_order(color_vertex);
   std::vector<int32_t> color_of(mesh_.num_colors());
   for (int i = 0; i < mesh_.num_colors(); ++i) color_of[color_order[i]] = i;
   tri_.resize(nf);
@@ -397,9 +445,14 @@ void Simplifier::setup() {
   face_alive_.assign(nf, 1);
   vertex_alive_.assign(nv, 1);
   alive_vertices_ = nv;
-  vfaces_.assign(nv, {});
+  {
+    std::vector<int32_t> counts(nv, 0);
+    for (const Tri& t : mesh_.triangles)
+      for (int32_t v : t) ++counts[v];
+    vfaces_.reserve(counts);
+  }
   for (int f = 0; f < nf; ++f)
-    for (int v : mesh_.triangles[f]) vfaces_[v].push_back(face_of[f]);
+    for (int v : mesh_.triangles[f]) vfaces_.push_back(v, face_of[f]);
   version_.assign(nv, 0);
   mark_.assign(nv, 0);
   only_color_.assign(nv, -1);
@@ -860,16 +913,15 @@ bool Simplifier::try_collapse(const Plan& e) {
     if (i == 1 && side[1] == side[0]) break;
     quadric_[side[i].second] += quadric_[side[i].first];
   }
-  for (int32_t f : vfaces_[u]) {
+  thread_local std::vector<int32_t> faces_of_u;
+  faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may grow the pool
+  for (int32_t f : faces_of_u) {
     Tri& t = tri_[f];
     const bool dies = t[0] == v || t[1] == v || t[2] == v;
     if (dies) {
       face_alive_[f] = 0;
-      for (int32_t w : t) {
-        if (w == u) continue;
-        auto& list = vfaces_[w];
-        list.erase(std::find(list.begin(), list.end(), f));
-      }
+      for (int32_t w : t)
+        if (w != u) vfaces_.erase(w, f);
       continue;
     }
     for (int k = 0; k < 3; ++k) {
@@ -878,9 +930,9 @@ bool Simplifier::try_collapse(const Plan& e) {
       const int32_t cu = tcol_[f][k];
       tcol_[f][k] = nfaces == 2 && side[1].first == cu ? side[1].second : side[0].second;
     }
-    vfaces_[v].push_back(f);
+    vfaces_.push_back(v, f);
   }
-  vfaces_[u].clear();
+  vfaces_.clear(u);
   vertex_alive_[u] = 0;
   --alive_vertices_;
   for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
