@@ -24,7 +24,6 @@
 #include <numeric>
 #include <span>
 #include <string>
-#include <unordered_set>
 
 #include <Eigen/Dense>
 
@@ -139,11 +138,6 @@ std::array<double, 3> best_color(const Quadric& q, double x, double y) {
   const double r = a[2] * x + a[6] * y + q.b[2], g = a[3] * x + a[7] * y + q.b[3], b = a[4] * x + a[8] * y + q.b[4];
   return {-(ci.c00 * r + ci.c01 * g + ci.c02 * b) / ci.det, -(ci.c01 * r + ci.c11 * g + ci.c12 * b) / ci.det,
           -(ci.c02 * r + ci.c12 * g + ci.c22 * b) / ci.det};
-}
-
-int64_t edge_key(int32_t a, int32_t b) {
-  if (a > b) std::swap(a, b);
-  return (int64_t{a} << 32) | static_cast<uint32_t>(b);
 }
 
 enum class Kind : uint8_t { kSmooth, kBorder, kFeature, kCorner };
@@ -376,6 +370,7 @@ class Simplifier {
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
   bool link_condition(int32_t u, int32_t v) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
+  bool tear_edge(int32_t a, int32_t b) const;
   double signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved, int num_moved) const;
   void write_back();
 
@@ -398,7 +393,7 @@ class Simplifier {
   std::vector<int32_t> feature_;   // feature index of tear vertices, else -1
   std::vector<int32_t> node_of_;   // node of tear vertices, else -1
   std::vector<Node> nodes_;
-  std::unordered_set<int64_t> tear_edges_;  // (min << 32 | max) of every feature edge
+  std::vector<int32_t> corner_node_offsets_, corner_nodes_;  // chain nodes of non-tear vertices, CSR
   std::vector<int32_t> only_color_;  // the color of a vertex with one color value, else -1
   mutable std::vector<uint32_t> mark_;  // neighbourhood scratch: vertices marked with a stamp
   mutable uint32_t stamp_ = 0;
@@ -503,7 +498,17 @@ void Simplifier::setup() {
       nodes_.push_back(node);
     }
     features_.push_back(std::move(s));
-    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) tear_edges_.insert(edge_key(f.vertices[i], f.vertices[i + 1]));
+  }
+  // Chain nodes at corners (a corner may end or join several chains), for tear edge lookups.
+  corner_node_offsets_.assign(size_t(nv) + 1, 0);
+  for (const Node& n : nodes_)
+    if (kind_[n.vertex] != Kind::kFeature) ++corner_node_offsets_[n.vertex + 1];
+  std::partial_sum(corner_node_offsets_.begin(), corner_node_offsets_.end(), corner_node_offsets_.begin());
+  corner_nodes_.resize(corner_node_offsets_.back());
+  {
+    std::vector<int32_t> fill(corner_node_offsets_.begin(), corner_node_offsets_.end() - 1);
+    for (int32_t i = 0; i < static_cast<int32_t>(nodes_.size()); ++i)
+      if (kind_[nodes_[i].vertex] != Kind::kFeature) corner_nodes_[fill[nodes_[i].vertex]++] = i;
   }
 
   // Quadrics per color index from the corners' 5D points.
@@ -544,6 +549,19 @@ int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
     }
   }
   return n;
+}
+
+// Whether (a, b) is a tear edge: consecutive in a feature chain.
+bool Simplifier::tear_edge(int32_t a, int32_t b) const {
+  auto linked = [&](int32_t node, int32_t other) {
+    const Node& n = nodes_[node];
+    return (n.prev >= 0 && nodes_[n.prev].vertex == other) || (n.next >= 0 && nodes_[n.next].vertex == other);
+  };
+  if (node_of_[a] >= 0) return linked(node_of_[a], b);
+  if (node_of_[b] >= 0) return linked(node_of_[b], a);
+  for (int32_t i = corner_node_offsets_[a]; i < corner_node_offsets_[a + 1]; ++i)
+    if (linked(corner_nodes_[i], b)) return true;
+  return false;
 }
 
 // Whether (u, v) is an edge of u's feature chain.
@@ -851,8 +869,7 @@ bool Simplifier::try_collapse(const Plan& e) {
     const int nfaces = faces_with_edge(u, v, faces);
     for (int i = 0; i < std::min(nfaces, 2); ++i) {
       for (int32_t w : tri_[faces[i]]) {
-        if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edges_.count(edge_key(u, w)) &&
-            tear_edges_.count(edge_key(v, w))) {
+        if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edge(u, w) && tear_edge(v, w)) {
           ++stats_.rejected_topology;
           return false;
         }
@@ -938,9 +955,6 @@ bool Simplifier::try_collapse(const Plan& e) {
   for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
   if (removed_node >= 0) {  // unlink the node; its two chain edges become one
     Node& n = nodes_[removed_node];
-    if (n.prev >= 0) tear_edges_.erase(edge_key(u, nodes_[n.prev].vertex));
-    if (n.next >= 0) tear_edges_.erase(edge_key(u, nodes_[n.next].vertex));
-    if (n.prev >= 0 && n.next >= 0) tear_edges_.insert(edge_key(nodes_[n.prev].vertex, nodes_[n.next].vertex));
     FeatureState& f = features_[feature_[u]];
     if (n.prev >= 0) nodes_[n.prev].next = n.next;
     if (n.next >= 0) nodes_[n.next].prev = n.prev;
