@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -27,6 +28,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/parallel_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
@@ -298,46 +300,69 @@ class CollapseQueue {
   size_t size_ = 0;
 };
 
-// The faces incident to each vertex, as lists in one pool (no allocation per vertex): each vertex
-// owns a slot; a list that outgrows it moves to a slot twice as large at the end of the pool. Lists
-// keep their order. Growing the pool invalidates views of every list.
+// Blocks of int32 that never move, handed out in order: one per worker, so that lists can grow
+// on several threads at once.
+class Arena {
+ public:
+  int32_t* take(size_t n) {
+    if (n > left_) {
+      const size_t size = std::max<size_t>(n, 1 << 16);
+      chunks_.push_back(std::make_unique<int32_t[]>(size));
+      next_ = chunks_.back().get();
+      left_ = size;
+    }
+    int32_t* out = next_;
+    next_ += n, left_ -= n;
+    return out;
+  }
+
+ private:
+  std::vector<std::unique_ptr<int32_t[]>> chunks_;
+  int32_t* next_ = nullptr;
+  size_t left_ = 0;
+};
+
+// The faces incident to each vertex: lists laid out in vertex order in one block, each with room to
+// grow; a full list moves to a block twice as large from the caller's arena. Lists keep their
+// order; growing a list invalidates views of it.
 class IncidenceLists {
  public:
   // `counts[v]` entries will be pushed for each vertex v first.
   void reserve(const std::vector<int32_t>& counts) {
-    start_.resize(counts.size());
+    data_.resize(counts.size());
     size_.assign(counts.size(), 0);
     capacity_.resize(counts.size());
     size_t total = 0;
     for (size_t v = 0; v < counts.size(); ++v) {
-      start_[v] = static_cast<int64_t>(total);
       capacity_[v] = std::max(8, counts[v] + 2);
       total += capacity_[v];
     }
-    pool_.assign(total, -1);
+    pool_ = std::make_unique<int32_t[]>(total);
+    total = 0;
+    for (size_t v = 0; v < counts.size(); ++v) data_[v] = pool_.get() + total, total += capacity_[v];
   }
-  std::span<const int32_t> operator[](int32_t v) const { return {pool_.data() + start_[v], size_t(size_[v])}; }
-  void push_back(int32_t v, int32_t f) {
+  std::span<const int32_t> operator[](int32_t v) const { return {data_[v], size_t(size_[v])}; }
+  void push_back(int32_t v, int32_t f, Arena& arena) {
     if (size_[v] == capacity_[v]) {
-      const int64_t start = static_cast<int64_t>(pool_.size());
-      pool_.resize(pool_.size() + 2 * size_t(capacity_[v]));
-      std::copy_n(pool_.begin() + start_[v], size_[v], pool_.begin() + start);
-      start_[v] = start;
+      int32_t* data = arena.take(2 * size_t(capacity_[v]));
+      std::copy_n(data_[v], size_[v], data);
+      data_[v] = data;
       capacity_[v] *= 2;
     }
-    pool_[start_[v] + size_[v]++] = f;
+    data_[v][size_[v]++] = f;
   }
   void erase(int32_t v, int32_t f) {
-    int32_t* first = pool_.data() + start_[v];
+    int32_t* first = data_[v];
     int32_t* last = first + size_[v];
-    std::copy(std::find(first, last, f) + 1, last, std::find(first, last, f));
+    int32_t* at = std::find(first, last, f);
+    std::copy(at + 1, last, at);
     --size_[v];
   }
   void clear(int32_t v) { size_[v] = 0; }
 
  private:
-  std::vector<int32_t> pool_;
-  std::vector<int64_t> start_;
+  std::unique_ptr<int32_t[]> pool_;
+  std::vector<int32_t*> data_;
   std::vector<int32_t> size_, capacity_;
 };
 
@@ -354,21 +379,40 @@ class Simplifier {
     int32_t remove = -1, keep = -1;
     Vec2 position;
   };
+  // Who simplifies what: one worker per region in the parallel phase, one for the whole mesh
+  // after. A worker collapses and moves only vertices it owns and reads its neighbourhood, which
+  // nobody else writes meanwhile; it has its own queue, statistics and scratch space.
+  struct Worker {
+    int32_t region = -1;  // -1: every vertex
+    int64_t alive = 0;    // live vertices of the region
+    int64_t stop = 0;     // simplify down to this many
+    CollapseQueue queue;
+    SimplifyStats stats;
+    Arena arena;
+    std::vector<uint32_t> mark;  // vertices marked with a stamp (neighbourhood queries)
+    uint32_t stamp = 0;
+    std::vector<int32_t> ring, faces;
+    uint32_t next_stamp() {
+      if (++stamp == 0) std::fill(mark.begin(), mark.end(), 0u), stamp = 1;
+      return stamp;
+    }
+  };
+
   void setup();
+  void split_regions(int num_regions_x, int num_regions_y);
+  bool owns(const Worker& w, int32_t v) const { return w.region < 0 || (region_[v] == w.region && !frozen_[v]); }
+  bool owns_window(const Worker& w, int32_t removed_node) const;
+  void simplify_with(Worker& w);
   Plan plan(int32_t a, int32_t b) const;
   Plan plan_direction(int32_t u, int32_t v) const;
-  void push_edges(int32_t v);
-  bool try_collapse(const Plan& e);
-  void push(const Plan& p);
-  void rebuild_heap();
-  void neighbours(int32_t v, std::vector<int32_t>& out) const;
-  uint32_t next_stamp() const {
-    if (++stamp_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), stamp_ = 1;
-    return stamp_;
-  }
+  void push_edges(Worker& w, int32_t v);
+  bool try_collapse(Worker& w, const Plan& e);
+  void push(Worker& w, const Plan& p);
+  void rebuild_queue(Worker& w);
+  void neighbours(Worker& w, int32_t v, std::vector<int32_t>& out) const;
   bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
-  bool link_condition(int32_t u, int32_t v) const;
+  bool link_condition(Worker& w, int32_t u, int32_t v) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
   bool tear_edge(int32_t a, int32_t b) const;
   double signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved, int num_moved) const;
@@ -381,7 +425,6 @@ class Simplifier {
   ControlMesh& mesh_;
   int w_, h_;
   SimplifyOptions options_;
-  SimplifyStats stats_;
 
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
@@ -395,13 +438,12 @@ class Simplifier {
   std::vector<Node> nodes_;
   std::vector<int32_t> corner_node_offsets_, corner_nodes_;  // chain nodes of non-tear vertices, CSR
   std::vector<int32_t> only_color_;  // the color of a vertex with one color value, else -1
-  mutable std::vector<uint32_t> mark_;  // neighbourhood scratch: vertices marked with a stamp
-  mutable uint32_t stamp_ = 0;
   std::vector<uint32_t> version_;
   std::vector<Quadric> quadric_;   // per color index
   std::vector<FeatureState> features_;
-  CollapseQueue heap_;
-  int alive_vertices_ = 0;
+  std::vector<Arena> arenas_;     // where incidence lists grew
+  std::vector<int16_t> region_;   // region of each vertex in the parallel phase
+  std::vector<uint8_t> frozen_;   // left alone in the parallel phase (seams, shared closed features)
 };
 
 void Simplifier::setup() {
@@ -439,17 +481,16 @@ void Simplifier::setup() {
   }
   face_alive_.assign(nf, 1);
   vertex_alive_.assign(nv, 1);
-  alive_vertices_ = nv;
   {
     std::vector<int32_t> counts(nv, 0);
     for (const Tri& t : mesh_.triangles)
       for (int32_t v : t) ++counts[v];
     vfaces_.reserve(counts);
   }
+  Arena& arena = arenas_.emplace_back();  // (unused: the lists have room)
   for (int f = 0; f < nf; ++f)
-    for (int v : mesh_.triangles[f]) vfaces_.push_back(v, face_of[f]);
+    for (int v : mesh_.triangles[f]) vfaces_.push_back(v, face_of[f], arena);
   version_.assign(nv, 0);
-  mark_.assign(nv, 0);
   only_color_.assign(nv, -1);
   std::vector<uint8_t> seen(nv, 0);
   for (int f = 0; f < nf; ++f) {
@@ -527,13 +568,13 @@ void Simplifier::setup() {
 }
 
 // The distinct neighbours of v, in no particular order.
-void Simplifier::neighbours(int32_t v, std::vector<int32_t>& out) const {
+void Simplifier::neighbours(Worker& worker, int32_t v, std::vector<int32_t>& out) const {
   out.clear();
-  const uint32_t stamp = next_stamp();
+  const uint32_t stamp = worker.next_stamp();
   for (int32_t f : vfaces_[v]) {
     for (int32_t w : tri_[f]) {
-      if (w == v || mark_[w] == stamp) continue;
-      mark_[w] = stamp;
+      if (w == v || worker.mark[w] == stamp) continue;
+      worker.mark[w] = stamp;
       out.push_back(w);
     }
   }
@@ -644,9 +685,11 @@ Simplifier::Plan Simplifier::plan(int32_t a, int32_t b) const {
   return q.cost < p.cost ? q : p;
 }
 
-void Simplifier::push_edges(int32_t v) {
-  thread_local std::vector<int32_t> ring;
-  neighbours(v, ring);
+// Plans the edges from v to the neighbours the worker owns (v is one of its own).
+void Simplifier::push_edges(Worker& worker, int32_t v) {
+  std::vector<int32_t>& ring = worker.ring;
+  neighbours(worker, v, ring);
+  std::erase_if(ring, [&](int32_t w) { return !owns(worker, w); });
   // Planning is bound by fetching the neighbours' quadrics: request them all first.
   for (int32_t w : ring) {
     const int32_t c = only_color_[w];
@@ -655,39 +698,39 @@ void Simplifier::push_edges(int32_t v) {
     __builtin_prefetch(q), __builtin_prefetch(q + 64), __builtin_prefetch(q + 128);
   }
   for (int32_t w : ring) {
-    push(plan(v, w));
+    push(worker, plan(v, w));
   }
 }
 
-void Simplifier::push(const Plan& p) {
+void Simplifier::push(Worker& worker, const Plan& p) {
   if (p.remove < 0 || !std::isfinite(p.cost)) return;
   const uint64_t cost_bits = std::bit_cast<uint32_t>(static_cast<float>(p.cost));
-  heap_.push({cost_bits << 32 | static_cast<uint32_t>(p.remove), p.keep, static_cast<uint16_t>(version_[p.remove]),
+  worker.queue.push({cost_bits << 32 | static_cast<uint32_t>(p.remove), p.keep, static_cast<uint16_t>(version_[p.remove]),
               static_cast<uint16_t>(version_[p.keep])});
 }
 
-// Re-plans every live edge into a fresh heap, dropping the stale entries that pile up.
-void Simplifier::rebuild_heap() {
-  heap_.clear();
-  thread_local std::vector<int32_t> ring;
+// Re-plans every live edge of the worker into a fresh queue, dropping the stale entries that pile up.
+void Simplifier::rebuild_queue(Worker& worker) {
+  worker.queue.clear();
+  std::vector<int32_t>& ring = worker.ring;
   for (int32_t v = 0; v < static_cast<int32_t>(pos_.size()); ++v) {
-    if (!vertex_alive_[v]) continue;
-    neighbours(v, ring);
+    if (!vertex_alive_[v] || !owns(worker, v)) continue;
+    neighbours(worker, v, ring);
     for (int32_t w : ring)
-      if (w > v) push(plan(v, w));
+      if (w > v && owns(worker, w)) push(worker, plan(v, w));
   }
 }
 
-bool Simplifier::link_condition(int32_t u, int32_t v) const {
+bool Simplifier::link_condition(Worker& worker, int32_t u, int32_t v) const {
   // Mark u's neighbours, then count v's marked ones, each once.
-  const uint32_t of_u = next_stamp(), counted = next_stamp();
+  const uint32_t of_u = worker.next_stamp(), counted = worker.next_stamp();
   for (int32_t f : vfaces_[u])
-    for (int32_t w : tri_[f]) mark_[w] = of_u;
+    for (int32_t w : tri_[f]) worker.mark[w] = of_u;
   int common = 0;
   for (int32_t f : vfaces_[v]) {
     for (int32_t w : tri_[f]) {
-      if (w == u || w == v || mark_[w] != of_u) continue;
-      mark_[w] = counted;
+      if (w == u || w == v || worker.mark[w] != of_u) continue;
+      worker.mark[w] = counted;
       ++common;
     }
   }
@@ -857,10 +900,14 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
   return worst;
 }
 
-bool Simplifier::try_collapse(const Plan& e) {
+bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   const int32_t u = e.remove, v = e.keep;
-  if (!link_condition(u, v)) {
-    ++stats_.rejected_topology;
+  SimplifyStats& stats = worker.stats;
+  // A collapse along a feature refits nodes up to five away: they must all be the worker's.
+  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
+  if (removed_node >= 0 && !owns_window(worker, removed_node)) return false;
+  if (!link_condition(worker, u, v)) {
+    ++stats.rejected_topology;
     return false;
   }
   // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
@@ -870,7 +917,7 @@ bool Simplifier::try_collapse(const Plan& e) {
     for (int i = 0; i < std::min(nfaces, 2); ++i) {
       for (int32_t w : tri_[faces[i]]) {
         if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edge(u, w) && tear_edge(v, w)) {
-          ++stats_.rejected_topology;
+          ++stats.rejected_topology;
           return false;
         }
       }
@@ -882,14 +929,13 @@ bool Simplifier::try_collapse(const Plan& e) {
   moved[num_moved++] = {v, e.position};
 
   // A collapse along a feature: the chain loses u, then its neighbourhood is refitted.
-  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
   if (removed_node >= 0) {
     const double error = refit(removed_node, moved, num_moved);
     if (error > options_.max_feature_error) {
-      ++stats_.rejected_feature;
+      ++stats.rejected_feature;
       return false;
     }
-    stats_.max_feature_error = std::max(stats_.max_feature_error, error);
+    stats.max_feature_error = std::max(stats.max_feature_error, error);
   }
 
   // No flipped or degenerate triangle among everything that moves.
@@ -911,7 +957,7 @@ bool Simplifier::try_collapse(const Plan& e) {
   };
   for (int i = 0; i < num_moved; ++i) {
     if (!faces_ok(moved[i].first)) {
-      ++stats_.rejected_topology;
+      ++stats.rejected_topology;
       return false;
     }
   }
@@ -930,8 +976,8 @@ bool Simplifier::try_collapse(const Plan& e) {
     if (i == 1 && side[1] == side[0]) break;
     quadric_[side[i].second] += quadric_[side[i].first];
   }
-  thread_local std::vector<int32_t> faces_of_u;
-  faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may grow the pool
+  std::vector<int32_t>& faces_of_u = worker.faces;
+  faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may move
   for (int32_t f : faces_of_u) {
     Tri& t = tri_[f];
     const bool dies = t[0] == v || t[1] == v || t[2] == v;
@@ -947,11 +993,11 @@ bool Simplifier::try_collapse(const Plan& e) {
       const int32_t cu = tcol_[f][k];
       tcol_[f][k] = nfaces == 2 && side[1].first == cu ? side[1].second : side[0].second;
     }
-    vfaces_.push_back(v, f);
+    vfaces_.push_back(v, f, worker.arena);
   }
   vfaces_.clear(u);
   vertex_alive_[u] = 0;
-  --alive_vertices_;
+  --worker.alive;
   for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
   if (removed_node >= 0) {  // unlink the node; its two chain edges become one
     Node& n = nodes_[removed_node];
@@ -960,25 +1006,26 @@ bool Simplifier::try_collapse(const Plan& e) {
     if (n.next >= 0) nodes_[n.next].prev = n.prev;
     if (f.head == removed_node) f.head = n.next;
     n.alive = false;
-    --f.size;
+    std::atomic_ref<int32_t>(f.size).fetch_sub(1, std::memory_order_relaxed);  // an open chain may span workers
     node_of_[u] = -1;
   }
-  ++stats_.collapses;
+  ++stats.collapses;
 
   // Costs change around v and every moved vertex.
   ++version_[v];
-  push_edges(v);
+  push_edges(worker, v);
   for (int i = 2; i < num_moved; ++i) {
     ++version_[moved[i].first];
-    push_edges(moved[i].first);
+    push_edges(worker, moved[i].first);
   }
   return true;
 }
 
-SimplifyStats Simplifier::run() {
-  setup();
-  rebuild_heap();
-  size_t rebuild_at = 4 * heap_.size();
+// Greedy collapses, cheapest first, of the worker's edges until it is down to w.stop vertices.
+void Simplifier::simplify_with(Worker& worker) {
+  worker.mark.assign(pos_.size(), 0);
+  rebuild_queue(worker);
+  size_t rebuild_at = 4 * worker.queue.size();
   auto live = [&](const Entry& e) {
     const int32_t remove = e.remove();
     return vertex_alive_[remove] && vertex_alive_[e.keep] &&
@@ -986,19 +1033,110 @@ SimplifyStats Simplifier::run() {
            static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
   };
   Entry e;
-  while (alive_vertices_ > options_.target_vertices && heap_.pop(e, live)) {
+  while (worker.alive > worker.stop && worker.queue.pop(e, live)) {
     if (!live(e)) continue;
     const int32_t remove = e.remove();
     const Plan p = plan_direction(remove, e.keep);
     if (p.remove < 0) continue;
-    try_collapse(p);
-    if (heap_.size() > rebuild_at) {
-      rebuild_heap();
-      rebuild_at = std::max<size_t>(4 * heap_.size(), 1024);
+    try_collapse(worker, p);
+    if (worker.queue.size() > rebuild_at) {
+      rebuild_queue(worker);
+      rebuild_at = std::max<size_t>(4 * worker.queue.size(), 1024);
     }
   }
+  worker.mark = {};
+}
+
+SimplifyStats Simplifier::run() {
+  setup();
+  const int64_t target = options_.target_vertices;
+  SimplifyStats stats;
+  auto merge = [&](const SimplifyStats& s) {
+    stats.collapses += s.collapses;
+    stats.rejected_topology += s.rejected_topology;
+    stats.rejected_feature += s.rejected_feature;
+    stats.max_feature_error = std::max(stats.max_feature_error, s.max_feature_error);
+  };
+
+  // Parallel phase (deterministic whatever the thread count): the image is cut into a fixed grid of
+  // regions, and each region is simplified on its own, its seams frozen, down to `target`
+  // vertices plus its frozen ones. The collapses of a region do not depend on the other regions,
+  // and however the final vertices are shared among regions, none ends with more than `target`:
+  // so this is the start of what one global pass would do in the region, up to the seams.
+  constexpr int kRegionsX = 2, kRegionsY = 2;
+  const int64_t nv = static_cast<int64_t>(pos_.size());
+  if (nv > 4 * kRegionsX * kRegionsY * target) {
+    split_regions(kRegionsX, kRegionsY);
+    std::vector<Worker> workers(kRegionsX * kRegionsY);
+    for (int64_t v = 0; v < nv; ++v) {
+      Worker& w = workers[region_[v]];
+      ++w.alive;
+      w.stop += frozen_[v];
+    }
+    for (size_t r = 0; r < workers.size(); ++r) {
+      workers[r].region = static_cast<int32_t>(r);
+      workers[r].stop += target;
+    }
+    detail::parallel_for(static_cast<int>(workers.size()), options_.threads, [&](int r) { simplify_with(workers[r]); });
+    for (Worker& w : workers) {
+      merge(w.stats);
+      arenas_.push_back(std::move(w.arena));
+    }
+  }
+
+  // Then everything, one collapse at a time.
+  Worker all;
+  for (int64_t v = 0; v < nv; ++v) all.alive += vertex_alive_[v];
+  all.stop = target;
+  simplify_with(all);
+  merge(all.stats);
   write_back();
-  return stats_;
+  return stats;
+}
+
+// Regions: a grid of nx x ny rectangles of the image by initial position. Frozen: every vertex with
+// a neighbour in another region (the seams), and every vertex of a closed feature that is not all
+// within one region's unfrozen vertices (its length is shared state).
+void Simplifier::split_regions(int nx, int ny) {
+  const int32_t nv = static_cast<int32_t>(pos_.size());
+  region_.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) {
+    const int rx = std::clamp(static_cast<int>(pos_[v].x * nx / w_), 0, nx - 1);
+    const int ry = std::clamp(static_cast<int>(pos_[v].y * ny / h_), 0, ny - 1);
+    region_[v] = static_cast<int16_t>(ry * nx + rx);
+  }
+  frozen_.assign(nv, 0);
+  for (const Tri& t : tri_) {
+    if (region_[t[0]] == region_[t[1]] && region_[t[1]] == region_[t[2]]) continue;
+    for (int32_t v : t) frozen_[v] = 1;
+  }
+  for (const FeatureState& f : features_) {
+    if (!f.closed) continue;
+    bool shared = false;
+    int32_t n = f.head;
+    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) {
+      const int32_t v = nodes_[n].vertex;
+      shared |= frozen_[v] || region_[v] != region_[nodes_[f.head].vertex];
+    }
+    if (!shared) continue;
+    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) frozen_[nodes_[n].vertex] = 1;
+  }
+}
+
+// Whether every node that the refit after removing `removed_node` reads or moves is the worker's
+// (the same walk as refit(): five nodes each way, stopping at corners).
+bool Simplifier::owns_window(const Worker& worker, int32_t removed_node) const {
+  if (worker.region < 0) return true;
+  constexpr int kReach = 5;
+  for (int direction = 0; direction < 2; ++direction) {
+    int count = 0;
+    for (int32_t n = direction ? nodes_[removed_node].next : nodes_[removed_node].prev; n >= 0 && n != removed_node;
+         n = direction ? nodes_[n].next : nodes_[n].prev) {
+      if (!owns(worker, nodes_[n].vertex)) return false;
+      if (kind_[nodes_[n].vertex] == Kind::kCorner || ++count == kReach) break;
+    }
+  }
+  return true;
 }
 
 void Simplifier::write_back() {
