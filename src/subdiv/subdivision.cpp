@@ -556,8 +556,8 @@ Masks group_masks(const std::vector<Eigen::Triplet<double, int32_t>>& triplets, 
 
 // out = masks x in, for the rows listed in `rows` (in that order), through a dense accumulator over
 // the control values; exact zeros are dropped, and columns come out sorted when `sorted`.
-StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
-                    bool sorted) {
+StencilRows compose_rows(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
+                         bool sorted) {
   StencilRows out;
   out.offsets.reserve(rows.size() + 1);
   out.columns.reserve(rows.size() * 12);
@@ -586,6 +586,31 @@ StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const i
       seen[c] = 0;
     }
     out.offsets.push_back(static_cast<int32_t>(out.columns.size()));
+  }
+  return out;
+}
+
+// compose_rows() with large row sets split over all cores; rows are independent, so the result is
+// the same for any split.
+StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
+                    bool sorted) {
+  const int parts = rows.size() < 65536 ? 1 : resolve_threads(0);
+  if (parts == 1) return compose_rows(masks, in, rows, num_control, sorted);
+  std::vector<StencilRows> part(parts);
+  std::vector<std::thread> pool;
+  auto run = [&](int i) {
+    const size_t begin = rows.size() * i / parts, end = rows.size() * (i + 1) / parts;
+    part[i] = compose_rows(masks, in, rows.subspan(begin, end - begin), num_control, sorted);
+  };
+  for (int i = 1; i < parts; ++i) pool.emplace_back(run, i);
+  run(0);
+  for (std::thread& t : pool) t.join();
+  StencilRows out = std::move(part[0]);
+  for (int i = 1; i < parts; ++i) {
+    const int32_t base = static_cast<int32_t>(out.columns.size());
+    for (size_t r = 1; r < part[i].offsets.size(); ++r) out.offsets.push_back(base + part[i].offsets[r]);
+    out.columns.insert(out.columns.end(), part[i].columns.begin(), part[i].columns.end());
+    out.weights.insert(out.weights.end(), part[i].weights.begin(), part[i].weights.end());
   }
   return out;
 }
