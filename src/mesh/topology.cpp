@@ -53,9 +53,27 @@ MeshTopology MeshTopology::build(const ControlMesh& mesh, int width, int height)
       half[size_t(f) * 3 + k] = {edge_key(a, b), f, static_cast<int8_t>(k)};
     }
   }
-  std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
-    return x.key != y.key ? x.key < y.key : x.face < y.face;
-  });
+  // Order by (key, face): a counting sort on the smaller vertex (stable, so faces stay in order),
+  // then each vertex's handful of half-edges by the larger one.
+  {
+    std::vector<int32_t> start(size_t(nv) + 1, 0);
+    for (const HalfEdge& h : half) ++start[(h.key >> 32) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<HalfEdge> sorted(half.size());
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (const HalfEdge& h : half) sorted[fill[h.key >> 32]++] = h;
+    for (int v = 0; v < nv; ++v) {
+      HalfEdge* first = sorted.data() + start[v];
+      HalfEdge* last = sorted.data() + start[v + 1];
+      for (HalfEdge* i = first + 1; i < last; ++i) {  // stable insertion sort by key
+        const HalfEdge h = *i;
+        HalfEdge* j = i;
+        for (; j > first && (j - 1)->key > h.key; --j) *j = *(j - 1);
+        *j = h;
+      }
+    }
+    half = std::move(sorted);
+  }
 
   t.face_edges.assign(nf, {-1, -1, -1});
   for (size_t i = 0; i < half.size();) {

@@ -12,7 +12,6 @@
 #include <opensubdiv/far/patchTableFactory.h>
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/stencilTable.h>
-#include <opensubdiv/far/stencilTableFactory.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefiner.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
@@ -39,7 +38,8 @@ using Value2 = Value<2>;
 using Value3 = Value<3>;
 
 // Primvar stand-ins that record weights instead of values: reading vertex j yields "unit j", and
-// the destination row collects (j, weight) triplets. Used to turn the limit masks into a matrix.
+// the destination row collects (j, weight) triplets. Used to turn the refinement and limit masks
+// into matrices.
 struct UnitRef {
   int index;
 };
@@ -52,6 +52,11 @@ struct TripletRow {
   void Clear(void* = nullptr) {}
   void AddWithWeight(const UnitRef& src, double weight) {
     if (weight != 0) triplets->emplace_back(row, src.index, weight);
+  }
+  // Face-varying refinement of quad schemes reads back values it has just written (face points);
+  // the Loop scheme never does.
+  void AddWithWeight(const TripletRow&, double) {
+    throw Error(ErrorCode::kInvalidArgument, "stencils: a mask refers to a refined value (not a Loop mask)");
   }
 };
 struct TripletSink {
@@ -443,6 +448,18 @@ void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<
       out);
 }
 
+void Subdivision::evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const {
+  if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
+    throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
+  }
+  impl_->refine_and_limit<2, false>(
+      [&](int i, double* v) {
+        v[0] = positions[i].x;
+        v[1] = positions[i].y;
+      },
+      out);
+}
+
 void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
   if (static_cast<int>(colors.size()) != impl_->num_control_colors) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: color count does not match the mesh");
@@ -506,92 +523,156 @@ void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Colo
   }
 }
 
-// Limit stencils = (limit masks at the last level) x (refinement stencils to the last level),
-// restricted to the output rows and expressed over the full control index space.
+namespace {
+
+// Sparse rows over the control values, in CSR form.
+struct StencilRows {
+  std::vector<int32_t> offsets{0}, columns;
+  std::vector<double> weights;
+  int num_rows() const { return static_cast<int>(offsets.size()) - 1; }
+};
+
+// Masks recorded from PrimvarRefiner (destination value, source value, weight), grouped by
+// destination in CSR form. PrimvarRefiner visits each destination once, but not in index order.
+struct Masks {
+  std::vector<int32_t> offsets, sources;
+  std::vector<double> weights;
+};
+Masks group_masks(const std::vector<Eigen::Triplet<double, int32_t>>& triplets, int num_rows) {
+  Masks m;
+  m.offsets.assign(size_t(num_rows) + 1, 0);
+  for (const auto& t : triplets) ++m.offsets[t.row() + 1];
+  std::partial_sum(m.offsets.begin(), m.offsets.end(), m.offsets.begin());
+  std::vector<int32_t> fill(m.offsets.begin(), m.offsets.end() - 1);
+  m.sources.resize(triplets.size());
+  m.weights.resize(triplets.size());
+  for (const auto& t : triplets) {
+    const int32_t k = fill[t.row()]++;
+    m.sources[k] = t.col();
+    m.weights[k] = t.value();
+  }
+  return m;
+}
+
+// out = masks x in, for the rows listed in `rows` (in that order), through a dense accumulator over
+// the control values; exact zeros are dropped, and columns come out sorted when `sorted`.
+StencilRows compose_rows(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
+                         bool sorted) {
+  StencilRows out;
+  out.offsets.reserve(rows.size() + 1);
+  out.columns.reserve(rows.size() * 12);
+  out.weights.reserve(rows.size() * 12);
+  std::vector<double> acc(num_control, 0.0);
+  std::vector<uint8_t> seen(num_control, 0);
+  std::vector<int32_t> touched(num_control + 1);
+  for (const int32_t r : rows) {
+    size_t num_touched = 0;
+    for (int32_t e = masks.offsets[r]; e < masks.offsets[r + 1]; ++e) {
+      const int32_t j = masks.sources[e];
+      const double w = masks.weights[e];
+      for (int32_t k = in.offsets[j]; k < in.offsets[j + 1]; ++k) {
+        const int32_t c = in.columns[k];
+        touched[num_touched] = c;  // kept only the first time c is seen
+        num_touched += seen[c] ^ 1;
+        seen[c] = 1;
+        acc[c] += w * in.weights[k];
+      }
+    }
+    if (sorted) std::sort(touched.begin(), touched.begin() + num_touched);
+    for (size_t i = 0; i < num_touched; ++i) {
+      const int32_t c = touched[i];
+      if (acc[c] != 0.0) out.columns.push_back(c), out.weights.push_back(acc[c]);
+      acc[c] = 0.0;
+      seen[c] = 0;
+    }
+    out.offsets.push_back(static_cast<int32_t>(out.columns.size()));
+  }
+  return out;
+}
+
+// compose_rows() with large row sets split over all cores; rows are independent, so the result is
+// the same for any split.
+StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
+                    bool sorted) {
+  const int parts = rows.size() < 65536 ? 1 : resolve_threads(0);
+  if (parts == 1) return compose_rows(masks, in, rows, num_control, sorted);
+  std::vector<StencilRows> part(parts);
+  std::vector<std::thread> pool;
+  auto run = [&](int i) {
+    const size_t begin = rows.size() * i / parts, end = rows.size() * (i + 1) / parts;
+    part[i] = compose_rows(masks, in, rows.subspan(begin, end - begin), num_control, sorted);
+  };
+  for (int i = 1; i < parts; ++i) pool.emplace_back(run, i);
+  run(0);
+  for (std::thread& t : pool) t.join();
+  StencilRows out = std::move(part[0]);
+  for (int i = 1; i < parts; ++i) {
+    const int32_t base = static_cast<int32_t>(out.columns.size());
+    for (size_t r = 1; r < part[i].offsets.size(); ++r) out.offsets.push_back(base + part[i].offsets[r]);
+    out.columns.insert(out.columns.end(), part[i].columns.begin(), part[i].columns.end());
+    out.weights.insert(out.weights.end(), part[i].weights.begin(), part[i].weights.end());
+  }
+  return out;
+}
+
+}  // namespace
+
+// Limit stencils = (limit masks at the last level) x (refinement masks of each level) x ... x
+// (the sub-mesh's values as control values), restricted to the output rows and expressed over the
+// full control index space. The masks come from PrimvarRefiner applied to "unit" values that
+// record their weights; composing them level by level keeps every row as short as its support.
 SparseMatrix Subdivision::Impl::limit_stencils(bool face_varying) const {
   using Triplet = Eigen::Triplet<double, int32_t>;
-  const Far::TopologyLevel& last = refiner->GetLevel(depth);
-  const int num_last = face_varying ? last.GetNumFVarValues(0) : last.GetNumVertices();
   const std::vector<int32_t>& base_map = face_varying ? sub.colors : sub.vertices;
   const int num_control = face_varying ? num_control_colors : num_control_vertices;
+  const auto count = [&](int level) {
+    const Far::TopologyLevel& l = refiner->GetLevel(level);
+    return face_varying ? l.GetNumFVarValues(0) : l.GetNumVertices();
+  };
 
-  // Refinement as CSR arrays: last-level value j = sum over k of weights[k] * control[columns[k]].
-  std::vector<int32_t> refine_offsets(size_t(num_last) + 1, 0), refine_columns;
-  std::vector<double> refine_weights;
-  if (depth == 0) {
-    std::iota(refine_offsets.begin(), refine_offsets.end(), 0);
-    refine_columns.assign(base_map.begin(), base_map.end());
-    refine_weights.assign(num_last, 1.0);
-  } else {
-    Far::StencilTableFactoryReal<double>::Options options;
-    options.interpolationMode = face_varying ? Far::StencilTableFactoryReal<double>::INTERPOLATE_FACE_VARYING
-                                             : Far::StencilTableFactoryReal<double>::INTERPOLATE_VERTEX;
-    options.generateOffsets = true;
-    options.generateIntermediateLevels = false;
-    options.fvarChannel = 0;
-    std::unique_ptr<const Far::StencilTableReal<double>> table(
-        Far::StencilTableFactoryReal<double>::Create(*refiner, options));
-    const auto& sizes = table->GetSizes();
-    const auto& offsets = table->GetOffsets();
-    const auto& indices = table->GetControlIndices();
-    refine_weights = table->GetWeights();
-    refine_columns.resize(indices.size());
-    for (size_t k = 0; k < indices.size(); ++k) refine_columns[k] = base_map[indices[k]];
-    for (int j = 0; j < num_last; ++j) refine_offsets[j + 1] = offsets[j] + sizes[j];
+  // Level 0: each sub-mesh value is one control value.
+  StencilRows rows;
+  rows.offsets.resize(base_map.size() + 1);
+  std::iota(rows.offsets.begin(), rows.offsets.end(), 0);
+  rows.columns.assign(base_map.begin(), base_map.end());
+  rows.weights.assign(base_map.size(), 1.0);
+
+  Far::PrimvarRefinerReal<double> primvar(*refiner);
+  std::vector<Triplet> triplets;
+  std::vector<int32_t> all;
+  UnitSource src;
+  TripletSink sink{&triplets};
+  for (int level = 1; level <= depth; ++level) {
+    triplets.clear();
+    triplets.reserve(size_t(count(level)) * 6);
+    if (face_varying) {
+      primvar.InterpolateFaceVarying(level, src, sink, 0);
+    } else {
+      primvar.Interpolate(level, src, sink);
+    }
+    all.resize(count(level));
+    std::iota(all.begin(), all.end(), 0);
+    rows = compose(group_masks(triplets, count(level)), rows, all, num_control, false);
   }
 
-  // Limit masks at the last level (the identity without the limit push). The sink receives each
-  // vertex's weights in vertex order, so the triplets are already grouped by row.
-  std::vector<Triplet> limit;
-  limit.reserve(size_t(num_last) * 8);
+  // Limit masks at the last level (the identity without the limit push), for the output rows.
+  const int num_last = count(depth);
+  triplets.clear();
   if (push_to_limit) {
-    Far::PrimvarRefinerReal<double> primvar(*refiner);
-    UnitSource src;
-    TripletSink sink{&limit};
+    triplets.reserve(size_t(num_last) * 8);
     if (face_varying) {
       primvar.LimitFaceVarying(src, sink, 0);
     } else {
       primvar.Limit(src, sink);
     }
   } else {
-    for (int i = 0; i < num_last; ++i) limit.emplace_back(i, i, 1.0);
+    for (int i = 0; i < num_last; ++i) triplets.emplace_back(i, i, 1.0);
   }
-  std::vector<int32_t> limit_offsets(size_t(num_last) + 1, 0);
-  for (const Triplet& t : limit) ++limit_offsets[t.row() + 1];
-  std::partial_sum(limit_offsets.begin(), limit_offsets.end(), limit_offsets.begin());
-
-  // Compose the output rows: row i = sum over limit entries (j, w) of w * refine row j, with a
-  // dense accumulator over the touched columns; rows come out in order with sorted columns.
   const std::vector<int32_t>& out_map = face_varying ? out_colors : out_vertices;
-  std::vector<double> acc(num_control, 0.0);
-  std::vector<uint8_t> seen(num_control, 0);
-  std::vector<int32_t> touched, outer(out_map.size() + 1, 0), inner;
-  std::vector<double> values;
-  inner.reserve(out_map.size() * 16);
-  values.reserve(out_map.size() * 16);
-  for (size_t i = 0; i < out_map.size(); ++i) {
-    touched.clear();
-    const int32_t r = out_map[i];
-    for (int32_t e = limit_offsets[r]; e < limit_offsets[r + 1]; ++e) {
-      const int32_t j = limit[e].col();
-      const double w = limit[e].value();
-      for (int32_t k = refine_offsets[j]; k < refine_offsets[j + 1]; ++k) {
-        const int32_t c = refine_columns[k];
-        if (!seen[c]) seen[c] = 1, touched.push_back(c);
-        acc[c] += w * refine_weights[k];
-      }
-    }
-    std::sort(touched.begin(), touched.end());
-    for (int32_t c : touched) {
-      if (acc[c] != 0.0) inner.push_back(c), values.push_back(acc[c]);
-      acc[c] = 0.0;
-      seen[c] = 0;
-    }
-    outer[i + 1] = static_cast<int32_t>(inner.size());
-  }
+  const StencilRows out = compose(group_masks(triplets, num_last), rows, out_map, num_control, true);
   return Eigen::Map<const SparseMatrix>(static_cast<int32_t>(out_map.size()), num_control,
-                                        static_cast<int32_t>(inner.size()), outer.data(), inner.data(),
-                                        values.data());
+                                        static_cast<int32_t>(out.columns.size()), out.offsets.data(),
+                                        out.columns.data(), out.weights.data());
 }
 
 const SparseMatrix& Subdivision::position_stencils() const {

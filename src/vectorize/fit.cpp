@@ -5,11 +5,13 @@
 // triangle containing each pixel centre), the fit solves
 //     min_c |B S c - t|^2 + lambda |c - c0|^2
 // through the normal equations S' (B'B) S c = S' B' t + lambda c0. B'B is assembled directly on the
-// refined values, so the large pixel matrix is never formed.
+// refined values (a 3x3 Gram block of barycentric weights per refined triangle), so the large
+// pixel matrix is never formed, and the products run row by row through a dense accumulator.
 #include "subvec/vectorize/fit.h"
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 
 #include <Eigen/SparseCholesky>
@@ -77,6 +79,114 @@ class SegmentGrid {
   std::vector<std::vector<int32_t>> buckets_;
 };
 
+// Sparse rows, CSR.
+struct Rows {
+  std::vector<int32_t> offsets{0}, columns;
+  std::vector<double> values;
+  int num_rows() const { return static_cast<int>(offsets.size()) - 1; }
+};
+
+// Accumulates sparse rows through a dense array over the columns.
+class RowAccumulator {
+ public:
+  explicit RowAccumulator(int columns) : acc_(columns, 0.0), seen_(columns, 0), touched_(size_t(columns) + 1) {}
+  void add(int32_t column, double value) {
+    touched_[count_] = column;  // kept only the first time the column is seen
+    count_ += seen_[column] ^ 1;
+    seen_[column] = 1;
+    acc_[column] += value;
+  }
+  // Appends the row (columns from `first_column` on, sorted; exact zeros dropped, except the
+  // diagonal `keep` when given) and starts a new one.
+  void flush(Rows& out, int32_t first_column = 0, int32_t keep = -1) {
+    if (keep >= 0 && !seen_[keep]) touched_[count_++] = keep, seen_[keep] = 1;
+    std::sort(touched_.begin(), touched_.begin() + count_);
+    for (size_t i = 0; i < count_; ++i) {
+      const int32_t column = touched_[i];
+      if (column >= first_column && (acc_[column] != 0.0 || column == keep)) {
+        out.columns.push_back(column);
+        out.values.push_back(acc_[column]);
+      }
+      acc_[column] = 0.0;
+      seen_[column] = 0;
+    }
+    count_ = 0;
+    out.offsets.push_back(static_cast<int32_t>(out.columns.size()));
+  }
+
+ private:
+  std::vector<double> acc_;
+  std::vector<uint8_t> seen_;
+  std::vector<int32_t> touched_;
+  size_t count_ = 0;
+};
+
+// B'B over the m refined color values: the Gram blocks of the refined triangles (symmetric, packed
+// 00 01 02 11 12 22) plus a diagonal.
+Rows gram_rows(const RefinedMesh& refined, int m, const std::vector<std::array<double, 6>>& blocks,
+               const std::vector<double>& diagonal) {
+  static constexpr int kPacked[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+  std::vector<int32_t> first(size_t(m) + 1, 0), corners;
+  if (!blocks.empty()) {
+    for (const Tri& t : refined.triangle_colors)
+      for (int32_t v : t) ++first[v + 1];
+    std::partial_sum(first.begin(), first.end(), first.begin());
+    corners.resize(first.back());
+    std::vector<int32_t> fill(first.begin(), first.end() - 1);
+    for (int t = 0; t < refined.num_triangles(); ++t)
+      for (int k = 0; k < 3; ++k) corners[fill[refined.triangle_colors[t][k]]++] = 3 * t + k;
+  }
+  Rows out;
+  out.offsets.reserve(size_t(m) + 1);
+  out.columns.reserve(size_t(m) * 7);
+  out.values.reserve(size_t(m) * 7);
+  RowAccumulator acc(m);
+  for (int32_t v = 0; v < m; ++v) {
+    if (!diagonal.empty()) acc.add(v, diagonal[v]);
+    for (int32_t i = first[v]; i < first[v + 1] && !blocks.empty(); ++i) {
+      const int32_t t = corners[i] / 3, k = corners[i] % 3;
+      for (int j = 0; j < 3; ++j) acc.add(refined.triangle_colors[t][j], blocks[t][kPacked[k][j]]);
+    }
+    acc.flush(out);
+  }
+  return out;
+}
+
+// a * s, with s a sparse matrix of `columns` columns.
+Rows multiply(const Rows& a, const SparseMatrix& s, int columns) {
+  Rows out;
+  out.offsets.reserve(a.offsets.size());
+  RowAccumulator acc(columns);
+  for (int r = 0; r < a.num_rows(); ++r) {
+    for (int32_t e = a.offsets[r]; e < a.offsets[r + 1]; ++e) {
+      const double w = a.values[e];
+      for (SparseMatrix::InnerIterator it(s, a.columns[e]); it; ++it) acc.add(static_cast<int32_t>(it.col()), w * it.value());
+    }
+    acc.flush(out);
+  }
+  return out;
+}
+
+// The transpose of s (rows x columns) as rows.
+Rows transpose(const SparseMatrix& s) {
+  Rows out;
+  out.offsets.assign(size_t(s.cols()) + 1, 0);
+  for (int r = 0; r < s.rows(); ++r)
+    for (SparseMatrix::InnerIterator it(s, r); it; ++it) ++out.offsets[it.col() + 1];
+  std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
+  out.columns.resize(out.offsets.back());
+  out.values.resize(out.offsets.back());
+  std::vector<int32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (int r = 0; r < s.rows(); ++r) {
+    for (SparseMatrix::InnerIterator it(s, r); it; ++it) {
+      const int32_t k = fill[it.col()]++;
+      out.columns[k] = r;
+      out.values[k] = it.value();
+    }
+  }
+  return out;
+}
+
 std::array<double, 3> pixel(const Image8& image, int x, int y) {
   const uint8_t* p = image.row(y) + size_t(x) * image.channels;
   return {double(p[0]), double(p[1]), double(p[2])};
@@ -113,7 +223,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   const RefinedMesh& refined = sub.topology();
   const int num_refined = sub.num_vertices();
   std::vector<float> limit(size_t(num_refined) * 2);
-  sub.evaluate_positions(mesh.positions, limit);
+  sub.evaluate_positions_once(mesh.positions, limit);
   const SparseMatrix& s = sub.color_stencils();
   const int m = static_cast<int>(s.rows()), c = static_cast<int>(s.cols());
 
@@ -124,17 +234,11 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   }
   const SegmentGrid grid(std::move(segments), width, height, 4);
 
-  // Accumulate B'B (on refined values) and B't.
-  std::vector<Eigen::Triplet<double, int32_t>> btb;
-  Eigen::MatrixX3d btt = Eigen::MatrixX3d::Zero(m, 3);
+  // Accumulate B'B (on refined values: per refined triangle, or on the diagonal) and B't.
+  std::vector<std::array<double, 6>> blocks;
+  std::vector<double> diagonal;
+  std::vector<std::array<double, 3>> btt(m, {0, 0, 0});
   ColorFitStats stats;
-  auto add_row = [&](const int32_t* values, const double* weights, int n, const std::array<double, 3>& target) {
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) btb.emplace_back(values[i], values[j], weights[i] * weights[j]);
-      for (int k = 0; k < 3; ++k) btt(values[i], k) += weights[i] * target[k];
-    }
-    ++stats.rows;
-  };
 
   struct Location {
     int32_t triangle = -1;
@@ -142,6 +246,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   };
   std::vector<Location> located;
   if (options.target == ColorFitTarget::kPixels) {
+    blocks.assign(refined.num_triangles(), {0, 0, 0, 0, 0, 0});
     // Locate every pixel centre in a refined triangle (first one wins on shared edges).
     located.assign(size_t(width) * height, Location{});
     for (int t = 0; t < refined.num_triangles(); ++t) {
@@ -217,7 +322,12 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         }
         const Tri& values = refined.triangle_colors[loc.triangle];
         const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
-        add_row(values.data(), w, 3, target);
+        std::array<double, 6>& g = blocks[loc.triangle];
+        g[0] += w[0] * w[0], g[1] += w[0] * w[1], g[2] += w[0] * w[2];
+        g[3] += w[1] * w[1], g[4] += w[1] * w[2], g[5] += w[2] * w[2];
+        for (int i = 0; i < 3; ++i)
+          for (int k = 0; k < 3; ++k) btt[values[i]][k] += w[i] * target[k];
+        ++stats.rows;
       }
     }
   } else {
@@ -235,6 +345,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         sx[value] += cx, sy[value] += cy, cnt[value] += 1;
       }
     }
+    diagonal.assign(m, 0.0);
     std::vector<int> values_at_vertex(num_refined, 0);
     for (int v = 0; v < m; ++v)
       if (vertex_of[v] >= 0) ++values_at_vertex[vertex_of[v]];
@@ -245,30 +356,52 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         const double dx = sx[v] / cnt[v] - x, dy = sy[v] / cnt[v] - y, len = std::hypot(dx, dy);
         if (len > 0) x += 0.75 * dx / len, y += 0.75 * dy / len;
       }
-      const int32_t value = v;
-      const double one = 1.0;
-      add_row(&value, &one, 1, sample_bilinear(image, x, y));
+      const auto target = sample_bilinear(image, x, y);
+      diagonal[v] += 1;
+      for (int k = 0; k < 3; ++k) btt[v][k] += target[k];
+      ++stats.rows;
     }
   }
 
-  SparseMatrix nref(m, m);
-  nref.setFromTriplets(btb.begin(), btb.end());
-  btb.clear();
-  btb.shrink_to_fit();
-  const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t> st = s.transpose();
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t> normal = st * (nref * s);
-  Eigen::MatrixX3d rhs = st * btt;
+  // The normal equations, lower triangle: column i of the lower triangle is row i of S' (B'B S)
+  // from column i on.
+  const Rows gram = gram_rows(refined, m, blocks, diagonal);
+  blocks = {};
+  const Rows gram_s = multiply(gram, s, c);
+  const Rows st = transpose(s);
+  Rows lower;
+  lower.offsets.reserve(size_t(c) + 1);
+  Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
+  {
+    RowAccumulator acc(c);
+    for (int32_t i = 0; i < c; ++i) {
+      for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
+        const int32_t r = st.columns[e];
+        const double w = st.values[e];
+        for (int32_t k = gram_s.offsets[r]; k < gram_s.offsets[r + 1]; ++k) {
+          if (gram_s.columns[k] >= i) acc.add(gram_s.columns[k], w * gram_s.values[k]);
+        }
+        for (int k = 0; k < 3; ++k) rhs(i, k) += w * btt[r][k];
+      }
+      acc.flush(lower, i, i);
+    }
+  }
 
-  // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches.
-  const double scale = normal.diagonal().sum() / std::max(1, c);
+  // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches. Each
+  // column's first entry is its diagonal.
+  double trace = 0;
+  for (int i = 0; i < c; ++i) trace += lower.values[lower.offsets[i]];
+  const double scale = trace / std::max(1, c);
   const double lambda = options.regularization * std::max(scale, 1e-12);
   for (int i = 0; i < c; ++i) {
-    normal.coeffRef(i, i) += lambda;
+    lower.values[lower.offsets[i]] += lambda;
     rhs(i, 0) += lambda * mesh.colors[i].r;
     rhs(i, 1) += lambda * mesh.colors[i].g;
     rhs(i, 2) += lambda * mesh.colors[i].b;
   }
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> solver(normal);
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> normal(
+      c, c, static_cast<int32_t>(lower.columns.size()), lower.offsets.data(), lower.columns.data(), lower.values.data());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>, Eigen::Lower> solver(normal);
   if (solver.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, "color fit: normal equations are singular");
   const Eigen::MatrixX3d x = solver.solve(rhs);
   for (int i = 0; i < c; ++i) {

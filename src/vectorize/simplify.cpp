@@ -17,12 +17,18 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <bit>
 #include <cmath>
+#include <cstring>
+#include <memory>
+#include <numeric>
+#include <span>
 #include <string>
-#include <unordered_set>
 
 #include <Eigen/Dense>
 
+#include "core/parallel_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
@@ -32,13 +38,17 @@ namespace {
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 
-// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b).
-struct Quadric {
-  Mat5 a = Mat5::Zero();
-  Vec5 b = Vec5::Zero();
+// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b). A is symmetric and kept as its upper
+// triangle, row by row (xx xy xr xg xb | yy yr yg yb | rr rg rb | gg gb | bb): 21 doubles, padded
+// to three cache lines, so that merging and reducing two quadrics touch six lines.
+struct alignas(64) Quadric {
+  std::array<double, 15> a{};
+  std::array<double, 5> b{};
   double c = 0;
   Quadric& operator+=(const Quadric& o) {
-    a += o.a, b += o.b, c += o.c;
+    for (int i = 0; i < 15; ++i) a[i] += o.a[i];
+    for (int i = 0; i < 5; ++i) b[i] += o.b[i];
+    c += o.c;
     return *this;
   }
 };
@@ -57,44 +67,79 @@ Quadric triangle_quadric(const Vec5& p, const Vec5& q, const Vec5& r) {
   e2 /= l2;
   const double area = 0.5 * std::abs((q(0) - p(0)) * (r(1) - p(1)) - (q(1) - p(1)) * (r(0) - p(0)));
   const double pe1 = p.dot(e1), pe2 = p.dot(e2);
-  out.a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
-  out.b = area * (pe1 * e1 + pe2 * e2 - p);
+  const Mat5 a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
+  for (int i = 0, n = 0; i < 5; ++i)
+    for (int j = i; j < 5; ++j) out.a[n++] = a(i, j);
+  const Vec5 b = area * (pe1 * e1 + pe2 * e2 - p);
+  for (int i = 0; i < 5; ++i) out.b[i] = b(i);
   out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
   return out;
 }
 
-// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p.
+// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p, with M
+// symmetric (m00, m01, m11).
 struct Quadric2 {
-  Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d g = Eigen::Vector2d::Zero();
-  double k = 0;
-  double operator()(const Eigen::Vector2d& p) const { return p.dot(m * p) + 2 * g.dot(p) + k; }
+  double m00 = 0, m01 = 0, m11 = 0, g0 = 0, g1 = 0, k = 0;
+  double operator()(double x, double y) const {
+    return x * (m00 * x + m01 * y) + y * (m01 * x + m11 * y) + 2 * (g0 * x + g1 * y) + k;
+  }
   Quadric2& operator+=(const Quadric2& o) {
-    m += o.m, g += o.g, k += o.k;
+    m00 += o.m00, m01 += o.m01, m11 += o.m11, g0 += o.g0, g1 += o.g1, k += o.k;
     return *this;
   }
 };
 
+// The color block of a quadric, regularized, as the adjugate C (symmetric: c00 c01 c02 c11 c12
+// c22) and determinant of Acc + 1e-9 I: (Acc + 1e-9 I)^-1 = C / det.
+struct ColorInverse {
+  double c00, c01, c02, c11, c12, c22, det;
+};
+ColorInverse color_inverse(const std::array<double, 15>& a) {
+  constexpr double kEps = 1e-9;
+  const double rr = a[9] + kEps, rg = a[10], rb = a[11], gg = a[12] + kEps, gb = a[13], bb = a[14] + kEps;
+  ColorInverse v;
+  v.c00 = gg * bb - gb * gb;
+  v.c01 = rb * gb - rg * bb;
+  v.c02 = rg * gb - rb * gg;
+  v.c11 = rr * bb - rb * rb;
+  v.c12 = rg * rb - rr * gb;
+  v.c22 = rr * gg - rg * rg;
+  v.det = rr * v.c00 + rg * v.c01 + rb * v.c02;
+  return v;
+}
+
+// Schur complement of the color block: min over colors of Q(p, colors).
 Quadric2 reduce(const Quadric& q) {
-  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix<double, 3, 2> acp = q.a.block<3, 2>(2, 0);
-  const Eigen::Matrix3d inv = acc.inverse();
+  const auto& a = q.a;
+  const ColorInverse ci = color_inverse(a);
+  // Columns x and y of the color-position block, and the color part of b.
+  const double xr = a[2], xg = a[3], xb = a[4], yr = a[6], yg = a[7], yb = a[8];
+  const double br = q.b[2], bg = q.b[3], bb = q.b[4];
+  // C times (x column, y column, b colors).
+  const double wx0 = ci.c00 * xr + ci.c01 * xg + ci.c02 * xb, wx1 = ci.c01 * xr + ci.c11 * xg + ci.c12 * xb,
+               wx2 = ci.c02 * xr + ci.c12 * xg + ci.c22 * xb;
+  const double wy0 = ci.c00 * yr + ci.c01 * yg + ci.c02 * yb, wy1 = ci.c01 * yr + ci.c11 * yg + ci.c12 * yb,
+               wy2 = ci.c02 * yr + ci.c12 * yg + ci.c22 * yb;
+  const double wb0 = ci.c00 * br + ci.c01 * bg + ci.c02 * bb, wb1 = ci.c01 * br + ci.c11 * bg + ci.c12 * bb,
+               wb2 = ci.c02 * br + ci.c12 * bg + ci.c22 * bb;
+  const double inv_det = 1 / ci.det;
   Quadric2 r;
-  r.m = q.a.block<2, 2>(0, 0) - acp.transpose() * inv * acp;
-  r.g = q.b.head<2>() - acp.transpose() * inv * q.b.tail<3>();
-  r.k = q.c - q.b.tail<3>().dot(inv * q.b.tail<3>());
+  r.m00 = a[0] - (xr * wx0 + xg * wx1 + xb * wx2) * inv_det;
+  r.m01 = a[1] - (xr * wy0 + xg * wy1 + xb * wy2) * inv_det;
+  r.m11 = a[5] - (yr * wy0 + yg * wy1 + yb * wy2) * inv_det;
+  r.g0 = q.b[0] - (xr * wb0 + xg * wb1 + xb * wb2) * inv_det;
+  r.g1 = q.b[1] - (yr * wb0 + yg * wb1 + yb * wb2) * inv_det;
+  r.k = q.c - (br * wb0 + bg * wb1 + bb * wb2) * inv_det;
   return r;
 }
 
-// Colors minimizing q at position p.
-Eigen::Vector3d best_color(const Quadric& q, const Eigen::Vector2d& p) {
-  const Eigen::Matrix3d acc = q.a.block<3, 3>(2, 2) + 1e-9 * Eigen::Matrix3d::Identity();
-  return -acc.inverse() * (q.a.block<3, 2>(2, 0) * p + q.b.tail<3>());
-}
-
-int64_t edge_key(int32_t a, int32_t b) {
-  if (a > b) std::swap(a, b);
-  return (int64_t{a} << 32) | static_cast<uint32_t>(b);
+// Colors minimizing q at position (x, y).
+std::array<double, 3> best_color(const Quadric& q, double x, double y) {
+  const auto& a = q.a;
+  const ColorInverse ci = color_inverse(a);
+  const double r = a[2] * x + a[6] * y + q.b[2], g = a[3] * x + a[7] * y + q.b[3], b = a[4] * x + a[8] * y + q.b[4];
+  return {-(ci.c00 * r + ci.c01 * g + ci.c02 * b) / ci.det, -(ci.c01 * r + ci.c11 * g + ci.c12 * b) / ci.det,
+          -(ci.c02 * r + ci.c12 * g + ci.c22 * b) / ci.det};
 }
 
 enum class Kind : uint8_t { kSmooth, kBorder, kFeature, kCorner };
@@ -124,32 +169,35 @@ struct FeatureState {
   double saliency = 0;
 };
 
-// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries), which
-// halves the depth and the cache misses of a binary heap; the lazy collapse queue is dominated by
-// them.
+// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries, the
+// array offset by three slots so that every group of four siblings starts on a 64-byte boundary),
+// which halves the depth and the cache misses of a binary heap; the lazy collapse queue is
+// dominated by them.
 template <class T>
 class QuadHeap {
+  static_assert(sizeof(T) == 16);
+  static constexpr size_t kPad = 3;
+
  public:
-  bool empty() const { return v_.empty(); }
-  size_t size() const { return v_.size(); }
-  const T& top() const { return v_.front(); }
-  void clear() { v_.clear(); }
+  bool empty() const { return size_ == 0; }
+  size_t size() const { return size_; }
+  const T& top() const { return at(0); }
+  void clear() { size_ = 0; }
   void push(const T& x) {
-    size_t i = v_.size();
-    v_.push_back(x);
+    if (size_ == capacity_) grow();
+    size_t i = size_++;
     while (i > 0) {
       const size_t parent = (i - 1) / 4;
-      if (!(x < v_[parent])) break;
-      v_[i] = v_[parent];
+      if (!(x < at(parent))) break;
+      at(i) = at(parent);
       i = parent;
     }
-    v_[i] = x;
+    at(i) = x;
   }
   void pop() {
-    const T x = v_.back();
-    v_.pop_back();
-    if (v_.empty()) return;
-    const size_t n = v_.size();
+    const T x = at(--size_);
+    if (size_ == 0) return;
+    const size_t n = size_;
     size_t i = 0;
     while (true) {
       const size_t first = 4 * i + 1;
@@ -157,16 +205,165 @@ class QuadHeap {
       size_t best = first;
       const size_t last = std::min(first + 4, n);
       for (size_t c = first + 1; c < last; ++c)
-        if (v_[c] < v_[best]) best = c;
-      if (!(v_[best] < x)) break;
-      v_[i] = v_[best];
+        if (at(c) < at(best)) best = c;
+      if (!(at(best) < x)) break;
+      at(i) = at(best);
       i = best;
     }
-    v_[i] = x;
+    at(i) = x;
   }
 
  private:
-  std::vector<T> v_;
+  struct alignas(64) Line {
+    unsigned char bytes[64];
+  };
+  T& at(size_t i) { return reinterpret_cast<T*>(storage_.get())[i + kPad]; }
+  const T& at(size_t i) const { return reinterpret_cast<const T*>(storage_.get())[i + kPad]; }
+  void grow() {
+    const size_t capacity = std::max<size_t>(1024, 2 * capacity_);
+    std::unique_ptr<Line[]> storage(new Line[(capacity + kPad) * sizeof(T) / sizeof(Line) + 1]);
+    if (size_) std::memcpy(reinterpret_cast<T*>(storage.get()) + kPad, &at(0), size_ * sizeof(T));
+    storage_ = std::move(storage);
+    capacity_ = capacity;
+  }
+  std::unique_ptr<Line[]> storage_;
+  size_t size_ = 0, capacity_ = 0;
+};
+
+// A queue entry: the collapse of `remove` into `keep`, planned when the two vertices had these
+// versions. 16 bytes. Ordered by cost, then the removed and the kept vertex (determinism); the cost
+// is a non-negative float, so its bits order like the value and cost and removed vertex compare as
+// one 64-bit key. Versions are truncated: an entry that survives a wrap-around is still fully
+// re-planned and checked before it collapses anything.
+struct Entry {
+  uint64_t key;  // cost bits << 32 | remove
+  int32_t keep;
+  uint16_t version_remove, version_keep;
+  int32_t remove() const { return static_cast<int32_t>(key & 0xffffffffu); }
+  bool operator<(const Entry& o) const { return key != o.key ? key < o.key : keep < o.keep; }
+};
+
+// The lazy collapse queue: entries are never updated in place; a re-planned edge gets a new entry
+// and the old one goes stale, to be skipped when it comes out. Most entries go stale long before
+// they would reach the front, so only the front lives in a heap: entries are binned by the high
+// bits of their cost (1/16 of an octave per bin), the heap holds every entry of the bins up to
+// `front_`, and the bins above wait unsorted until the heap runs dry, when the next non-empty bin
+// is moved into the heap with its stale entries dropped. Entries come out in exactly the order of
+// one big heap, at the cost of a heap that stays small enough for the cache.
+class CollapseQueue {
+ public:
+  size_t size() const { return size_; }
+  void clear() {
+    heap_.clear();
+    for (auto& bin : bins_) std::vector<Entry>().swap(bin);
+    front_ = 0;
+    size_ = 0;
+  }
+  void push(const Entry& e) {
+    const uint32_t b = bin(e);
+    if (b <= front_) {
+      heap_.push(e);
+    } else {
+      bins_[b].push_back(e);
+    }
+    ++size_;
+  }
+  // Takes the smallest entry into `out`; false when the queue is empty. `live(e)` says whether an
+  // entry is still current; entries that are not may be dropped unseen.
+  template <class Live>
+  bool pop(Entry& out, const Live& live) {
+    while (heap_.empty()) {
+      uint32_t b = front_ + 1;
+      while (b < kBins && bins_[b].empty()) ++b;
+      if (b == kBins) return false;
+      front_ = b;
+      std::vector<Entry> entries;
+      entries.swap(bins_[b]);
+      for (const Entry& e : entries) {
+        if (live(e)) heap_.push(e);
+        else --size_;
+      }
+    }
+    out = heap_.top();
+    heap_.pop();
+    --size_;
+    return true;
+  }
+
+ private:
+  static constexpr int kShift = 32 + 19;  // float bits above the 4 leading mantissa bits
+  static constexpr uint32_t kBins = uint32_t{1} << (63 - kShift);
+  static uint32_t bin(const Entry& e) { return static_cast<uint32_t>(e.key >> kShift); }
+  QuadHeap<Entry> heap_;
+  std::vector<std::vector<Entry>> bins_ = std::vector<std::vector<Entry>>(kBins);
+  uint32_t front_ = 0;
+  size_t size_ = 0;
+};
+
+// Blocks of int32 that never move, handed out in order: one per worker, so that lists can grow
+// on several threads at once.
+class Arena {
+ public:
+  int32_t* take(size_t n) {
+    if (n > left_) {
+      const size_t size = std::max<size_t>(n, 1 << 16);
+      chunks_.push_back(std::make_unique<int32_t[]>(size));
+      next_ = chunks_.back().get();
+      left_ = size;
+    }
+    int32_t* out = next_;
+    next_ += n, left_ -= n;
+    return out;
+  }
+
+ private:
+  std::vector<std::unique_ptr<int32_t[]>> chunks_;
+  int32_t* next_ = nullptr;
+  size_t left_ = 0;
+};
+
+// The faces incident to each vertex: lists laid out in vertex order in one block, each with room to
+// grow; a full list moves to a block twice as large from the caller's arena. Lists keep their
+// order; growing a list invalidates views of it.
+class IncidenceLists {
+ public:
+  // `counts[v]` entries will be pushed for each vertex v first.
+  void reserve(const std::vector<int32_t>& counts) {
+    data_.resize(counts.size());
+    size_.assign(counts.size(), 0);
+    capacity_.resize(counts.size());
+    size_t total = 0;
+    for (size_t v = 0; v < counts.size(); ++v) {
+      capacity_[v] = std::max(8, counts[v] + 2);
+      total += capacity_[v];
+    }
+    pool_ = std::make_unique<int32_t[]>(total);
+    total = 0;
+    for (size_t v = 0; v < counts.size(); ++v) data_[v] = pool_.get() + total, total += capacity_[v];
+  }
+  std::span<const int32_t> operator[](int32_t v) const { return {data_[v], size_t(size_[v])}; }
+  void push_back(int32_t v, int32_t f, Arena& arena) {
+    if (size_[v] == capacity_[v]) {
+      int32_t* data = arena.take(2 * size_t(capacity_[v]));
+      std::copy_n(data_[v], size_[v], data);
+      data_[v] = data;
+      capacity_[v] *= 2;
+    }
+    data_[v][size_[v]++] = f;
+  }
+  void erase(int32_t v, int32_t f) {
+    int32_t* first = data_[v];
+    int32_t* last = first + size_[v];
+    int32_t* at = std::find(first, last, f);
+    std::copy(at + 1, last, at);
+    --size_[v];
+  }
+  void clear(int32_t v) { size_[v] = 0; }
+
+ private:
+  std::unique_ptr<int32_t[]> pool_;
+  std::vector<int32_t*> data_;
+  std::vector<int32_t> size_, capacity_;
 };
 
 class Simplifier {
@@ -182,31 +379,42 @@ class Simplifier {
     int32_t remove = -1, keep = -1;
     Vec2 position;
   };
-  // A heap entry: 16 bytes, so that the lazy heap (stale entries are skipped when popped) stays
-  // cache friendly. Versions are truncated: an entry that survives a wrap-around is still fully
-  // re-planned and checked before it collapses anything.
-  struct Entry {
-    float cost;
-    int32_t remove, keep;
-    uint16_t version_remove, version_keep;
-    bool operator<(const Entry& o) const {  // cheaper first, ties by indices (determinism)
-      if (cost != o.cost) return cost < o.cost;
-      if (remove != o.remove) return remove < o.remove;
-      return keep < o.keep;
+  // Who simplifies what: one worker per region in the parallel phase, one for the whole mesh
+  // after. A worker collapses and moves only vertices it owns and reads its neighbourhood, which
+  // nobody else writes meanwhile; it has its own queue, statistics and scratch space.
+  struct Worker {
+    int32_t region = -1;  // -1: every vertex
+    int64_t alive = 0;    // live vertices of the region
+    int64_t stop = 0;     // simplify down to this many
+    CollapseQueue queue;
+    SimplifyStats stats;
+    Arena arena;
+    std::vector<uint32_t> mark;  // vertices marked with a stamp (neighbourhood queries)
+    uint32_t stamp = 0;
+    std::vector<int32_t> ring, faces;
+    uint32_t next_stamp() {
+      if (++stamp == 0) std::fill(mark.begin(), mark.end(), 0u), stamp = 1;
+      return stamp;
     }
   };
 
   void setup();
+  void split_regions(int num_regions_x, int num_regions_y);
+  bool owns(const Worker& w, int32_t v) const { return w.region < 0 || (region_[v] == w.region && !frozen_[v]); }
+  bool owns_window(const Worker& w, int32_t removed_node) const;
+  void simplify_with(Worker& w);
   Plan plan(int32_t a, int32_t b) const;
   Plan plan_direction(int32_t u, int32_t v) const;
-  void push_edges(int32_t v);
-  bool try_collapse(const Plan& e);
-  void push(const Plan& p);
-  void rebuild_heap();
-  void neighbours(int32_t v, std::vector<int32_t>& out) const;
+  void push_edges(Worker& w, int32_t v);
+  bool try_collapse(Worker& w, const Plan& e);
+  void push(Worker& w, const Plan& p);
+  void rebuild_queue(Worker& w);
+  void neighbours(Worker& w, int32_t v, std::vector<int32_t>& out) const;
+  bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
-  bool link_condition(int32_t u, int32_t v) const;
+  bool link_condition(Worker& w, int32_t u, int32_t v) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
+  bool tear_edge(int32_t a, int32_t b) const;
   double signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved, int num_moved) const;
   void write_back();
 
@@ -217,38 +425,81 @@ class Simplifier {
   ControlMesh& mesh_;
   int w_, h_;
   SimplifyOptions options_;
-  SimplifyStats stats_;
 
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
+  std::vector<int32_t> face_order_;  // input face of each face
   std::vector<uint8_t> face_alive_, vertex_alive_;
-  std::vector<std::vector<int32_t>> vfaces_;
+  IncidenceLists vfaces_;
   std::vector<Kind> kind_;
   std::vector<uint8_t> sides_;     // bit mask: 1 x=0, 2 y=0, 4 x=W, 8 y=H
   std::vector<int32_t> feature_;   // feature index of tear vertices, else -1
   std::vector<int32_t> node_of_;   // node of tear vertices, else -1
   std::vector<Node> nodes_;
-  std::unordered_set<int64_t> tear_edges_;  // (min << 32 | max) of every feature edge
+  std::vector<int32_t> corner_node_offsets_, corner_nodes_;  // chain nodes of non-tear vertices, CSR
+  std::vector<int32_t> only_color_;  // the color of a vertex with one color value, else -1
   std::vector<uint32_t> version_;
   std::vector<Quadric> quadric_;   // per color index
   std::vector<FeatureState> features_;
-  QuadHeap<Entry> heap_;
-  int alive_vertices_ = 0;
+  std::vector<Arena> arenas_;     // where incidence lists grew
+  std::vector<int16_t> region_;   // region of each vertex in the parallel phase
+  std::vector<uint8_t> frozen_;   // left alone in the parallel phase (seams, shared closed features)
 };
 
 void Simplifier::setup() {
   const MeshTopology topo = MeshTopology::build(mesh_, w_, h_);
   const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   pos_ = mesh_.positions;
-  tri_ = mesh_.triangles;
-  tcol_ = mesh_.triangle_colors;
+  // Faces and color values are renumbered to follow the vertex order, which is spatially coherent,
+  // so that a vertex's neighbourhood and its quadrics share cache lines: faces by their smallest
+  // vertex, color values by their vertex. Everything that depends on an order (incidence lists,
+  // quadric sums, the output) still follows the input order.
+  // (Stable counting sorts by vertex.)
+  auto stable_order = [nv](const std::vector<int32_t>& key) {
+    std::vector<int32_t> start(size_t(nv) + 1, 0), order(key.size());
+    for (int32_t k : key) ++start[k + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    for (size_t i = 0; i < key.size(); ++i) order[start[key[i]]++] = static_cast<int32_t>(i);
+    return order;
+  };
+  std::vector<int32_t> min_vertex(nf);
+  for (int f = 0; f < nf; ++f) min_vertex[f] = std::min({mesh_.triangles[f][0], mesh_.triangles[f][1], mesh_.triangles[f][2]});
+  face_order_ = stable_order(min_vertex);
+  std::vector<int32_t> face_of(nf);
+  for (int i = 0; i < nf; ++i) face_of[face_order_[i]] = i;
+  std::vector<int32_t> color_vertex(mesh_.num_colors(), 0);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) color_vertex[mesh_.triangle_colors[f][k]] = mesh_.triangles[f][k];
+  const std::vector<int32_t> color_order = stable_order(color_vertex);
+  std::vector<int32_t> color_of(mesh_.num_colors());
+  for (int i = 0; i < mesh_.num_colors(); ++i) color_of[color_order[i]] = i;
+  tri_.resize(nf);
+  tcol_.resize(nf);
+  for (int i = 0; i < nf; ++i) {
+    tri_[i] = mesh_.triangles[face_order_[i]];
+    for (int k = 0; k < 3; ++k) tcol_[i][k] = color_of[mesh_.triangle_colors[face_order_[i]][k]];
+  }
   face_alive_.assign(nf, 1);
   vertex_alive_.assign(nv, 1);
-  alive_vertices_ = nv;
-  vfaces_.assign(nv, {});
+  {
+    std::vector<int32_t> counts(nv, 0);
+    for (const Tri& t : mesh_.triangles)
+      for (int32_t v : t) ++counts[v];
+    vfaces_.reserve(counts);
+  }
+  Arena& arena = arenas_.emplace_back();  // (unused: the lists have room)
   for (int f = 0; f < nf; ++f)
-    for (int v : tri_[f]) vfaces_[v].push_back(f);
+    for (int v : mesh_.triangles[f]) vfaces_.push_back(v, face_of[f], arena);
   version_.assign(nv, 0);
+  only_color_.assign(nv, -1);
+  std::vector<uint8_t> seen(nv, 0);
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = tri_[f][k], c = tcol_[f][k];
+      if (!seen[v]) only_color_[v] = c, seen[v] = 1;
+      else if (only_color_[v] != c) only_color_[v] = -1;
+    }
+  }
 
   kind_.resize(nv);
   sides_.assign(nv, 0);
@@ -288,7 +539,17 @@ void Simplifier::setup() {
       nodes_.push_back(node);
     }
     features_.push_back(std::move(s));
-    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) tear_edges_.insert(edge_key(f.vertices[i], f.vertices[i + 1]));
+  }
+  // Chain nodes at corners (a corner may end or join several chains), for tear edge lookups.
+  corner_node_offsets_.assign(size_t(nv) + 1, 0);
+  for (const Node& n : nodes_)
+    if (kind_[n.vertex] != Kind::kFeature) ++corner_node_offsets_[n.vertex + 1];
+  std::partial_sum(corner_node_offsets_.begin(), corner_node_offsets_.end(), corner_node_offsets_.begin());
+  corner_nodes_.resize(corner_node_offsets_.back());
+  {
+    std::vector<int32_t> fill(corner_node_offsets_.begin(), corner_node_offsets_.end() - 1);
+    for (int32_t i = 0; i < static_cast<int32_t>(nodes_.size()); ++i)
+      if (kind_[nodes_[i].vertex] != Kind::kFeature) corner_nodes_[fill[nodes_[i].vertex]++] = i;
   }
 
   // Quadrics per color index from the corners' 5D points.
@@ -297,22 +558,26 @@ void Simplifier::setup() {
   for (int f = 0; f < nf; ++f) {
     Vec5 p[3];
     for (int k = 0; k < 3; ++k) {
-      const Vec2 x = pos_[tri_[f][k]];
-      const Color c = mesh_.colors[tcol_[f][k]];
+      const Vec2 x = pos_[mesh_.triangles[f][k]];
+      const Color c = mesh_.colors[mesh_.triangle_colors[f][k]];
       p[k] << x.x, x.y, cs * c.r, cs * c.g, cs * c.b;
     }
     const Quadric q = triangle_quadric(p[0], p[1], p[2]);
-    for (int k = 0; k < 3; ++k) quadric_[tcol_[f][k]] += q;
+    for (int k = 0; k < 3; ++k) quadric_[color_of[mesh_.triangle_colors[f][k]]] += q;
   }
 }
 
-void Simplifier::neighbours(int32_t v, std::vector<int32_t>& out) const {
+// The distinct neighbours of v, in no particular order.
+void Simplifier::neighbours(Worker& worker, int32_t v, std::vector<int32_t>& out) const {
   out.clear();
-  for (int32_t f : vfaces_[v])
-    for (int32_t w : tri_[f])
-      if (w != v) out.push_back(w);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  const uint32_t stamp = worker.next_stamp();
+  for (int32_t f : vfaces_[v]) {
+    for (int32_t w : tri_[f]) {
+      if (w == v || worker.mark[w] == stamp) continue;
+      worker.mark[w] = stamp;
+      out.push_back(w);
+    }
+  }
 }
 
 int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
@@ -327,6 +592,19 @@ int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
   return n;
 }
 
+// Whether (a, b) is a tear edge: consecutive in a feature chain.
+bool Simplifier::tear_edge(int32_t a, int32_t b) const {
+  auto linked = [&](int32_t node, int32_t other) {
+    const Node& n = nodes_[node];
+    return (n.prev >= 0 && nodes_[n.prev].vertex == other) || (n.next >= 0 && nodes_[n.next].vertex == other);
+  };
+  if (node_of_[a] >= 0) return linked(node_of_[a], b);
+  if (node_of_[b] >= 0) return linked(node_of_[b], a);
+  for (int32_t i = corner_node_offsets_[a]; i < corner_node_offsets_[a + 1]; ++i)
+    if (linked(corner_nodes_[i], b)) return true;
+  return false;
+}
+
 // Whether (u, v) is an edge of u's feature chain.
 bool Simplifier::feature_neighbour(int32_t u, int32_t v) const {
   const int32_t n = node_of_[u];
@@ -339,56 +617,64 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
   Plan p;
   const Kind ku = kind_[u], kv = kind_[v];
   if (ku == Kind::kCorner) return p;
+  // A smooth vertex into a vertex with one color: the edge (which exists: u and v are neighbours)
+  // merges one pair of quadrics whatever its faces.
   int32_t faces[2];
-  const int nfaces = faces_with_edge(u, v, faces);
-  if (nfaces < 1 || nfaces > 2) return p;
-  switch (ku) {
-    case Kind::kSmooth:
-      break;
-    case Kind::kBorder:
-      if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
-      break;
-    case Kind::kFeature:
-      if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
-      if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
-      break;
-    case Kind::kCorner:
-      return p;
-  }
-  if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
-
-  // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
-  Quadric2 r;
   int32_t pairs[2][2];
   int npairs = 0;
-  for (int i = 0; i < nfaces; ++i) {
-    const Tri& t = tri_[faces[i]];
-    int32_t cu = -1, cv = -1;
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] == u) cu = tcol_[faces[i]][k];
-      if (t[k] == v) cv = tcol_[faces[i]][k];
+  if (ku == Kind::kSmooth && only_color_[u] >= 0 && only_color_[v] >= 0) {
+    pairs[0][0] = only_color_[u], pairs[0][1] = only_color_[v];
+    npairs = 1;
+  } else {
+    const int nfaces = faces_with_edge(u, v, faces);
+    if (nfaces < 1 || nfaces > 2) return p;
+    switch (ku) {
+      case Kind::kSmooth:
+        break;
+      case Kind::kBorder:
+        if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
+        break;
+      case Kind::kFeature:
+        if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
+        if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
+        break;
+      case Kind::kCorner:
+        return p;
     }
-    if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
-    pairs[npairs][0] = cu, pairs[npairs][1] = cv;
-    ++npairs;
+    if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
+
+    // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
+    for (int i = 0; i < nfaces; ++i) {
+      const Tri& t = tri_[faces[i]];
+      int32_t cu = -1, cv = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] == u) cu = tcol_[faces[i]][k];
+        if (t[k] == v) cv = tcol_[faces[i]][k];
+      }
+      if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
+      pairs[npairs][0] = cu, pairs[npairs][1] = cv;
+      ++npairs;
+    }
   }
+  Quadric2 r;
   for (int i = 0; i < npairs; ++i) {
     Quadric q = quadric_[pairs[i][0]];
     q += quadric_[pairs[i][1]];
     r += reduce(q);
   }
-  const Eigen::Vector2d pu(pos_[u].x, pos_[u].y), pv(pos_[v].x, pos_[v].y);
-  Eigen::Vector2d best = pv;
+  const Vec2 pu = pos_[u], pv = pos_[v];
+  Vec2 best = pv;
   if (ku == Kind::kSmooth && kv == Kind::kSmooth) {
     // Best point on the segment: R(pu + t (pv - pu)) is quadratic in t.
-    const Eigen::Vector2d d = pv - pu;
-    const double a = d.dot(r.m * d), b = 2 * (d.dot(r.m * pu) + r.g.dot(d));
+    const double dx = pv.x - pu.x, dy = pv.y - pu.y;
+    const double mdx = r.m00 * dx + r.m01 * dy, mdy = r.m01 * dx + r.m11 * dy;
+    const double a = dx * mdx + dy * mdy, b = 2 * (pu.x * mdx + pu.y * mdy + r.g0 * dx + r.g1 * dy);
     const double t = a > 1e-12 ? std::clamp(-b / (2 * a), 0.0, 1.0) : 0.5;
-    best = pu + t * d;
+    best = {pu.x + t * dx, pu.y + t * dy};
   }
-  p.cost = std::max(0.0, r(best));
+  p.cost = std::max(0.0, r(best.x, best.y));
   p.remove = u, p.keep = v;
-  p.position = {best.x(), best.y()};
+  p.position = best;
   return p;
 }
 
@@ -399,41 +685,54 @@ Simplifier::Plan Simplifier::plan(int32_t a, int32_t b) const {
   return q.cost < p.cost ? q : p;
 }
 
-void Simplifier::push_edges(int32_t v) {
-  thread_local std::vector<int32_t> ring;
-  neighbours(v, ring);
+// Plans the edges from v to the neighbours the worker owns (v is one of its own).
+void Simplifier::push_edges(Worker& worker, int32_t v) {
+  std::vector<int32_t>& ring = worker.ring;
+  neighbours(worker, v, ring);
+  std::erase_if(ring, [&](int32_t w) { return !owns(worker, w); });
+  // Planning is bound by fetching the neighbours' quadrics: request them all first.
   for (int32_t w : ring) {
-    push(plan(v, w));
+    const int32_t c = only_color_[w];
+    if (c < 0) continue;
+    const char* q = reinterpret_cast<const char*>(&quadric_[c]);
+    __builtin_prefetch(q), __builtin_prefetch(q + 64), __builtin_prefetch(q + 128);
+  }
+  for (int32_t w : ring) {
+    push(worker, plan(v, w));
   }
 }
 
-void Simplifier::push(const Plan& p) {
+void Simplifier::push(Worker& worker, const Plan& p) {
   if (p.remove < 0 || !std::isfinite(p.cost)) return;
-  heap_.push({static_cast<float>(p.cost), p.remove, p.keep, static_cast<uint16_t>(version_[p.remove]),
+  const uint64_t cost_bits = std::bit_cast<uint32_t>(static_cast<float>(p.cost));
+  worker.queue.push({cost_bits << 32 | static_cast<uint32_t>(p.remove), p.keep, static_cast<uint16_t>(version_[p.remove]),
               static_cast<uint16_t>(version_[p.keep])});
 }
 
-// Re-plans every live edge into a fresh heap, dropping the stale entries that pile up.
-void Simplifier::rebuild_heap() {
-  heap_.clear();
-  thread_local std::vector<int32_t> ring;
+// Re-plans every live edge of the worker into a fresh queue, dropping the stale entries that pile up.
+void Simplifier::rebuild_queue(Worker& worker) {
+  worker.queue.clear();
+  std::vector<int32_t>& ring = worker.ring;
   for (int32_t v = 0; v < static_cast<int32_t>(pos_.size()); ++v) {
-    if (!vertex_alive_[v]) continue;
-    neighbours(v, ring);
+    if (!vertex_alive_[v] || !owns(worker, v)) continue;
+    neighbours(worker, v, ring);
     for (int32_t w : ring)
-      if (w > v) push(plan(v, w));
+      if (w > v && owns(worker, w)) push(worker, plan(v, w));
   }
 }
 
-bool Simplifier::link_condition(int32_t u, int32_t v) const {
-  thread_local std::vector<int32_t> ru, rv;
-  neighbours(u, ru);
-  neighbours(v, rv);
+bool Simplifier::link_condition(Worker& worker, int32_t u, int32_t v) const {
+  // Mark u's neighbours, then count v's marked ones, each once.
+  const uint32_t of_u = worker.next_stamp(), counted = worker.next_stamp();
+  for (int32_t f : vfaces_[u])
+    for (int32_t w : tri_[f]) worker.mark[w] = of_u;
   int common = 0;
-  for (size_t i = 0, j = 0; i < ru.size() && j < rv.size();) {
-    if (ru[i] < rv[j]) ++i;
-    else if (ru[i] > rv[j]) ++j;
-    else ++common, ++i, ++j;
+  for (int32_t f : vfaces_[v]) {
+    for (int32_t w : tri_[f]) {
+      if (w == u || w == v || worker.mark[w] != of_u) continue;
+      worker.mark[w] = counted;
+      ++common;
+    }
   }
   int32_t faces[2];
   return common == faces_with_edge(u, v, faces);
@@ -601,10 +900,14 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
   return worst;
 }
 
-bool Simplifier::try_collapse(const Plan& e) {
+bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   const int32_t u = e.remove, v = e.keep;
-  if (!link_condition(u, v)) {
-    ++stats_.rejected_topology;
+  SimplifyStats& stats = worker.stats;
+  // A collapse along a feature refits nodes up to five away: they must all be the worker's.
+  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
+  if (removed_node >= 0 && !owns_window(worker, removed_node)) return false;
+  if (!link_condition(worker, u, v)) {
+    ++stats.rejected_topology;
     return false;
   }
   // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
@@ -613,8 +916,8 @@ bool Simplifier::try_collapse(const Plan& e) {
     const int nfaces = faces_with_edge(u, v, faces);
     for (int i = 0; i < std::min(nfaces, 2); ++i) {
       for (int32_t w : tri_[faces[i]]) {
-        if (w != u && w != v && tear_edges_.count(edge_key(u, w)) && tear_edges_.count(edge_key(v, w))) {
-          ++stats_.rejected_topology;
+        if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edge(u, w) && tear_edge(v, w)) {
+          ++stats.rejected_topology;
           return false;
         }
       }
@@ -626,14 +929,13 @@ bool Simplifier::try_collapse(const Plan& e) {
   moved[num_moved++] = {v, e.position};
 
   // A collapse along a feature: the chain loses u, then its neighbourhood is refitted.
-  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
   if (removed_node >= 0) {
     const double error = refit(removed_node, moved, num_moved);
     if (error > options_.max_feature_error) {
-      ++stats_.rejected_feature;
+      ++stats.rejected_feature;
       return false;
     }
-    stats_.max_feature_error = std::max(stats_.max_feature_error, error);
+    stats.max_feature_error = std::max(stats.max_feature_error, error);
   }
 
   // No flipped or degenerate triangle among everything that moves.
@@ -655,7 +957,7 @@ bool Simplifier::try_collapse(const Plan& e) {
   };
   for (int i = 0; i < num_moved; ++i) {
     if (!faces_ok(moved[i].first)) {
-      ++stats_.rejected_topology;
+      ++stats.rejected_topology;
       return false;
     }
   }
@@ -674,16 +976,15 @@ bool Simplifier::try_collapse(const Plan& e) {
     if (i == 1 && side[1] == side[0]) break;
     quadric_[side[i].second] += quadric_[side[i].first];
   }
-  for (int32_t f : vfaces_[u]) {
+  std::vector<int32_t>& faces_of_u = worker.faces;
+  faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may move
+  for (int32_t f : faces_of_u) {
     Tri& t = tri_[f];
     const bool dies = t[0] == v || t[1] == v || t[2] == v;
     if (dies) {
       face_alive_[f] = 0;
-      for (int32_t w : t) {
-        if (w == u) continue;
-        auto& list = vfaces_[w];
-        list.erase(std::find(list.begin(), list.end(), f));
-      }
+      for (int32_t w : t)
+        if (w != u) vfaces_.erase(w, f);
       continue;
     }
     for (int k = 0; k < 3; ++k) {
@@ -692,59 +993,150 @@ bool Simplifier::try_collapse(const Plan& e) {
       const int32_t cu = tcol_[f][k];
       tcol_[f][k] = nfaces == 2 && side[1].first == cu ? side[1].second : side[0].second;
     }
-    vfaces_[v].push_back(f);
+    vfaces_.push_back(v, f, worker.arena);
   }
-  vfaces_[u].clear();
+  vfaces_.clear(u);
   vertex_alive_[u] = 0;
-  --alive_vertices_;
+  --worker.alive;
   for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
   if (removed_node >= 0) {  // unlink the node; its two chain edges become one
     Node& n = nodes_[removed_node];
-    if (n.prev >= 0) tear_edges_.erase(edge_key(u, nodes_[n.prev].vertex));
-    if (n.next >= 0) tear_edges_.erase(edge_key(u, nodes_[n.next].vertex));
-    if (n.prev >= 0 && n.next >= 0) tear_edges_.insert(edge_key(nodes_[n.prev].vertex, nodes_[n.next].vertex));
     FeatureState& f = features_[feature_[u]];
     if (n.prev >= 0) nodes_[n.prev].next = n.next;
     if (n.next >= 0) nodes_[n.next].prev = n.prev;
     if (f.head == removed_node) f.head = n.next;
     n.alive = false;
-    --f.size;
+    std::atomic_ref<int32_t>(f.size).fetch_sub(1, std::memory_order_relaxed);  // an open chain may span workers
     node_of_[u] = -1;
   }
-  ++stats_.collapses;
+  ++stats.collapses;
 
   // Costs change around v and every moved vertex.
   ++version_[v];
-  push_edges(v);
+  push_edges(worker, v);
   for (int i = 2; i < num_moved; ++i) {
     ++version_[moved[i].first];
-    push_edges(moved[i].first);
+    push_edges(worker, moved[i].first);
   }
   return true;
 }
 
-SimplifyStats Simplifier::run() {
-  setup();
-  rebuild_heap();
-  size_t rebuild_at = 4 * heap_.size();
-  while (alive_vertices_ > options_.target_vertices && !heap_.empty()) {
-    const Entry e = heap_.top();
-    heap_.pop();
-    if (!vertex_alive_[e.remove] || !vertex_alive_[e.keep]) continue;
-    if (static_cast<uint16_t>(version_[e.remove]) != e.version_remove ||
-        static_cast<uint16_t>(version_[e.keep]) != e.version_keep) {
-      continue;
-    }
-    const Plan p = plan_direction(e.remove, e.keep);
+// Greedy collapses, cheapest first, of the worker's edges until it is down to w.stop vertices.
+void Simplifier::simplify_with(Worker& worker) {
+  worker.mark.assign(pos_.size(), 0);
+  rebuild_queue(worker);
+  size_t rebuild_at = 4 * worker.queue.size();
+  auto live = [&](const Entry& e) {
+    const int32_t remove = e.remove();
+    return vertex_alive_[remove] && vertex_alive_[e.keep] &&
+           static_cast<uint16_t>(version_[remove]) == e.version_remove &&
+           static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
+  };
+  Entry e;
+  while (worker.alive > worker.stop && worker.queue.pop(e, live)) {
+    if (!live(e)) continue;
+    const int32_t remove = e.remove();
+    const Plan p = plan_direction(remove, e.keep);
     if (p.remove < 0) continue;
-    try_collapse(p);
-    if (heap_.size() > rebuild_at) {
-      rebuild_heap();
-      rebuild_at = std::max<size_t>(4 * heap_.size(), 1024);
+    try_collapse(worker, p);
+    if (worker.queue.size() > rebuild_at) {
+      rebuild_queue(worker);
+      rebuild_at = std::max<size_t>(4 * worker.queue.size(), 1024);
     }
   }
+  worker.mark = {};
+}
+
+SimplifyStats Simplifier::run() {
+  setup();
+  const int64_t target = options_.target_vertices;
+  SimplifyStats stats;
+  auto merge = [&](const SimplifyStats& s) {
+    stats.collapses += s.collapses;
+    stats.rejected_topology += s.rejected_topology;
+    stats.rejected_feature += s.rejected_feature;
+    stats.max_feature_error = std::max(stats.max_feature_error, s.max_feature_error);
+  };
+
+  // Parallel phase (deterministic whatever the thread count): the image is cut into a fixed grid of
+  // regions, and each region is simplified on its own, its seams frozen, down to `target`
+  // vertices plus its frozen ones. The collapses of a region do not depend on the other regions,
+  // and however the final vertices are shared among regions, none ends with more than `target`:
+  // so this is the start of what one global pass would do in the region, up to the seams.
+  constexpr int kRegionsX = 2, kRegionsY = 2;
+  const int64_t nv = static_cast<int64_t>(pos_.size());
+  if (nv > 4 * kRegionsX * kRegionsY * target) {
+    split_regions(kRegionsX, kRegionsY);
+    std::vector<Worker> workers(kRegionsX * kRegionsY);
+    for (int64_t v = 0; v < nv; ++v) {
+      Worker& w = workers[region_[v]];
+      ++w.alive;
+      w.stop += frozen_[v];
+    }
+    for (size_t r = 0; r < workers.size(); ++r) {
+      workers[r].region = static_cast<int32_t>(r);
+      workers[r].stop += target;
+    }
+    detail::parallel_for(static_cast<int>(workers.size()), options_.threads, [&](int r) { simplify_with(workers[r]); });
+    for (Worker& w : workers) {
+      merge(w.stats);
+      arenas_.push_back(std::move(w.arena));
+    }
+  }
+
+  // Then everything, one collapse at a time.
+  Worker all;
+  for (int64_t v = 0; v < nv; ++v) all.alive += vertex_alive_[v];
+  all.stop = target;
+  simplify_with(all);
+  merge(all.stats);
   write_back();
-  return stats_;
+  return stats;
+}
+
+// Regions: a grid of nx x ny rectangles of the image by initial position. Frozen: every vertex with
+// a neighbour in another region (the seams), and every vertex of a closed feature that is not all
+// within one region's unfrozen vertices (its length is shared state).
+void Simplifier::split_regions(int nx, int ny) {
+  const int32_t nv = static_cast<int32_t>(pos_.size());
+  region_.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) {
+    const int rx = std::clamp(static_cast<int>(pos_[v].x * nx / w_), 0, nx - 1);
+    const int ry = std::clamp(static_cast<int>(pos_[v].y * ny / h_), 0, ny - 1);
+    region_[v] = static_cast<int16_t>(ry * nx + rx);
+  }
+  frozen_.assign(nv, 0);
+  for (const Tri& t : tri_) {
+    if (region_[t[0]] == region_[t[1]] && region_[t[1]] == region_[t[2]]) continue;
+    for (int32_t v : t) frozen_[v] = 1;
+  }
+  for (const FeatureState& f : features_) {
+    if (!f.closed) continue;
+    bool shared = false;
+    int32_t n = f.head;
+    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) {
+      const int32_t v = nodes_[n].vertex;
+      shared |= frozen_[v] || region_[v] != region_[nodes_[f.head].vertex];
+    }
+    if (!shared) continue;
+    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) frozen_[nodes_[n].vertex] = 1;
+  }
+}
+
+// Whether every node that the refit after removing `removed_node` reads or moves is the worker's
+// (the same walk as refit(): five nodes each way, stopping at corners).
+bool Simplifier::owns_window(const Worker& worker, int32_t removed_node) const {
+  if (worker.region < 0) return true;
+  constexpr int kReach = 5;
+  for (int direction = 0; direction < 2; ++direction) {
+    int count = 0;
+    for (int32_t n = direction ? nodes_[removed_node].next : nodes_[removed_node].prev; n >= 0 && n != removed_node;
+         n = direction ? nodes_[n].next : nodes_[n].prev) {
+      if (!owns(worker, nodes_[n].vertex)) return false;
+      if (kind_[nodes_[n].vertex] == Kind::kCorner || ++count == kReach) break;
+    }
+  }
+  return true;
 }
 
 void Simplifier::write_back() {
@@ -755,8 +1147,9 @@ void Simplifier::write_back() {
     vmap[v] = out.num_vertices();
     out.positions.push_back(pos_[v]);
   }
-  std::vector<int32_t> color_vertex;
-  for (size_t f = 0; f < tri_.size(); ++f) {
+  std::vector<int32_t> color_vertex, face_of(tri_.size());
+  for (size_t i = 0; i < tri_.size(); ++i) face_of[face_order_[i]] = static_cast<int32_t>(i);
+  for (const int32_t f : face_of) {
     if (!face_alive_[f]) continue;
     Tri t, c;
     for (int k = 0; k < 3; ++k) {
@@ -766,8 +1159,10 @@ void Simplifier::write_back() {
         ci = static_cast<int32_t>(color_vertex.size());
         color_vertex.push_back(tri_[f][k]);
         const Vec2 p = pos_[tri_[f][k]];
-        const Eigen::Vector3d rgb = best_color(quadric_[tcol_[f][k]], {p.x, p.y}) / options_.color_scale;
-        out.colors.push_back({static_cast<float>(rgb(0)), static_cast<float>(rgb(1)), static_cast<float>(rgb(2))});
+        const auto rgb = best_color(quadric_[tcol_[f][k]], p.x, p.y);
+        const double scale = 1 / options_.color_scale;
+        out.colors.push_back({static_cast<float>(rgb[0] * scale), static_cast<float>(rgb[1] * scale),
+                              static_cast<float>(rgb[2] * scale)});
       }
       c[k] = ci;
     }

@@ -84,6 +84,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   SimplifyOptions simplify_options;
   simplify_options.target_vertices = target;
   simplify_options.max_feature_error = options.max_feature_error;
+  simplify_options.threads = options.threads;
   r.simplify = simplify(mesh, image.width, image.height, simplify_options);
   lap("simplify");
 

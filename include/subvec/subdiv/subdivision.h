@@ -72,6 +72,9 @@ class Subdivision {
                 int threads = 0) const;
   void evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads = 0) const;
   void evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads = 0) const;
+  // The positions of evaluate_positions() (to float precision) for a single evaluation: refines
+  // level by level and never builds the position stencils, which cost several evaluations.
+  void evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const;
 
   // Limit stencils: row i expresses refined vertex i (color value i) as a combination of control
   // vertices (color values). #N by #V and #M by #C; every row sums to 1 (to 3e-8 for color values

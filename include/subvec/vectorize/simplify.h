@@ -13,6 +13,7 @@ struct SimplifyOptions {
   int target_vertices = 0;          // stop when this many control vertices remain
   double max_feature_error = 1.0;   // pixels
   double color_scale = 2.0;         // colors enter the quadrics as color_scale * (0..255)
+  int threads = 0;                  // <= 0: all cores; the result does not depend on it
 };
 
 struct SimplifyStats {

@@ -29,6 +29,7 @@ struct VectorizeOptions {
   InitialMeshOptions initial_mesh;
   double max_feature_error = 1.0;  // pixels (simplification rolls back collapses beyond it)
   ColorFitOptions fit;
+  int threads = 0;       // <= 0: all cores; the result does not depend on it
   // Called with a stage name and the fraction of the whole job done (0..1).
   std::function<void(const std::string& stage, double fraction)> progress;
 };

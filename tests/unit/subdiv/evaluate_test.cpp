@@ -27,5 +27,17 @@ TEST(Evaluate, ColorsAreIdenticalWhateverTheThreadCount) {
   }
 }
 
+TEST(Evaluate, OneOffPositionsMatchTheStencils) {
+  const testing::TestMesh t = testing::torn_disk();
+  const MeshTopology topo = t.topology();
+  for (int depth : {0, 1, 3}) {
+    const Subdivision sub(t.mesh, topo, depth);
+    std::vector<float> once(size_t(sub.num_vertices()) * 2), stencils(once.size());
+    sub.evaluate_positions_once(t.mesh.positions, once);
+    sub.evaluate_positions(t.mesh.positions, stencils);
+    for (size_t i = 0; i < once.size(); ++i) EXPECT_NEAR(once[i], stencils[i], 1e-4) << "depth " << depth;
+  }
+}
+
 }  // namespace
 }  // namespace subvec

@@ -152,6 +152,29 @@ TEST(Vectorize, IsDeterministic) {
   EXPECT_EQ(a.levels[0].triangles, b.levels[0].triangles);
 }
 
+TEST(Simplify, IdenticalForAnyThreadCount) {
+  // Regions are simplified in parallel first; the result must not depend on the schedule.
+  const Image8 img = disk_image(160, 128, 70.3, 61.8, 37.5);
+  const ControlMesh dense = build_initial_mesh(img, detect_features(img));
+  std::vector<ControlMesh> out;
+  for (int threads : {1, 2, 3}) {
+    ControlMesh mesh = dense;
+    SimplifyOptions options;
+    options.target_vertices = 150;
+    options.threads = threads;
+    simplify(mesh, img.width, img.height, options);
+    EXPECT_NO_THROW(validate_level(mesh, img.width, img.height));
+    EXPECT_EQ(mesh.num_vertices(), 150);
+    out.push_back(std::move(mesh));
+  }
+  for (size_t i = 1; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].positions, out[0].positions);
+    EXPECT_EQ(out[i].colors, out[0].colors);
+    EXPECT_EQ(out[i].triangles, out[0].triangles);
+    EXPECT_EQ(out[i].triangle_colors, out[0].triangle_colors);
+  }
+}
+
 TEST(Vectorize, PixelFitBeatsVertexFitAndErrorFallsWithRatio) {
   const Image8 img = disk_image(96, 96, 44.0, 50.5, 27.5);
   VectorizeOptions pixel_fit;
