@@ -15,7 +15,7 @@
 #include <emmintrin.h>
 #endif
 
-#include "render/parallel_p.h"
+#include "core/parallel_p.h"
 
 namespace subvec::detail {
 namespace {

@@ -22,7 +22,7 @@
 #include <cmath>
 #include <string>
 
-#include "render/parallel_p.h"
+#include "core/parallel_p.h"
 #include "render/raster_p.h"
 #include "render/renderer_p.h"
 #include "render/strokes_p.h"
