@@ -410,6 +410,7 @@ class Simplifier {
   void push(Worker& w, const Plan& p);
   void rebuild_queue(Worker& w);
   void neighbours(Worker& w, int32_t v, std::vector<int32_t>& out) const;
+  bool image_corner(Vec2 p) const { return (p.x == 0 || p.x == w_) && (p.y == 0 || p.y == h_); }
   bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
   bool link_condition(Worker& w, int32_t u, int32_t v) const;
@@ -447,7 +448,6 @@ class Simplifier {
 };
 
 void Simplifier::setup() {
-  const MeshTopology topo = MeshTopology::build(mesh_, w_, h_);
   const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   pos_ = mesh_.positions;
   // Faces and color values are renumbered to follow the vertex order, which is spatially coherent,
@@ -502,16 +502,41 @@ void Simplifier::setup() {
   }
 
   kind_.resize(nv);
+  // Vertex types as in MeshTopology (paper §3.2), counted directly: border edges join two vertices on
+  // one side of the image (in a valid mesh no other edge does), creases are listed, tears are the
+  // features' edges; feature ends and the image corners are corners.
   sides_.assign(nv, 0);
   for (int v = 0; v < nv; ++v) {
     const Vec2 p = pos_[v];
     sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == w_ ? 4 : 0) | (p.y == h_ ? 8 : 0));
-    switch (topo.vertex_tags[v]) {
-      case VertexTag::kSmooth: kind_[v] = Kind::kSmooth; break;
-      case VertexTag::kTear: kind_[v] = Kind::kFeature; break;
-      case VertexTag::kCrease: kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner; break;  // interior creases stay
-      case VertexTag::kCorner: kind_[v] = Kind::kCorner; break;
+  }
+  std::vector<uint8_t> creases(nv, 0), tears(nv, 0), corner(nv, 0);
+  for (int v = 0; v < nv; ++v) {
+    if (!sides_[v]) continue;
+    std::array<int32_t, 8> along{};
+    int count = 0;
+    for (int32_t f : vfaces_[v]) {
+      for (int32_t w : tri_[f]) {
+        if (w == v || !(sides_[v] & sides_[w]) || std::find(along.begin(), along.begin() + count, w) != along.begin() + count) continue;
+        if (count < 8) along[count++] = w;
+      }
     }
+    creases[v] = static_cast<uint8_t>(count);
+    corner[v] = (image_corner(pos_[v]) ? 1 : 0);
+  }
+  for (const EdgeVerts& e : mesh_.creases)
+    for (int32_t v : e) creases[v] = static_cast<uint8_t>(std::min(creases[v] + 1, 255));
+  for (const Feature& f : mesh_.features) {
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i)
+      for (int32_t v : {f.vertices[i], f.vertices[i + 1]}) tears[v] = static_cast<uint8_t>(std::min(tears[v] + 1, 255));
+    if (!f.closed()) corner[f.vertices.front()] = corner[f.vertices.back()] = 1;
+  }
+  for (int v = 0; v < nv; ++v) {
+    if (corner[v]) kind_[v] = Kind::kCorner;
+    else if (creases[v] == 0 && tears[v] == 0) kind_[v] = Kind::kSmooth;
+    else if (creases[v] == 2 && tears[v] == 0) kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner;  // interior creases stay
+    else if (tears[v] == 2 && creases[v] == 0) kind_[v] = Kind::kFeature;
+    else kind_[v] = Kind::kCorner;
   }
 
   feature_.assign(nv, -1);
