@@ -13,6 +13,13 @@
 // by least squares to the detected polyline (eq. 1) and the collapse is rolled back if the limit
 // curve (a uniform cubic B-spline of the chain, corners interpolated) leaves it by more than
 // max_feature_error. No collapse may break the link condition or flip or flatten a triangle.
+//
+// Speed. Collapses are cheapest first from a lazy queue whose front alone is a heap (binned by
+// cost, see CollapseQueue). Faces and color values are renumbered in vertex order for locality.
+// Most collapses run in parallel: the image is cut into 2 x 2 regions with frozen seams, each
+// simplified on its own (a Worker per region, writing only what it owns) down to the target plus its
+// frozen vertices, then one global pass finishes; see run() for why that matches one global pass
+// away from the seams. The output does not depend on the thread count.
 #include "subvec/vectorize/simplify.h"
 
 #include <algorithm>
