@@ -401,8 +401,12 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
     for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
       const int32_t r = st.columns[e];
       const double w = st.values[e];
-      for (int32_t k = gram_s.offsets[r]; k < gram_s.offsets[r + 1]; ++k) {
-        if (gram_s.columns[k] >= i) acc.add(gram_s.columns[k], w * gram_s.values[k]);
+      // (Rows come out of RowAccumulator sorted: the lower triangle is a suffix.)
+      const int32_t* first = gram_s.columns.data() + gram_s.offsets[r];
+      const int32_t* last = gram_s.columns.data() + gram_s.offsets[r + 1];
+      for (int32_t k = static_cast<int32_t>(std::lower_bound(first, last, i) - gram_s.columns.data());
+           k < gram_s.offsets[r + 1]; ++k) {
+        acc.add(gram_s.columns[k], w * gram_s.values[k]);
       }
       for (int k = 0; k < 3; ++k) rhs(i, k) += w * btt[r][k];
     }
