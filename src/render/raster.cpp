@@ -722,45 +722,54 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
         quad_colors = tail_colors;
       }
       cover_quad(f.fixed, quad, n, last_x, band_y0, last_y, q);
-      // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first two are shaded and
+      // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first (two) are shaded and
       // drawn without branches (a missing one, kNone, to a dummy pixel), only the rare others
       // one by one.
       const __m128i none = _mm_set1_epi32(1 << QuadCoverage::kNone);
       const __m128i second = _mm_and_si128(q.owned, _mm_sub_epi32(q.owned, _mm_set1_epi32(1)));
-      const __m128i which[2] = {lowest_bit(_mm_or_si128(q.owned, none)),
-                                lowest_bit(_mm_or_si128(second, none))};
-      __m128i rgb_v[2];
-      shade_quad<2>(mesh.colors.data(), quad_colors, q, which, rgb_v);
       const __m128i rest = _mm_and_si128(second, _mm_sub_epi32(second, _mm_set1_epi32(1)));
-      const unsigned more = ~unsigned(_mm_movemask_ps(
-                                _mm_castsi128_ps(_mm_cmpeq_epi32(rest, _mm_setzero_si128())))) &
-                            0xfu;
-      alignas(16) int32_t px0[4], py0[4], c0[4], c1[4];
-      alignas(16) uint32_t rgb0[4], rgb1[4];
+      const __m128i zero = _mm_setzero_si128();
+      const unsigned more =
+          ~unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(rest, zero)))) & 0xfu;
+      alignas(16) int32_t px0[4], py0[4];
       _mm_store_si128(reinterpret_cast<__m128i*>(px0), q.px0);
       _mm_store_si128(reinterpret_cast<__m128i*>(py0), q.py0);
-      _mm_store_si128(reinterpret_cast<__m128i*>(c0), which[0]);
-      _mm_store_si128(reinterpret_cast<__m128i*>(c1), which[1]);
-      _mm_store_si128(reinterpret_cast<__m128i*>(rgb0), rgb_v[0]);
-      _mm_store_si128(reinterpret_cast<__m128i*>(rgb1), rgb_v[1]);
-      auto draw_lane = [&](int lane) {
-        // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
-        const uintptr_t origin = uintptr_t(pixels) + uintptr_t(py0[lane]) * stride +
-                                 uintptr_t(px0[lane]) * kChannels;
-        offsets[QuadCoverage::kNone] = uintptr_t(dummy) - origin;
-        draw(reinterpret_cast<uint8_t*>(origin + offsets[c0[lane]]), rgb0[lane]);
-        draw(reinterpret_cast<uint8_t*>(origin + offsets[c1[lane]]), rgb1[lane]);
-      };
-      if ((n == 4) & (q.large == 0)) {
-        draw_lane(0), draw_lane(1), draw_lane(2), draw_lane(3);
-      } else {
-        for (int lane = 0; lane < n; ++lane) {
-          if ((q.large >> lane) & 1) {
-            draw_triangle(ti + lane);
-          } else {
-            draw_lane(lane);
+      // Rounds: 1 when no lane owns a second candidate (most quads at 1-pixel edges), else 2.
+      auto draw_quad = [&]<int kRounds>() {
+        __m128i which[kRounds], rgb_v[kRounds];
+        which[0] = lowest_bit(_mm_or_si128(q.owned, none));
+        if constexpr (kRounds == 2) which[1] = lowest_bit(_mm_or_si128(second, none));
+        shade_quad<kRounds>(mesh.colors.data(), quad_colors, q, which, rgb_v);
+        alignas(16) int32_t c[kRounds][4];
+        alignas(16) uint32_t rgb[kRounds][4];
+        for (int r = 0; r < kRounds; ++r) {
+          _mm_store_si128(reinterpret_cast<__m128i*>(c[r]), which[r]);
+          _mm_store_si128(reinterpret_cast<__m128i*>(rgb[r]), rgb_v[r]);
+        }
+        auto draw_lane = [&](int lane) {
+          // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
+          const uintptr_t origin = uintptr_t(pixels) + uintptr_t(py0[lane]) * stride +
+                                   uintptr_t(px0[lane]) * kChannels;
+          offsets[QuadCoverage::kNone] = uintptr_t(dummy) - origin;
+          for (int r = 0; r < kRounds; ++r)
+            draw(reinterpret_cast<uint8_t*>(origin + offsets[c[r][lane]]), rgb[r][lane]);
+        };
+        if ((n == 4) & (q.large == 0)) {
+          draw_lane(0), draw_lane(1), draw_lane(2), draw_lane(3);
+        } else {
+          for (int lane = 0; lane < n; ++lane) {
+            if ((q.large >> lane) & 1) {
+              draw_triangle(ti + lane);
+            } else {
+              draw_lane(lane);
+            }
           }
         }
+      };
+      if (_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(second, zero))) == 0xf) {
+        draw_quad.template operator()<1>();
+      } else {
+        draw_quad.template operator()<2>();
       }
       for (unsigned lanes = more; lanes; lanes &= lanes - 1) {  // owning 3 or more
         const int lane = std::countr_zero(lanes);

@@ -4,10 +4,13 @@
 // Design note. Refined triangles are tiny (about 1-3 output pixels each), so the per-triangle
 // setup dominates and everything is integer and branch-light:
 //  - vertices are snapped once per frame to 24.8 fixed point in output pixels;
-//  - coverage is tested with exact int64 edge functions at pixel centres under a top-left fill
+//  - coverage is tested with exact integer edge functions at pixel centres under a top-left fill
 //    rule, so a sample on an edge shared by two triangles belongs to exactly one of them, and a
 //    sample on a shared vertex to exactly one triangle of the fan;
-//  - colors are the barycentric (Gouraud) interpolation of the three corner colors.
+//  - colors are the barycentric (Gouraud) interpolation of the three corner colors;
+//  - triangles with at most 4 x 2 candidate centres (nearly all) are tested, shaded and drawn four
+//    at a time in SIMD lanes without data-dependent branches; the others, and the subsamples, one
+//    by one. Both give the same bytes.
 // The only discontinuities of the limit color field are the tears (and the image border when the
 // window leaves the image), so anti-aliasing is local: the pixels crossed by refined tear / border
 // segments are marked, and inside those pixels the same triangle pass also tests a 4x4 grid of

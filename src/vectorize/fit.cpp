@@ -16,6 +16,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "core/parallel_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/subdiv/subdivision.h"
@@ -121,10 +122,31 @@ class RowAccumulator {
   size_t count_ = 0;
 };
 
+// Rows 0 .. count-1 of `columns` columns; build(acc, r, out) appends row r to out through acc. One
+// contiguous range of rows per thread: rows are independent, so the result is the same for any split.
+template <class Build>
+Rows build_rows(int count, int columns, int threads, const Build& build) {
+  const int parts = count < 1024 ? 1 : std::min(detail::resolve_threads(threads), 8);
+  std::vector<Rows> part(parts);
+  detail::parallel_for(parts, parts, [&](int p) {
+    RowAccumulator acc(columns);
+    const int end = static_cast<int>(int64_t(count) * (p + 1) / parts);
+    for (int r = static_cast<int>(int64_t(count) * p / parts); r < end; ++r) build(acc, r, part[p]);
+  });
+  Rows out = std::move(part[0]);
+  for (int p = 1; p < parts; ++p) {
+    const int32_t base = static_cast<int32_t>(out.columns.size());
+    for (size_t r = 1; r < part[p].offsets.size(); ++r) out.offsets.push_back(base + part[p].offsets[r]);
+    out.columns.insert(out.columns.end(), part[p].columns.begin(), part[p].columns.end());
+    out.values.insert(out.values.end(), part[p].values.begin(), part[p].values.end());
+  }
+  return out;
+}
+
 // B'B over the m refined color values: the Gram blocks of the refined triangles (symmetric, packed
 // 00 01 02 11 12 22) plus a diagonal.
 Rows gram_rows(const RefinedMesh& refined, int m, const std::vector<std::array<double, 6>>& blocks,
-               const std::vector<double>& diagonal) {
+               const std::vector<double>& diagonal, int threads) {
   static constexpr int kPacked[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
   std::vector<int32_t> first(size_t(m) + 1, 0), corners;
   if (!blocks.empty()) {
@@ -136,35 +158,25 @@ Rows gram_rows(const RefinedMesh& refined, int m, const std::vector<std::array<d
     for (int t = 0; t < refined.num_triangles(); ++t)
       for (int k = 0; k < 3; ++k) corners[fill[refined.triangle_colors[t][k]]++] = 3 * t + k;
   }
-  Rows out;
-  out.offsets.reserve(size_t(m) + 1);
-  out.columns.reserve(size_t(m) * 7);
-  out.values.reserve(size_t(m) * 7);
-  RowAccumulator acc(m);
-  for (int32_t v = 0; v < m; ++v) {
+  return build_rows(m, m, threads, [&](RowAccumulator& acc, int32_t v, Rows& out) {
     if (!diagonal.empty()) acc.add(v, diagonal[v]);
     for (int32_t i = first[v]; i < first[v + 1] && !blocks.empty(); ++i) {
       const int32_t t = corners[i] / 3, k = corners[i] % 3;
       for (int j = 0; j < 3; ++j) acc.add(refined.triangle_colors[t][j], blocks[t][kPacked[k][j]]);
     }
     acc.flush(out);
-  }
-  return out;
+  });
 }
 
 // a * s, with s a sparse matrix of `columns` columns.
-Rows multiply(const Rows& a, const SparseMatrix& s, int columns) {
-  Rows out;
-  out.offsets.reserve(a.offsets.size());
-  RowAccumulator acc(columns);
-  for (int r = 0; r < a.num_rows(); ++r) {
+Rows multiply(const Rows& a, const SparseMatrix& s, int columns, int threads) {
+  return build_rows(a.num_rows(), columns, threads, [&](RowAccumulator& acc, int r, Rows& out) {
     for (int32_t e = a.offsets[r]; e < a.offsets[r + 1]; ++e) {
       const double w = a.values[e];
       for (SparseMatrix::InnerIterator it(s, a.columns[e]); it; ++it) acc.add(static_cast<int32_t>(it.col()), w * it.value());
     }
     acc.flush(out);
-  }
-  return out;
+  });
 }
 
 // The transpose of s (rows x columns) as rows.
@@ -285,14 +297,17 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         for (int x = x0; x <= x1; ++x)
           if (point_segment_distance(x + 0.5, y + 0.5, sg) < options.band) band[size_t(y) * width + x] = 1;
     }
-    std::vector<int32_t> nearby;
+    // Targets: the pixel, or for band pixels the hole-filled color (in parallel, image rows apart),
+    // then the rows in pixel order.
     const int r = static_cast<int>(std::ceil(options.fill_radius));
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const Location& loc = located[size_t(y) * width + x];
-        if (loc.triangle < 0) continue;
-        std::array<double, 3> target = pixel(image, x, y);
-        if (band[size_t(y) * width + x]) {
+    std::vector<std::array<double, 3>> filled(size_t(width) * height);
+    std::vector<uint8_t> filled_ok(size_t(width) * height, 0);
+    const int parts = std::min(detail::resolve_threads(options.threads), height);
+    detail::parallel_for(parts, parts, [&](int part) {
+      std::vector<int32_t> nearby;
+      for (int y = height * part / parts; y < height * (part + 1) / parts; ++y) {
+        for (int x = 0; x < width; ++x) {
+          if (located[size_t(y) * width + x].triangle < 0 || !band[size_t(y) * width + x]) continue;
           // Hole filling: inverse-square-distance average of non-band pixels on the same side.
           const double cx = x + 0.5, cy = y + 0.5;
           grid.query(cx - r, cy - r, cx + r, cy + r, nearby);
@@ -317,7 +332,19 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
             }
           }
           if (wsum == 0) continue;  // nothing on this side nearby: leave the pixel out
-          for (int k = 0; k < 3; ++k) target[k] = sum[k] / wsum;
+          for (int k = 0; k < 3; ++k) filled[size_t(y) * width + x][k] = sum[k] / wsum;
+          filled_ok[size_t(y) * width + x] = 1;
+        }
+      }
+    });
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const Location& loc = located[size_t(y) * width + x];
+        if (loc.triangle < 0) continue;
+        std::array<double, 3> target = pixel(image, x, y);
+        if (band[size_t(y) * width + x]) {
+          if (!filled_ok[size_t(y) * width + x]) continue;
+          target = filled[size_t(y) * width + x];
           ++stats.filled;
         }
         const Tri& values = refined.triangle_colors[loc.triangle];
@@ -365,27 +392,26 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
 
   // The normal equations, lower triangle: column i of the lower triangle is row i of S' (B'B S)
   // from column i on.
-  const Rows gram = gram_rows(refined, m, blocks, diagonal);
+  const Rows gram = gram_rows(refined, m, blocks, diagonal, options.threads);
   blocks = {};
-  const Rows gram_s = multiply(gram, s, c);
+  const Rows gram_s = multiply(gram, s, c, options.threads);
   const Rows st = transpose(s);
-  Rows lower;
-  lower.offsets.reserve(size_t(c) + 1);
   Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
-  {
-    RowAccumulator acc(c);
-    for (int32_t i = 0; i < c; ++i) {
-      for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
-        const int32_t r = st.columns[e];
-        const double w = st.values[e];
-        for (int32_t k = gram_s.offsets[r]; k < gram_s.offsets[r + 1]; ++k) {
-          if (gram_s.columns[k] >= i) acc.add(gram_s.columns[k], w * gram_s.values[k]);
-        }
-        for (int k = 0; k < 3; ++k) rhs(i, k) += w * btt[r][k];
+  Rows lower = build_rows(c, c, options.threads, [&](RowAccumulator& acc, int32_t i, Rows& out) {
+    for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
+      const int32_t r = st.columns[e];
+      const double w = st.values[e];
+      // (Rows come out of RowAccumulator sorted: the lower triangle is a suffix.)
+      const int32_t* first = gram_s.columns.data() + gram_s.offsets[r];
+      const int32_t* last = gram_s.columns.data() + gram_s.offsets[r + 1];
+      for (int32_t k = static_cast<int32_t>(std::lower_bound(first, last, i) - gram_s.columns.data());
+           k < gram_s.offsets[r + 1]; ++k) {
+        acc.add(gram_s.columns[k], w * gram_s.values[k]);
       }
-      acc.flush(lower, i, i);
+      for (int k = 0; k < 3; ++k) rhs(i, k) += w * btt[r][k];
     }
-  }
+    acc.flush(out, i, i);
+  });
 
   // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches. Each
   // column's first entry is its diagonal.

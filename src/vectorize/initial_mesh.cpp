@@ -133,15 +133,23 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   std::vector<int32_t> owner(num_colors, -1);
   std::vector<int> sectors(mesh.num_vertices(), 0);
   for (int f = 0; f < mesh.num_triangles(); ++f) {
-    const Tri& t = mesh.triangles[f];
-    const Vec2 c{(mesh.positions[t[0]].x + mesh.positions[t[1]].x + mesh.positions[t[2]].x) / 3,
-                 (mesh.positions[t[0]].y + mesh.positions[t[1]].y + mesh.positions[t[2]].y) / 3};
     for (int k = 0; k < 3; ++k) {
       const int32_t ci = mesh.triangle_colors[f][k];
       if (owner[ci] < 0) {
-        owner[ci] = t[k];
-        ++sectors[t[k]];
+        owner[ci] = mesh.triangles[f][k];
+        ++sectors[owner[ci]];
       }
+    }
+  }
+  // Where a vertex has several sectors, the mean direction of each toward its faces' centroids.
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const Tri& t = mesh.triangles[f];
+    if (sectors[t[0]] < 2 && sectors[t[1]] < 2 && sectors[t[2]] < 2) continue;
+    const Vec2 c{(mesh.positions[t[0]].x + mesh.positions[t[1]].x + mesh.positions[t[2]].x) / 3,
+                 (mesh.positions[t[0]].y + mesh.positions[t[1]].y + mesh.positions[t[2]].y) / 3};
+    for (int k = 0; k < 3; ++k) {
+      if (sectors[t[k]] < 2) continue;
+      const int32_t ci = mesh.triangle_colors[f][k];
       const Vec2 p = mesh.positions[t[k]];
       const double len = std::hypot(c.x - p.x, c.y - p.y);
       if (len > 0) toward[ci].x += (c.x - p.x) / len, toward[ci].y += (c.y - p.y) / len;

@@ -13,6 +13,13 @@
 // by least squares to the detected polyline (eq. 1) and the collapse is rolled back if the limit
 // curve (a uniform cubic B-spline of the chain, corners interpolated) leaves it by more than
 // max_feature_error. No collapse may break the link condition or flip or flatten a triangle.
+//
+// Speed. Collapses are cheapest first from a lazy queue whose front alone is a heap (binned by
+// cost, see CollapseQueue). Faces and color values are renumbered in vertex order for locality.
+// Most collapses run in parallel: the image is cut into 2 x 2 regions with frozen seams, each
+// simplified on its own (a Worker per region, writing only what it owns) down to the target plus its
+// frozen vertices, then one global pass finishes; see run() for why that matches one global pass
+// away from the seams. The output does not depend on the thread count.
 #include "subvec/vectorize/simplify.h"
 
 #include <algorithm>
@@ -35,8 +42,6 @@
 namespace subvec {
 namespace {
 
-using Mat5 = Eigen::Matrix<double, 5, 5>;
-using Vec5 = Eigen::Matrix<double, 5, 1>;
 
 // Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b). A is symmetric and kept as its upper
 // triangle, row by row (xx xy xr xg xb | yy yr yg yb | rr rg rb | gg gb | bb): 21 doubles, padded
@@ -53,26 +58,33 @@ struct alignas(64) Quadric {
   }
 };
 
-// Garland-Heckbert quadric of the plane through three 5D points, weighted by the xy area.
-Quadric triangle_quadric(const Vec5& p, const Vec5& q, const Vec5& r) {
+// Garland-Heckbert quadric of the plane through three 5D points, weighted by the xy area. (Written
+// out with the sums in the order Eigen's vectorized 5-vector reductions use, which earlier versions
+// called: the same bits, a third of the instructions.)
+using Point5 = std::array<double, 5>;  // (x, y, r, g, b)
+double dot5(const Point5& a, const Point5& b) {
+  return ((a[0] * b[0] + a[2] * b[2]) + (a[1] * b[1] + a[3] * b[3])) + a[4] * b[4];
+}
+Quadric triangle_quadric(const Point5& p, const Point5& q, const Point5& r) {
   Quadric out;
-  Vec5 e1 = q - p;
-  const double l1 = e1.norm();
+  Point5 e1, e2;  // orthonormal, spanning the triangle's plane
+  for (int i = 0; i < 5; ++i) e1[i] = q[i] - p[i];
+  const double l1 = std::sqrt(dot5(e1, e1));
   if (l1 <= 0) return out;
-  e1 /= l1;
-  Vec5 e2 = r - p;
-  e2 -= e1.dot(e2) * e1;
-  const double l2 = e2.norm();
+  for (int i = 0; i < 5; ++i) e1[i] /= l1;
+  for (int i = 0; i < 5; ++i) e2[i] = r[i] - p[i];
+  const double along = dot5(e1, e2);
+  for (int i = 0; i < 5; ++i) e2[i] -= along * e1[i];
+  const double l2 = std::sqrt(dot5(e2, e2));
   if (l2 <= 0) return out;
-  e2 /= l2;
-  const double area = 0.5 * std::abs((q(0) - p(0)) * (r(1) - p(1)) - (q(1) - p(1)) * (r(0) - p(0)));
-  const double pe1 = p.dot(e1), pe2 = p.dot(e2);
-  const Mat5 a = area * (Mat5::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
+  for (int i = 0; i < 5; ++i) e2[i] /= l2;
+  const double area = 0.5 * std::abs((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
+  const double pe1 = dot5(p, e1), pe2 = dot5(p, e2);
+  // A = area (I - e1 e1' - e2 e2'), b = area (pe1 e1 + pe2 e2 - p), c = area (p'p - pe1^2 - pe2^2).
   for (int i = 0, n = 0; i < 5; ++i)
-    for (int j = i; j < 5; ++j) out.a[n++] = a(i, j);
-  const Vec5 b = area * (pe1 * e1 + pe2 * e2 - p);
-  for (int i = 0; i < 5; ++i) out.b[i] = b(i);
-  out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
+    for (int j = i; j < 5; ++j) out.a[n++] = area * (((i == j ? 1.0 : 0.0) - e1[i] * e1[j]) - e2[i] * e2[j]);
+  for (int i = 0; i < 5; ++i) out.b[i] = area * ((pe1 * e1[i] + pe2 * e2[i]) - p[i]);
+  out.c = area * ((dot5(p, p) - pe1 * pe1) - pe2 * pe2);
   return out;
 }
 
@@ -410,6 +422,7 @@ class Simplifier {
   void push(Worker& w, const Plan& p);
   void rebuild_queue(Worker& w);
   void neighbours(Worker& w, int32_t v, std::vector<int32_t>& out) const;
+  bool image_corner(Vec2 p) const { return (p.x == 0 || p.x == w_) && (p.y == 0 || p.y == h_); }
   bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
   bool link_condition(Worker& w, int32_t u, int32_t v) const;
@@ -447,7 +460,6 @@ class Simplifier {
 };
 
 void Simplifier::setup() {
-  const MeshTopology topo = MeshTopology::build(mesh_, w_, h_);
   const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   pos_ = mesh_.positions;
   // Faces and color values are renumbered to follow the vertex order, which is spatially coherent,
@@ -502,16 +514,41 @@ void Simplifier::setup() {
   }
 
   kind_.resize(nv);
+  // Vertex types as in MeshTopology (paper §3.2), counted directly: border edges join two vertices on
+  // one side of the image (in a valid mesh no other edge does), creases are listed, tears are the
+  // features' edges; feature ends and the image corners are corners.
   sides_.assign(nv, 0);
   for (int v = 0; v < nv; ++v) {
     const Vec2 p = pos_[v];
     sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == w_ ? 4 : 0) | (p.y == h_ ? 8 : 0));
-    switch (topo.vertex_tags[v]) {
-      case VertexTag::kSmooth: kind_[v] = Kind::kSmooth; break;
-      case VertexTag::kTear: kind_[v] = Kind::kFeature; break;
-      case VertexTag::kCrease: kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner; break;  // interior creases stay
-      case VertexTag::kCorner: kind_[v] = Kind::kCorner; break;
+  }
+  std::vector<uint8_t> creases(nv, 0), tears(nv, 0), corner(nv, 0);
+  for (int v = 0; v < nv; ++v) {
+    if (!sides_[v]) continue;
+    std::array<int32_t, 8> along{};
+    int count = 0;
+    for (int32_t f : vfaces_[v]) {
+      for (int32_t w : tri_[f]) {
+        if (w == v || !(sides_[v] & sides_[w]) || std::find(along.begin(), along.begin() + count, w) != along.begin() + count) continue;
+        if (count < 8) along[count++] = w;
+      }
     }
+    creases[v] = static_cast<uint8_t>(count);
+    corner[v] = (image_corner(pos_[v]) ? 1 : 0);
+  }
+  for (const EdgeVerts& e : mesh_.creases)
+    for (int32_t v : e) creases[v] = static_cast<uint8_t>(std::min(creases[v] + 1, 255));
+  for (const Feature& f : mesh_.features) {
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i)
+      for (int32_t v : {f.vertices[i], f.vertices[i + 1]}) tears[v] = static_cast<uint8_t>(std::min(tears[v] + 1, 255));
+    if (!f.closed()) corner[f.vertices.front()] = corner[f.vertices.back()] = 1;
+  }
+  for (int v = 0; v < nv; ++v) {
+    if (corner[v]) kind_[v] = Kind::kCorner;
+    else if (creases[v] == 0 && tears[v] == 0) kind_[v] = Kind::kSmooth;
+    else if (creases[v] == 2 && tears[v] == 0) kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner;  // interior creases stay
+    else if (tears[v] == 2 && creases[v] == 0) kind_[v] = Kind::kFeature;
+    else kind_[v] = Kind::kCorner;
   }
 
   feature_.assign(nv, -1);
@@ -556,11 +593,11 @@ void Simplifier::setup() {
   quadric_.assign(mesh_.num_colors(), Quadric{});
   const double cs = options_.color_scale;
   for (int f = 0; f < nf; ++f) {
-    Vec5 p[3];
+    Point5 p[3];
     for (int k = 0; k < 3; ++k) {
       const Vec2 x = pos_[mesh_.triangles[f][k]];
       const Color c = mesh_.colors[mesh_.triangle_colors[f][k]];
-      p[k] << x.x, x.y, cs * c.r, cs * c.g, cs * c.b;
+      p[k] = {x.x, x.y, cs * c.r, cs * c.g, cs * c.b};
     }
     const Quadric q = triangle_quadric(p[0], p[1], p[2]);
     for (int k = 0; k < 3; ++k) quadric_[color_of[mesh_.triangle_colors[f][k]]] += q;

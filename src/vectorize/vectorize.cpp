@@ -90,7 +90,9 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
 
   // Stage 4: colors.
   progress("fit", 0.8);
-  const ColorFitStats fit = fit_colors(mesh, image.width, image.height, image, options.fit);
+  ColorFitOptions fit_options = options.fit;
+  fit_options.threads = options.threads;
+  const ColorFitStats fit = fit_colors(mesh, image.width, image.height, image, fit_options);
   lap("fit");
   progress("done", 1.0);
 

@@ -21,6 +21,7 @@ struct ColorFitOptions {
   double band = 0.5;          // pixels this close to a tear get hole-filled targets
   double fill_radius = 3.0;   // how far hole filling looks for same-side pixels
   double regularization = 1e-6;  // relative Tikhonov weight toward the current colors
+  int threads = 0;               // <= 0: all cores; the result does not depend on it
 };
 
 struct ColorFitStats {

@@ -152,8 +152,9 @@ TEST(Vectorize, IsDeterministic) {
   EXPECT_EQ(a.levels[0].triangles, b.levels[0].triangles);
 }
 
-TEST(Simplify, IdenticalForAnyThreadCount) {
-  // Regions are simplified in parallel first; the result must not depend on the schedule.
+TEST(Vectorize, IdenticalForAnyThreadCount) {
+  // Regions are simplified in parallel first, and the fit assembles its rows in parallel; neither
+  // result may depend on the schedule.
   const Image8 img = disk_image(160, 128, 70.3, 61.8, 37.5);
   const ControlMesh dense = build_initial_mesh(img, detect_features(img));
   std::vector<ControlMesh> out;
@@ -165,6 +166,9 @@ TEST(Simplify, IdenticalForAnyThreadCount) {
     simplify(mesh, img.width, img.height, options);
     EXPECT_NO_THROW(validate_level(mesh, img.width, img.height));
     EXPECT_EQ(mesh.num_vertices(), 150);
+    ColorFitOptions fit;
+    fit.threads = threads;
+    fit_colors(mesh, img.width, img.height, img, fit);
     out.push_back(std::move(mesh));
   }
   for (size_t i = 1; i < out.size(); ++i) {
