@@ -205,8 +205,10 @@ void run_info(const std::string& input, bool json) {
   std::error_code ec;
   const auto bytes = fs::file_size(input, ec);
   std::vector<LevelInfo> levels;
+  int64_t total_vertices = 0;
   for (const subvec::ControlMesh& mesh : image.levels) {
     levels.push_back(level_info(mesh, image.width, image.height));
+    total_vertices += mesh.num_vertices();
   }
 
   if (json) {
@@ -214,6 +216,7 @@ void run_info(const std::string& input, bool json) {
     j["width"] = image.width;
     j["height"] = image.height;
     j["bytes"] = ec ? 0 : bytes;
+    j["bytes_per_vertex"] = ec || total_vertices == 0 ? 0.0 : double(bytes) / double(total_vertices);
     j["levels"] = nlohmann::ordered_json::array();
     for (const LevelInfo& l : levels) {
       j["levels"].push_back({{"vertices", l.vertices},
@@ -235,7 +238,11 @@ void run_info(const std::string& input, bool json) {
 
   std::printf("%s\n", input.c_str());
   std::printf("  size       %d x %d pixels\n", image.width, image.height);
-  std::printf("  file       %llu bytes\n", static_cast<unsigned long long>(ec ? 0 : bytes));
+  std::printf("  file       %llu bytes", static_cast<unsigned long long>(ec ? 0 : bytes));
+  if (!ec && total_vertices > 0) {
+    std::printf(" (%.2f per control vertex)", double(bytes) / double(total_vertices));
+  }
+  std::printf("\n");
   std::printf("  levels     %zu (0 is the finest)\n", levels.size());
   std::printf("  strokes    %zu\n", image.strokes.size());
   const char* label = "metadata";
@@ -254,9 +261,11 @@ void run_info(const std::string& input, bool json) {
 
 // ---- convert ---------------------------------------------------------------------------------
 
-void run_convert(const std::string& input, const std::string& output) {
+void run_convert(const std::string& input, const std::string& output, bool lossless) {
   subvec::svec_format_for(output);  // rejects an unknown extension before any work
-  subvec::write_svec(output, subvec::read_svec(input));
+  subvec::SvecWriteOptions options;
+  options.lossless = lossless;
+  subvec::write_svec(output, subvec::read_svec(input), options);
 }
 
 // ---- compare ---------------------------------------------------------------------------------
@@ -469,14 +478,19 @@ int run(int argc, char** argv) {
 
   // convert
   std::string convert_input, convert_output;
+  bool convert_lossless = false;
   CLI::App* convert =
       app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
   convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
   convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
       ->required();
+  convert->add_flag("--lossless", convert_lossless,
+                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
+                    "of the compact form");
   convert->footer(
       "Examples:\n"
       "  subvec convert in.svec.json -o in.svec     # compact binary\n"
+      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
       "  subvec convert in.svec -o in.svec.json     # readable JSON");
 
   // compare
@@ -553,7 +567,7 @@ int run(int argc, char** argv) {
   } else if (info->parsed()) {
     run_info(info_input, info_json);
   } else if (convert->parsed()) {
-    run_convert(convert_input, convert_output);
+    run_convert(convert_input, convert_output, convert_lossless);
   } else if (compare->parsed()) {
     run_compare(compare_ref, compare_test, compare_json);
   } else if (vectorize->parsed()) {

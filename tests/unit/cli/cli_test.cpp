@@ -203,10 +203,11 @@ TEST_F(Cli, InfoText) {
 TEST_F(Cli, ConvertRoundTrip) {
   const fs::path bin = dir_ / "a.svec", json = dir_ / "b.svec.json", direct = dir_ / "c.svec.json",
                  bin2 = dir_ / "d.svec";
-  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin) + " --lossless").status,
+            0);
   ASSERT_EQ(subvec("convert " + q(bin) + " -o " + q(json)).status, 0);
   ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(direct)).status, 0);
-  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2) + " --lossless").status, 0);
   // json -> svec -> json gives the text json -> json gives; svec -> json -> svec the same bytes.
   EXPECT_EQ(read_text(json), read_text(direct));
   EXPECT_EQ(read_text(bin), read_text(bin2));
@@ -215,6 +216,27 @@ TEST_F(Cli, ConvertRoundTrip) {
   ASSERT_EQ(subvec("render " + q(bin) + " -o " + q(dir_ / "x.png")).status, 0);
   ASSERT_EQ(subvec("render " + q(example("03-junction")) + " -o " + q(dir_ / "y.png")).status, 0);
   EXPECT_EQ(read_text(dir_ / "x.png"), read_text(dir_ / "y.png"));
+}
+
+TEST_F(Cli, ConvertCompactIsStableAndRendersAlike) {
+  // The compact form (the default) rounds values and renumbers the mesh: a second conversion
+  // gives the same bytes, and the picture barely moves.
+  const fs::path bin = dir_ / "a.svec", json = dir_ / "b.svec.json", bin2 = dir_ / "c.svec";
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(bin) + " -o " + q(json)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2)).status, 0);
+  EXPECT_EQ(read_text(bin), read_text(bin2));
+  EXPECT_LT(fs::file_size(bin), fs::file_size(example("03-junction")) / 4);
+  ASSERT_EQ(subvec("render " + q(bin) + " -o " + q(dir_ / "x.png")).status, 0);
+  ASSERT_EQ(subvec("render " + q(example("03-junction")) + " -o " + q(dir_ / "y.png")).status, 0);
+  const CliResult r = subvec("compare " + q(dir_ / "y.png") + " " + q(dir_ / "x.png") + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_LT(nlohmann::json::parse(r.out)["mae_mean"].get<double>(), 0.5);
+  const CliResult info = subvec("info " + q(bin) + " --json");
+  ASSERT_EQ(info.status, 0) << info.err;
+  const nlohmann::json j = nlohmann::json::parse(info.out);
+  EXPECT_NEAR(j["bytes_per_vertex"].get<double>(),
+              j["bytes"].get<double>() / j["levels"][0]["vertices"].get<double>(), 1e-9);
 }
 
 TEST_F(Cli, CompareIdenticalImages) {
