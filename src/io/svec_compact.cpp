@@ -1,6 +1,7 @@
 // Compact levels of `.svec` version 2 (docs/format.md, "Compact levels").
 //
-// Design note. A level is coded as five sections, each its own zstd block:
+// Design note. A level is coded as six sections (the larger ones each in their own zstd block, so
+// that they get their own entropy tables):
 //  1. connectivity: the mesh, closed into a sphere by one virtual vertex joined to every border
 //     edge, is visited by region growing from triangle 0. A frontier (cyclic lists of boundary
 //     edges) separates visited from unvisited triangles; each step takes the triangle across the
@@ -11,15 +12,15 @@
 //     every case. Three operations share a byte: about 2 bits per triangle before zstd.
 //  2. split offsets: the virtual vertex's number, then one varint per S.
 //  3. positions: integers on the 2^-p pixel grid, in the order vertices were met, each predicted
-//     by the parallelogram rule u + w - apex over the gate edge (apex: the visited triangle's
-//     third vertex), or from the border neighbor when the gate touches the virtual vertex.
-//  4. creases and features: a feature is its start vertex and, per step, the rank of the next
+//     by the mean of the parallelograms a + b - c over the already decoded triangles around it
+//     (multi-parallelogram prediction), or from the gate it was met across.
+//  4-5. creases and features: a feature is its start vertex and, per step, the rank of the next
 //     vertex among the current vertex's neighbors sorted by how straight they continue the chain
-//     (mostly rank 0).
-//  5. colors: integers on the 2^-c level grid, in canonical face-varying order (first use by the
-//     triangles in traversal order; tears are known by then), each predicted by the
-//     parallelogram rule across the gate edge when no tear intervenes, else by the mean of the
-//     triangle's known corners.
+//     (mostly rank 0); the ranks have their own section.
+//  6. colors: integers on the 2^-c level grid, in canonical face-varying order (first use by the
+//     triangles in traversal order; tears are known by then), each predicted by the mean of the
+//     decoded values it shares a triangle with, the residual written as green, red - green and
+//     blue - green.
 // Decoding mirrors each step with the same frontier code, so both sides stay in lock step; every
 // count, offset and index read is checked before use.
 #include "io/svec_compact_p.h"
@@ -557,6 +558,8 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
     m.features.push_back(g);
   }
 
+  // The two small sections share the block of the section after them.
+  std::vector<size_t> no_blocks;
   // 1. Connectivity (the seed is implicit; 2V - 3 operations).
   std::vector<uint8_t> bytes;
   for (size_t i = 1; i < ops.size() + 1; i += kOpsPerByte) {
@@ -571,7 +574,7 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
   bytes.clear();
   put_varint(bytes, uint64_t(tr.virtual_vertex));
   for (const uint64_t s : splits) put_varint(bytes, s);
-  put_section(out, bytes, "split offset bytes", block_ends);
+  put_section(out, bytes, "split offset bytes", no_blocks);
 
   // 3. Positions, in decode order.
   const size_t n_decode = tr.vertex_basis.size();
@@ -626,7 +629,7 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
                  uint64_t(rank_of(ranked_steps(nb, fp, from, f.vertices[i - 1]), f.vertices[i])));
     }
   }
-  put_section(out, bytes, "feature bytes", block_ends);
+  put_section(out, bytes, "feature bytes", no_blocks);
   put_section(out, steps, "feature step bytes", block_ends);
 
   // 5. Colors, in canonical face-varying order.
