@@ -23,6 +23,7 @@
 
 #include "subvec/core/error.h"
 #include "subvec/core/metrics.h"
+#include "subvec/export/export.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/topology.h"
@@ -100,18 +101,35 @@ struct RenderArgs {
   bool no_aa = false;
   int threads = 0;
   int depth = -1;
+  double tolerance = 0.25;  // .pdf and .svg only
 };
 
-// Output formats by extension; later issues add .pdf and .svg here.
+// Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
+// (subvec/export/export.h).
 void check_image_output(const fs::path& out) {
   const std::string ext = lower(out.extension().string());
-  if (ext == ".png") return;
+  if (ext == ".png" || subvec::is_vector_export(out)) return;
   if (ext.empty()) {
     throw Error(ErrorCode::kInvalidArgument,
-                "output " + in_quotes(out) + " has no extension (supported: .png)");
+                "output " + in_quotes(out) + " has no extension (supported: .png, .pdf, .svg)");
   }
   throw Error(ErrorCode::kInvalidArgument, "unsupported output format '" + ext + "' for " +
-                                               in_quotes(out) + " (supported: .png)");
+                                               in_quotes(out) + " (supported: .png, .pdf, .svg)");
+}
+
+// .pdf / .svg: the whole image at --scale (or --width), refined to --tolerance.
+void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bool width_given,
+                       bool scale_given) {
+  if (!a.window.empty() || lower(a.overlay) != "none") {
+    throw Error(ErrorCode::kInvalidArgument,
+                "--window and --overlay apply to .png output only, not to " + in_quotes(a.output));
+  }
+  subvec::ExportOptions options;
+  options.level = a.level;
+  options.scale = width_given ? double(a.width) / image.width : scale_given ? a.scale : 1.0;
+  options.tolerance = a.tolerance;
+  options.depth = a.depth;
+  subvec::write_vector_export(a.output, image, options);
 }
 
 void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
@@ -125,6 +143,11 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
                                                  " has " + std::to_string(num_levels) +
                                                  (num_levels == 1 ? " level" : " levels") +
                                                  " (0 to " + std::to_string(num_levels - 1) + ")");
+  }
+
+  if (subvec::is_vector_export(a.output)) {
+    run_vector_export(a, image, width_given, scale_given);
+    return;
   }
 
   subvec::RenderOptions options;
@@ -408,11 +431,12 @@ int run(int argc, char** argv) {
 
   // render
   RenderArgs ra;
-  CLI::App* render = app.add_subcommand("render", "Rasterize a vector image to PNG");
+  CLI::App* render =
+      app.add_subcommand("render", "Rasterize a vector image to PNG, or export it to PDF or SVG");
   render->add_option("input", ra.input, "Vector image (.svec or .svec.json)")->required();
   render
       ->add_option("-o,--output", ra.output,
-                   "Output image; the format follows the extension (.png)")
+                   "Output image; the format follows the extension (.png, .pdf, .svg)")
       ->required();
   CLI::Option* width_opt =
       render
@@ -455,13 +479,26 @@ int run(int argc, char** argv) {
       ->add_option("--depth", ra.depth,
                    "Subdivision depth; by default chosen from the output scale")
       ->check(CLI::Range(0, 10));
+  render
+      ->add_option("--tolerance", ra.tolerance,
+                   ".pdf, .svg: largest deviation of the drawn triangles from the limit surface, in "
+                   "output pixels (default 0.25)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            double v = 0;
+            const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0;
+            return ok ? std::string() : "expected a positive number, got '" + text + "'";
+          },
+          "POSITIVE", "positive"));
   render->footer(
       "Examples:\n"
       "  subvec render in.svec.json -o out.png                  # the image's own size\n"
       "  subvec render in.svec.json -o out.png --scale 4        # 4x larger\n"
       "  subvec render in.svec -o out.png --width 1920          # 1920 wide, aspect kept\n"
       "  subvec render in.svec -o zoom.png --window 10,10,42,34 --scale 16\n"
-      "  subvec render in.svec -o mesh.png --overlay mesh --scale 4");
+      "  subvec render in.svec -o mesh.png --overlay mesh --scale 4\n"
+      "  subvec render in.svec -o out.pdf                       # vector: PDF, 1 pt per pixel\n"
+      "  subvec render in.svec -o out.svg --scale 2");
 
   // info
   std::string info_input;

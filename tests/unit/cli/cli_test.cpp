@@ -239,6 +239,25 @@ TEST_F(Cli, ConvertCompactIsStableAndRendersAlike) {
               j["bytes"].get<double>() / j["levels"][0]["vertices"].get<double>(), 1e-9);
 }
 
+TEST_F(Cli, RenderExportsPdfAndSvg) {
+  const fs::path pdf = dir_ / "a.pdf", svg = dir_ / "a.SVG";
+  CliResult r = subvec("render " + q(example("01-disk")) + " -o " + q(pdf) + " --scale 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_EQ(read_text(pdf).rfind("%PDF-1.4", 0), 0u);
+  EXPECT_NE(read_text(pdf).find("/MediaBox [0 0 192 192]"), std::string::npos);
+  r = subvec("render " + q(example("01-disk")) + " -o " + q(svg) + " --width 48 --tolerance 0.5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(svg).find("width=\"48\" height=\"48\""), std::string::npos);
+  expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "b.pdf") +
+                        " --window 0,0,10,10"),
+                 "--window and --overlay apply to .png output only");
+  const CliResult bad = subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "c.svg") +
+                               " --tolerance 0");
+  EXPECT_EQ(bad.status, 105) << bad.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"a.SVG", "a.pdf"}));
+}
+
 TEST_F(Cli, CompareIdenticalImages) {
   const fs::path png = dir_ / "a.png";
   ASSERT_EQ(subvec("render " + q(example("02-open-tear")) + " -o " + q(png)).status, 0);
