@@ -1,8 +1,8 @@
 // PDF export (export.h, docs/export.md): one page of W x H image pixels times the scale, in points;
-// the limit mesh as a ShadingType 4 shading (PDF 32000-1:2008, 8.7.4.5.5) painted with `sh`, tear
-// hints (export_p.h) and strokes as filled outlines on top. The shading's vertices are packed as 8-bit flags, 24-bit
-// coordinates (Decode maps them onto [0, W] x [0, H] image pixels) and 16-bit color components,
-// in strips (flags 1 and 2 reuse the previous triangle's vertices), then Flate-compressed.
+// the limit mesh as a ShadingType 4 shading (PDF 32000-1:2008, 8.7.4.5.5) painted with `sh`, then
+// tear hints (export_p.h) and strokes as filled paths. The shading's vertices are packed as 8-bit
+// flags, 24-bit coordinates (Decode maps them onto [0, W] x [0, H] image pixels) and 16-bit color
+// components, in strips (flags 1 and 2 reuse the previous triangle's vertices), Flate-compressed.
 #include <zlib.h>
 
 #include <algorithm>
