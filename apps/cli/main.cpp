@@ -30,6 +30,7 @@
 
 #include "subvec/core/error.h"
 #include "subvec/core/metrics.h"
+#include "subvec/export/export.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/topology.h"
@@ -107,18 +108,35 @@ struct RenderArgs {
   bool no_aa = false;
   int threads = 0;
   int depth = -1;
+  double tolerance = 0.25;  // .pdf and .svg only
 };
 
-// Output formats by extension; later issues add .pdf and .svg here.
+// Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
+// (subvec/export/export.h).
 void check_image_output(const fs::path& out) {
   const std::string ext = lower(out.extension().string());
-  if (ext == ".png") return;
+  if (ext == ".png" || subvec::is_vector_export(out)) return;
   if (ext.empty()) {
     throw Error(ErrorCode::kInvalidArgument,
-                "output " + in_quotes(out) + " has no extension (supported: .png)");
+                "output " + in_quotes(out) + " has no extension (supported: .png, .pdf, .svg)");
   }
   throw Error(ErrorCode::kInvalidArgument, "unsupported output format '" + ext + "' for " +
-                                               in_quotes(out) + " (supported: .png)");
+                                               in_quotes(out) + " (supported: .png, .pdf, .svg)");
+}
+
+// .pdf / .svg: the whole image at --scale (or --width), refined to --tolerance.
+void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bool width_given,
+                       bool scale_given) {
+  if (!a.window.empty() || lower(a.overlay) != "none") {
+    throw Error(ErrorCode::kInvalidArgument,
+                "--window and --overlay apply to .png output only, not to " + in_quotes(a.output));
+  }
+  subvec::ExportOptions options;
+  options.level = a.level;
+  options.scale = width_given ? double(a.width) / image.width : scale_given ? a.scale : 1.0;
+  options.tolerance = a.tolerance;
+  options.depth = a.depth;
+  subvec::write_vector_export(a.output, image, options);
 }
 
 void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
@@ -132,6 +150,11 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
                                                  " has " + std::to_string(num_levels) +
                                                  (num_levels == 1 ? " level" : " levels") +
                                                  " (0 to " + std::to_string(num_levels - 1) + ")");
+  }
+
+  if (subvec::is_vector_export(a.output)) {
+    run_vector_export(a, image, width_given, scale_given);
+    return;
   }
 
   subvec::RenderOptions options;
@@ -212,8 +235,10 @@ void run_info(const std::string& input, bool json) {
   std::error_code ec;
   const auto bytes = fs::file_size(input, ec);
   std::vector<LevelInfo> levels;
+  int64_t total_vertices = 0;
   for (const subvec::ControlMesh& mesh : image.levels) {
     levels.push_back(level_info(mesh, image.width, image.height));
+    total_vertices += mesh.num_vertices();
   }
 
   if (json) {
@@ -221,6 +246,7 @@ void run_info(const std::string& input, bool json) {
     j["width"] = image.width;
     j["height"] = image.height;
     j["bytes"] = ec ? 0 : bytes;
+    j["bytes_per_vertex"] = ec || total_vertices == 0 ? 0.0 : double(bytes) / double(total_vertices);
     j["levels"] = nlohmann::ordered_json::array();
     for (const LevelInfo& l : levels) {
       j["levels"].push_back({{"vertices", l.vertices},
@@ -242,7 +268,11 @@ void run_info(const std::string& input, bool json) {
 
   std::printf("%s\n", input.c_str());
   std::printf("  size       %d x %d pixels\n", image.width, image.height);
-  std::printf("  file       %llu bytes\n", static_cast<unsigned long long>(ec ? 0 : bytes));
+  std::printf("  file       %llu bytes", static_cast<unsigned long long>(ec ? 0 : bytes));
+  if (!ec && total_vertices > 0) {
+    std::printf(" (%.2f per control vertex)", double(bytes) / double(total_vertices));
+  }
+  std::printf("\n");
   std::printf("  levels     %zu (0 is the finest)\n", levels.size());
   std::printf("  strokes    %zu\n", image.strokes.size());
   const char* label = "metadata";
@@ -261,9 +291,11 @@ void run_info(const std::string& input, bool json) {
 
 // ---- convert ---------------------------------------------------------------------------------
 
-void run_convert(const std::string& input, const std::string& output) {
+void run_convert(const std::string& input, const std::string& output, bool lossless) {
   subvec::svec_format_for(output);  // rejects an unknown extension before any work
-  subvec::write_svec(output, subvec::read_svec(input));
+  subvec::SvecWriteOptions options;
+  options.lossless = lossless;
+  subvec::write_svec(output, subvec::read_svec(input), options);
 }
 
 // ---- compare ---------------------------------------------------------------------------------
@@ -554,11 +586,12 @@ int run(int argc, char** argv) {
 
   // render
   RenderArgs ra;
-  CLI::App* render = app.add_subcommand("render", "Rasterize a vector image to PNG");
+  CLI::App* render =
+      app.add_subcommand("render", "Rasterize a vector image to PNG, or export it to PDF or SVG");
   render->add_option("input", ra.input, "Vector image (.svec or .svec.json)")->required();
   render
       ->add_option("-o,--output", ra.output,
-                   "Output image; the format follows the extension (.png)")
+                   "Output image; the format follows the extension (.png, .pdf, .svg)")
       ->required();
   CLI::Option* width_opt =
       render
@@ -601,13 +634,26 @@ int run(int argc, char** argv) {
       ->add_option("--depth", ra.depth,
                    "Subdivision depth; by default chosen from the output scale")
       ->check(CLI::Range(0, 10));
+  render
+      ->add_option("--tolerance", ra.tolerance,
+                   ".pdf, .svg: largest deviation of the drawn triangles from the limit surface, in "
+                   "output pixels (default 0.25)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            double v = 0;
+            const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0;
+            return ok ? std::string() : "expected a positive number, got '" + text + "'";
+          },
+          "POSITIVE", "positive"));
   render->footer(
       "Examples:\n"
       "  subvec render in.svec.json -o out.png                  # the image's own size\n"
       "  subvec render in.svec.json -o out.png --scale 4        # 4x larger\n"
       "  subvec render in.svec -o out.png --width 1920          # 1920 wide, aspect kept\n"
       "  subvec render in.svec -o zoom.png --window 10,10,42,34 --scale 16\n"
-      "  subvec render in.svec -o mesh.png --overlay mesh --scale 4");
+      "  subvec render in.svec -o mesh.png --overlay mesh --scale 4\n"
+      "  subvec render in.svec -o out.pdf                       # vector: PDF, 1 pt per pixel\n"
+      "  subvec render in.svec -o out.svg --scale 2");
 
   // info
   std::string info_input;
@@ -624,14 +670,19 @@ int run(int argc, char** argv) {
 
   // convert
   std::string convert_input, convert_output;
+  bool convert_lossless = false;
   CLI::App* convert =
       app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
   convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
   convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
       ->required();
+  convert->add_flag("--lossless", convert_lossless,
+                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
+                    "of the compact form");
   convert->footer(
       "Examples:\n"
       "  subvec convert in.svec.json -o in.svec     # compact binary\n"
+      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
       "  subvec convert in.svec -o in.svec.json     # readable JSON");
 
   // compare
@@ -732,7 +783,7 @@ int run(int argc, char** argv) {
   } else if (info->parsed()) {
     run_info(info_input, info_json);
   } else if (convert->parsed()) {
-    run_convert(convert_input, convert_output);
+    run_convert(convert_input, convert_output, convert_lossless);
   } else if (compare->parsed()) {
     run_compare(compare_ref, compare_test, compare_json);
   } else if (vectorize->parsed()) {

@@ -69,7 +69,8 @@ VectorImage read_svec(const std::filesystem::path& path) {
   }
 }
 
-void write_svec(const std::filesystem::path& path, const VectorImage& image) {
+void write_svec(const std::filesystem::path& path, const VectorImage& image,
+                const SvecWriteOptions& options) {
   const SvecFormat format = svec_format_for(path);
   try {
     validate(image);
@@ -80,7 +81,7 @@ void write_svec(const std::filesystem::path& path, const VectorImage& image) {
     const std::string text = to_svec_json(image);
     write_file_atomic(path, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
   } else {
-    write_file_atomic(path, to_svec_binary(image));
+    write_file_atomic(path, to_svec_binary(image, options));
   }
 }
 

@@ -8,11 +8,14 @@
 // then validated like a JSON one. Writing is deterministic (single-threaded zstd, fixed level).
 #include <zstd.h>
 
+#include <array>
 #include <bit>
 #include <cstring>
 #include <memory>
 #include <string>
 
+#include "io/svec_bytes_p.h"
+#include "io/svec_compact_p.h"
 #include "io/svec_p.h"
 #include "subvec/core/error.h"
 #include "subvec/io/svec.h"
@@ -23,106 +26,15 @@ namespace {
 
 using namespace svec_detail;
 
-[[noreturn]] void fail(const std::string& message, ErrorCode code = ErrorCode::kBadFile) {
-  throw Error(code, message);
-}
-
-std::string str(uint64_t v) { return std::to_string(v); }
-
-// ---------------------------------------------------------------------------------------------
-// Little-endian encoding.
-
-class ByteWriter {
- public:
-  std::vector<uint8_t> bytes;
-
-  void u32(uint32_t v) {
-    for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<uint8_t>(v >> (8 * k)));
-  }
-  void u64(uint64_t v) {
-    for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<uint8_t>(v >> (8 * k)));
-  }
-  void i32(int32_t v) { u32(static_cast<uint32_t>(v)); }
-  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
-  void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
-  void count(size_t n, const char* what) {
-    if (n > UINT32_MAX)
-      fail(std::string("too many ") + what + " for a .svec file", ErrorCode::kLimit);
-    u32(static_cast<uint32_t>(n));
-  }
-  void string(const std::string& s) {
-    count(s.size(), "bytes in a metadata string");
-    bytes.insert(bytes.end(), s.begin(), s.end());
-  }
-};
-
-class Cursor {
- public:
-  explicit Cursor(std::span<const uint8_t> bytes) : bytes_(bytes) {}
-
-  // What is being read, for messages: "level 0 triangles".
-  void set_context(std::string what) { context_ = std::move(what); }
-  size_t remaining() const { return bytes_.size() - pos_; }
-
-  const uint8_t* take(size_t n) {
-    if (n > remaining()) {
-      fail("truncated payload while reading " + context_ + " (needs " + str(n) +
-           " bytes at offset " + str(pos_) + ", " + str(remaining()) + " left)");
-    }
-    const uint8_t* p = bytes_.data() + pos_;
-    pos_ += n;
-    return p;
-  }
-  uint32_t u32() {
-    const uint8_t* p = take(4);
-    uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= uint32_t{p[k]} << (8 * k);
-    return v;
-  }
-  uint64_t u64() {
-    const uint8_t* p = take(8);
-    uint64_t v = 0;
-    for (int k = 0; k < 8; ++k) v |= uint64_t{p[k]} << (8 * k);
-    return v;
-  }
-  int32_t i32() { return static_cast<int32_t>(u32()); }
-  float f32() { return std::bit_cast<float>(u32()); }
-  double f64() { return std::bit_cast<double>(u64()); }
-
-  // An element count, capped by `max` and by the bytes left (each element takes at least
-  // `min_bytes`), so that no vector is sized from an unchecked number.
-  size_t count(const std::string& what, size_t min_bytes, int64_t max = Limits::kMaxElements) {
-    set_context(what + " count");
-    const uint32_t n = u32();
-    if (n > max) {
-      fail(what + ": count " + str(n) + " is over the limit of " + str(uint64_t(max)),
-           ErrorCode::kLimit);
-    }
-    set_context(what);
-    if (uint64_t{n} * min_bytes > remaining()) {
-      fail("truncated payload while reading " + what + " (" + str(n) + " declared, needing " +
-           str(uint64_t{n} * min_bytes) + " bytes at offset " + str(pos_) + ", " +
-           str(remaining()) + " left)");
-    }
-    return n;
-  }
-
-  std::string string(const std::string& what) {
-    const size_t n = count(what, 1);
-    const uint8_t* p = take(n);
-    return std::string(reinterpret_cast<const char*>(p), n);
-  }
-
- private:
-  std::span<const uint8_t> bytes_;
-  size_t pos_ = 0;
-  std::string context_ = "the payload";
-};
-
 // ---------------------------------------------------------------------------------------------
 // Payload.
 
-std::vector<uint8_t> encode_payload(const VectorImage& image) {
+// Strokes and metadata end the payload in both versions.
+void encode_trailer(ByteWriter& w, const VectorImage& image);
+void decode_trailer(Cursor& in, VectorImage& image);
+
+// Version 1: every value as stored in memory, in the image's own order.
+std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
   ByteWriter w;
   w.i32(image.width);
   w.i32(image.height);
@@ -151,6 +63,34 @@ std::vector<uint8_t> encode_payload(const VectorImage& image) {
       for (int32_t v : f.vertices) w.i32(v);
     }
   }
+  encode_trailer(w, image);
+  return std::move(w.bytes);
+}
+
+// Version 2: levels in the compact layout (svec_compact.cpp), already quantized with `bits`.
+std::vector<uint8_t> encode_payload_v2(const VectorImage& image,
+                                       const std::vector<std::array<int, 2>>& bits,
+                                       std::vector<size_t>& block_ends) {
+  ByteWriter w;
+  w.i32(image.width);
+  w.i32(image.height);
+  w.count(image.levels.size(), "levels");
+  for (size_t l = 0; l < image.levels.size(); ++l) {
+    const ControlMesh& m = image.levels[l];
+    w.count(m.positions.size(), "vertices");
+    w.count(m.colors.size(), "colors");
+    w.count(m.triangles.size(), "triangles");
+    w.count(m.creases.size(), "creases");
+    w.count(m.features.size(), "features");
+    w.bytes.push_back(static_cast<uint8_t>(bits[l][0]));
+    w.bytes.push_back(static_cast<uint8_t>(static_cast<int8_t>(bits[l][1])));
+    encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], w, block_ends);
+  }
+  encode_trailer(w, image);
+  return std::move(w.bytes);
+}
+
+void encode_trailer(ByteWriter& w, const VectorImage& image) {
   w.count(image.strokes.size(), "strokes");
   for (const Stroke& s : image.strokes) {
     w.i32(s.level);
@@ -165,10 +105,9 @@ std::vector<uint8_t> encode_payload(const VectorImage& image) {
     w.string(key);
     w.string(value);
   }
-  return std::move(w.bytes);
 }
 
-VectorImage decode_payload(std::span<const uint8_t> payload) {
+VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version) {
   Cursor in(payload);
   VectorImage image;
   in.set_context("image size");
@@ -176,6 +115,17 @@ VectorImage decode_payload(std::span<const uint8_t> payload) {
   image.height = in.i32();
   const size_t num_levels = in.count("levels", 20, Limits::kMaxLevels);
   image.levels.resize(num_levels);
+  if (version == kCompactVersion) {
+    if (image.width < 1 || image.height < 1 || image.width > Limits::kMaxDimension ||
+        image.height > Limits::kMaxDimension) {
+      fail("image size " + std::to_string(image.width) + " x " + std::to_string(image.height) +
+           " is out of range (1 to " + str(Limits::kMaxDimension) + " a side)");
+    }
+    for (size_t l = 0; l < num_levels; ++l)
+      image.levels[l] = decode_compact_level(in, int(l), image.width, image.height);
+    decode_trailer(in, image);
+    return image;
+  }
   for (size_t l = 0; l < num_levels; ++l) {
     ControlMesh& m = image.levels[l];
     const std::string level = "level " + str(l) + " ";
@@ -211,6 +161,11 @@ VectorImage decode_payload(std::span<const uint8_t> payload) {
       for (int32_t& v : f.vertices) v = in.i32();
     }
   }
+  decode_trailer(in, image);
+  return image;
+}
+
+void decode_trailer(Cursor& in, VectorImage& image) {
   image.strokes.resize(in.count("strokes", 28));
   for (size_t i = 0; i < image.strokes.size(); ++i) {
     Stroke& s = image.strokes[i];
@@ -231,7 +186,6 @@ VectorImage decode_payload(std::span<const uint8_t> payload) {
   }
   if (in.remaining() != 0)
     fail(str(in.remaining()) + " unexpected bytes after the payload's metadata");
-  return image;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -294,18 +248,34 @@ std::vector<uint8_t> decompress(std::span<const uint8_t> frame, uint64_t expecte
   return out;
 }
 
-std::vector<uint8_t> compress(std::span<const uint8_t> payload) {
+// One frame. A new block starts after each offset of `block_ends`, so that sections with
+// different statistics get their own entropy tables.
+std::vector<uint8_t> compress(std::span<const uint8_t> payload,
+                              std::span<const size_t> block_ends = {}) {
   std::unique_ptr<ZSTD_CCtx, CctxDeleter> cctx(ZSTD_createCCtx());
   if (!cctx) fail("out of memory for zstd", ErrorCode::kIo);
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, kZstdLevel);
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_checksumFlag, 1);
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1);
-  std::vector<uint8_t> frame(ZSTD_compressBound(payload.size()));
-  const size_t n =
-      ZSTD_compress2(cctx.get(), frame.data(), frame.size(), payload.data(), payload.size());
-  if (ZSTD_isError(n))
-    fail(std::string("zstd compression failed: ") + ZSTD_getErrorName(n), ErrorCode::kIo);
-  frame.resize(n);
+  ZSTD_CCtx_setPledgedSrcSize(cctx.get(), payload.size());
+  std::vector<uint8_t> frame(ZSTD_compressBound(payload.size()) + 64 * (block_ends.size() + 1));
+  ZSTD_outBuffer output{frame.data(), frame.size(), 0};
+  size_t begin = 0;
+  auto feed = [&](size_t end, ZSTD_EndDirective mode) {
+    ZSTD_inBuffer input{payload.data() + begin, end - begin, 0};
+    for (;;) {
+      const size_t left = ZSTD_compressStream2(cctx.get(), &output, &input, mode);
+      if (ZSTD_isError(left))
+        fail(std::string("zstd compression failed: ") + ZSTD_getErrorName(left), ErrorCode::kIo);
+      if (left == 0 && input.pos == input.size) break;
+      if (output.pos == output.size) fail("zstd compression overflowed its buffer", ErrorCode::kIo);
+    }
+    begin = end;
+  };
+  for (const size_t end : block_ends)
+    if (end > begin && end < payload.size()) feed(end, ZSTD_e_flush);
+  feed(payload.size(), ZSTD_e_end);
+  frame.resize(output.pos);
   return frame;
 }
 
@@ -342,9 +312,9 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
   const uint32_t flags = header.u32();
   const uint64_t payload_size = header.u64();
   const uint64_t frame_size = header.u64();
-  if (version != kBinaryVersion) {
-    fail("unsupported .svec version " + str(version) + " (this build reads " + str(kBinaryVersion) +
-         ")");
+  if (version != kLosslessVersion && version != kCompactVersion) {
+    fail("unsupported .svec version " + str(version) + " (this build reads " +
+         str(kLosslessVersion) + " and " + str(kCompactVersion) + ")");
   }
   if (flags != 0) fail("unsupported .svec flags " + str(flags) + " (this build knows none)");
   if (payload_size > kMaxPayloadBytes) {
@@ -361,22 +331,60 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
     fail(str(available - frame_size) + " unexpected bytes after the zstd frame");
   }
   const std::vector<uint8_t> payload = decompress(bytes.subspan(kHeaderBytes), payload_size);
-  VectorImage image = decode_payload(payload);
+  VectorImage image = decode_payload(payload, version);
   validate(image);
   return image;
 }
 
-std::vector<uint8_t> to_svec_binary(const VectorImage& image) {
-  const std::vector<uint8_t> payload = encode_payload(image);
+std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOptions& options) {
+  if (options.position_bits < 0 || options.position_bits > kMaxPositionBits ||
+      options.color_bits < kMinColorBits || options.color_bits > kMaxColorBits) {
+    fail("position bits " + std::to_string(options.position_bits) + " and color bits " +
+             std::to_string(options.color_bits) + " out of range (0 to " +
+             str(kMaxPositionBits) + " and " + std::to_string(kMinColorBits) + " to " +
+             str(kMaxColorBits) + ")",
+         ErrorCode::kInvalidArgument);
+  }
+  // Version 2 quantizes each level, with finer positions when the coarse grid would flip or
+  // collapse a triangle, and falls back to version 1 when even the finest grid does.
+  uint32_t version = options.lossless ? kLosslessVersion : kCompactVersion;
+  VectorImage quantized;
+  std::vector<std::array<int, 2>> bits;
+  if (version == kCompactVersion) {
+    validate(image);
+    quantized.width = image.width;
+    quantized.height = image.height;
+    quantized.strokes = image.strokes;
+    quantized.metadata = image.metadata;
+    for (size_t l = 0; l < image.levels.size() && version == kCompactVersion; ++l) {
+      version = kLosslessVersion;
+      for (int p = options.position_bits; p <= kMaxPositionBits; ++p) {
+        ControlMesh q = quantize_positions(image.levels[l], image.width, image.height, p);
+        try {
+          validate_level(q, image.width, image.height, int(l));
+        } catch (const Error&) {
+          continue;
+        }
+        quantized.levels.push_back(std::move(q));
+        bits.push_back({p, options.color_bits});
+        version = kCompactVersion;
+        break;
+      }
+    }
+  }
+  std::vector<size_t> block_ends;
+  const std::vector<uint8_t> payload = version == kCompactVersion
+                                           ? encode_payload_v2(quantized, bits, block_ends)
+                                           : encode_payload_v1(image);
   if (payload.size() > kMaxPayloadBytes) {
     fail("image too large for a .svec file (" + str(payload.size()) + " bytes of payload, limit " +
              str(kMaxPayloadBytes) + ")",
          ErrorCode::kLimit);
   }
-  const std::vector<uint8_t> frame = compress(payload);
+  const std::vector<uint8_t> frame = compress(payload, block_ends);
   ByteWriter w;
   w.bytes.assign(kMagic.begin(), kMagic.end());
-  w.u32(kBinaryVersion);
+  w.u32(version);
   w.u32(0);  // flags
   w.u64(payload.size());
   w.u64(frame.size());

@@ -10,7 +10,8 @@ namespace subvec::svec_detail {
 
 // .svec binary header: magic, then u32 version, u32 flags, u64 payload size, u64 frame size.
 inline constexpr std::array<uint8_t, 8> kMagic = {'S', 'U', 'B', 'V', 'E', 'C', 0x00, 0x1A};
-inline constexpr uint32_t kBinaryVersion = 1;
+inline constexpr uint32_t kLosslessVersion = 1;  // exact values, the image's own order
+inline constexpr uint32_t kCompactVersion = 2;   // quantized, predicted, traversal order
 inline constexpr size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8;
 inline constexpr uint64_t kMaxPayloadBytes = uint64_t{1} << 30;  // 1 GiB uncompressed
 inline constexpr int kZstdLevel = 9;

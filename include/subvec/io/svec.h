@@ -15,6 +15,19 @@ namespace subvec {
 
 enum class SvecFormat { kJson, kBinary };
 
+// How `.svec` (binary) files are written.
+struct SvecWriteOptions {
+  // Version 1: every value exactly as in memory, vertices, triangles and colors in their own
+  // order. Otherwise version 2, the compact form: positions and colors rounded to the grids below
+  // and the level renumbered in traversal order (the same picture; a second write is identical).
+  bool lossless = false;
+  // Version 2: positions on multiples of 2^-position_bits pixels (0 to 12; finer where needed to
+  // keep every triangle positive), colors on multiples of 2^-color_bits levels (0 to 12).
+  // docs/format.md gives the measured effect of each choice.
+  int position_bits = 2;
+  int color_bits = -1;
+};
+
 // `.svec.json` or `.json` -> kJson, `.svec` -> kBinary; anything else throws kInvalidArgument.
 SvecFormat svec_format_for(const std::filesystem::path& path);
 
@@ -24,10 +37,12 @@ VectorImage parse_svec_json(std::string_view text);
 VectorImage parse_svec_binary(std::span<const uint8_t> bytes);
 
 std::string to_svec_json(const VectorImage& image);
-std::vector<uint8_t> to_svec_binary(const VectorImage& image);
+std::vector<uint8_t> to_svec_binary(const VectorImage& image,
+                                    const SvecWriteOptions& options = {});
 
 // Read by content (binary magic, else JSON); write by extension, atomically.
 VectorImage read_svec(const std::filesystem::path& path);
-void write_svec(const std::filesystem::path& path, const VectorImage& image);
+void write_svec(const std::filesystem::path& path, const VectorImage& image,
+                const SvecWriteOptions& options = {});
 
 }  // namespace subvec

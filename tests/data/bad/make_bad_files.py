@@ -158,6 +158,32 @@ def binary_files():
     write("index-out-of-range.svec", svec(square_payload(tri_vertex=-7)))
 
 
+# The compact (version 2) payload of the square, as laid out in docs/format.md ("Worked example,
+# version 2"), in pieces so that one field at a time can be broken.
+COMPACT_HEAD = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 5, 4, 0, 0)
+COMPACT_SECTIONS = [bytes([0x32, 0x3C, 0x03]), bytes([0x03]),
+                    bytes.fromhex("0000 2000 0f10 0010 0000"), b"", b"",
+                    bytes.fromhex("7f8002 000100 007f8001 00bf01be01 007f8001")]
+
+
+def compact_payload(head=COMPACT_HEAD, precision=b"\x02\xff", sections=COMPACT_SECTIONS):
+    body = b"".join(struct.pack("<I", len(s)) + s for s in sections)
+    return head + precision + body + struct.pack("<II", 0, 0)
+
+
+def compact_files():
+    sections = list(COMPACT_SECTIONS)
+    sections[0] = bytes([0x7F, 0x3C, 0x03])  # 127: not three operations in base 5
+    write("compact-bad-operations.svec", svec(compact_payload(sections=sections), version=2))
+    write("compact-bad-precision.svec", svec(compact_payload(precision=b"\x0d\xff"), version=2))
+    head = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 6, 4, 0, 0)  # 6 colors declared
+    write("compact-color-count.svec", svec(compact_payload(head=head), version=2))
+    sections = list(COMPACT_SECTIONS)
+    sections[2] = sections[2] + b"\x00"
+    write("compact-trailing-section-bytes.svec", svec(compact_payload(sections=sections), version=2))
+
+
 if __name__ == "__main__":
     json_files()
     binary_files()
+    compact_files()

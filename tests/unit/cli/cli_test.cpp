@@ -205,10 +205,11 @@ TEST_F(Cli, InfoText) {
 TEST_F(Cli, ConvertRoundTrip) {
   const fs::path bin = dir_ / "a.svec", json = dir_ / "b.svec.json", direct = dir_ / "c.svec.json",
                  bin2 = dir_ / "d.svec";
-  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin) + " --lossless").status,
+            0);
   ASSERT_EQ(subvec("convert " + q(bin) + " -o " + q(json)).status, 0);
   ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(direct)).status, 0);
-  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2) + " --lossless").status, 0);
   // json -> svec -> json gives the text json -> json gives; svec -> json -> svec the same bytes.
   EXPECT_EQ(read_text(json), read_text(direct));
   EXPECT_EQ(read_text(bin), read_text(bin2));
@@ -217,6 +218,46 @@ TEST_F(Cli, ConvertRoundTrip) {
   ASSERT_EQ(subvec("render " + q(bin) + " -o " + q(dir_ / "x.png")).status, 0);
   ASSERT_EQ(subvec("render " + q(example("03-junction")) + " -o " + q(dir_ / "y.png")).status, 0);
   EXPECT_EQ(read_text(dir_ / "x.png"), read_text(dir_ / "y.png"));
+}
+
+TEST_F(Cli, ConvertCompactIsStableAndRendersAlike) {
+  // The compact form (the default) rounds values and renumbers the mesh: a second conversion
+  // gives the same bytes, and the picture barely moves.
+  const fs::path bin = dir_ / "a.svec", json = dir_ / "b.svec.json", bin2 = dir_ / "c.svec";
+  ASSERT_EQ(subvec("convert " + q(example("03-junction")) + " -o " + q(bin)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(bin) + " -o " + q(json)).status, 0);
+  ASSERT_EQ(subvec("convert " + q(json) + " -o " + q(bin2)).status, 0);
+  EXPECT_EQ(read_text(bin), read_text(bin2));
+  EXPECT_LT(fs::file_size(bin), fs::file_size(example("03-junction")) / 4);
+  ASSERT_EQ(subvec("render " + q(bin) + " -o " + q(dir_ / "x.png")).status, 0);
+  ASSERT_EQ(subvec("render " + q(example("03-junction")) + " -o " + q(dir_ / "y.png")).status, 0);
+  const CliResult r = subvec("compare " + q(dir_ / "y.png") + " " + q(dir_ / "x.png") + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_LT(nlohmann::json::parse(r.out)["mae_mean"].get<double>(), 0.5);
+  const CliResult info = subvec("info " + q(bin) + " --json");
+  ASSERT_EQ(info.status, 0) << info.err;
+  const nlohmann::json j = nlohmann::json::parse(info.out);
+  EXPECT_NEAR(j["bytes_per_vertex"].get<double>(),
+              j["bytes"].get<double>() / j["levels"][0]["vertices"].get<double>(), 1e-9);
+}
+
+TEST_F(Cli, RenderExportsPdfAndSvg) {
+  const fs::path pdf = dir_ / "a.pdf", svg = dir_ / "a.SVG";
+  CliResult r = subvec("render " + q(example("01-disk")) + " -o " + q(pdf) + " --scale 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_EQ(read_text(pdf).rfind("%PDF-1.4", 0), 0u);
+  EXPECT_NE(read_text(pdf).find("/MediaBox [0 0 192 192]"), std::string::npos);
+  r = subvec("render " + q(example("01-disk")) + " -o " + q(svg) + " --width 48 --tolerance 0.5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(svg).find("width=\"48\" height=\"48\""), std::string::npos);
+  expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "b.pdf") +
+                        " --window 0,0,10,10"),
+                 "--window and --overlay apply to .png output only");
+  const CliResult bad = subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "c.svg") +
+                               " --tolerance 0");
+  EXPECT_EQ(bad.status, 105) << bad.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"a.SVG", "a.pdf"}));
 }
 
 TEST_F(Cli, CompareIdenticalImages) {

@@ -82,7 +82,7 @@ const std::vector<BadFile>& corpus() {
       {"truncated.svec.json", E::kBadFile, {"invalid JSON", "line 9"}},
       // Binary containers.
       {"wrong-magic.svec", E::kBadFile, {"not a .svec file: wrong magic bytes (53 55 42 56 45 58"}},
-      {"wrong-version.svec", E::kBadFile, {"unsupported .svec version 7 (this build reads 1)"}},
+      {"wrong-version.svec", E::kBadFile, {"unsupported .svec version 7 (this build reads 1 and 2)"}},
       {"unknown-flags.svec", E::kBadFile, {"unsupported .svec flags 1"}},
       {"truncated-header.svec",
        E::kBadFile,
@@ -100,6 +100,17 @@ const std::vector<BadFile>& corpus() {
        {"truncated payload while reading level 0 triangle colors"}},
       {"trailing-payload-bytes.svec", E::kBadFile, {"2 unexpected bytes after the payload"}},
       {"trailing-file-bytes.svec", E::kBadFile, {"1 unexpected bytes after the zstd frame"}},
+      // Compact (version 2) payloads.
+      {"compact-bad-operations.svec",
+       E::kBadFile,
+       {"level 0 connectivity: byte 0 is not three operations"}},
+      {"compact-bad-precision.svec", E::kBadFile, {"level 0 precision: position bits 13"}},
+      {"compact-color-count.svec",
+       E::kBadFile,
+       {"level 0 colors: the tears give 5 color values, but 6 are declared"}},
+      {"compact-trailing-section-bytes.svec",
+       E::kBadFile,
+       {"1 unexpected bytes at the end of level 0 positions"}},
   };
   return files;
 }

@@ -1,6 +1,7 @@
-// The .svec binary reader and writer: exact round trips, JSON <-> binary identity, the documented
-// byte layout (crafted by hand here, in stored zstd blocks), and every way a file can be cut,
-// corrupted or lie about its sizes.
+// The .svec binary reader and writer, version 1 (lossless): exact round trips, JSON <-> binary
+// identity, the documented byte layout (crafted by hand here, in stored zstd blocks), and every way
+// a file can be cut, corrupted or lie about its sizes. The compact version 2 is tested in
+// svec_compact_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,8 @@ namespace subvec {
 namespace {
 
 using namespace svec_test;
+
+const SvecWriteOptions kLossless{.lossless = true};
 
 void expect_binary_error(const std::vector<uint8_t>& bytes, ErrorCode code,
                          const std::vector<std::string>& parts) {
@@ -27,13 +30,13 @@ uint64_t read_u64(const std::vector<uint8_t>& b, size_t at) {
 
 TEST(SvecBinary, RoundTripIsExact) {
   const VectorImage image = rich_image();
-  const std::vector<uint8_t> bytes = to_svec_binary(image);
+  const std::vector<uint8_t> bytes = to_svec_binary(image, kLossless);
   expect_same(parse_svec_binary(bytes), image);
-  EXPECT_EQ(to_svec_binary(image), bytes);  // deterministic
+  EXPECT_EQ(to_svec_binary(image, kLossless), bytes);  // deterministic
 }
 
 TEST(SvecBinary, HeaderIsAsDocumented) {
-  const std::vector<uint8_t> bytes = to_svec_binary(square_image());
+  const std::vector<uint8_t> bytes = to_svec_binary(square_image(), kLossless);
   ASSERT_GT(bytes.size(), 32u);
   const std::vector<uint8_t> magic(bytes.begin(), bytes.begin() + 8);
   EXPECT_EQ(magic, (std::vector<uint8_t>{0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1A}));
@@ -52,18 +55,18 @@ TEST(SvecBinary, HandCraftedFileFollowingTheDocsReads) {
 
 TEST(SvecBinary, JsonAndBinaryConvertWithoutLoss) {
   const std::string text = to_svec_json(rich_image());
-  const std::vector<uint8_t> bytes = to_svec_binary(parse_svec_json(text));
+  const std::vector<uint8_t> bytes = to_svec_binary(parse_svec_json(text), kLossless);
   EXPECT_EQ(to_svec_json(parse_svec_binary(bytes)), text);
-  EXPECT_EQ(to_svec_binary(parse_svec_json(to_svec_json(parse_svec_binary(bytes)))), bytes);
+  EXPECT_EQ(to_svec_binary(parse_svec_json(to_svec_json(parse_svec_binary(bytes))), kLossless), bytes);
   for (const std::string& block : doc_examples()) {
-    EXPECT_EQ(to_svec_json(parse_svec_binary(to_svec_binary(parse_svec_json(block)))), block);
+    EXPECT_EQ(to_svec_json(parse_svec_binary(to_svec_binary(parse_svec_json(block), kLossless))), block);
   }
 }
 
 // ---- bad inputs --------------------------------------------------------------------------------
 
 TEST(SvecBinaryErrors, WrongMagicVersionAndFlags) {
-  std::vector<uint8_t> bytes = to_svec_binary(square_image());
+  std::vector<uint8_t> bytes = to_svec_binary(square_image(), kLossless);
   std::vector<uint8_t> bad = bytes;
   bad[1] = 'V';
   expect_binary_error(bad, ErrorCode::kBadFile, {"not a .svec file: wrong magic bytes (53 56"});
@@ -72,13 +75,13 @@ TEST(SvecBinaryErrors, WrongMagicVersionAndFlags) {
   expect_binary_error(std::vector<uint8_t>(text.begin(), text.end()), ErrorCode::kBadFile,
                       {"wrong magic bytes (7b 22"});
   expect_binary_error(svec_file(square_payload().b, 7), ErrorCode::kBadFile,
-                      {"unsupported .svec version 7 (this build reads 1)"});
+                      {"unsupported .svec version 7 (this build reads 1 and 2)"});
   expect_binary_error(svec_file(square_payload().b, 1, 4), ErrorCode::kBadFile,
                       {"unsupported .svec flags 4"});
 }
 
 TEST(SvecBinaryErrors, EveryTruncationIsReportedNeverCrashes) {
-  const std::vector<uint8_t> bytes = to_svec_binary(rich_image());
+  const std::vector<uint8_t> bytes = to_svec_binary(rich_image(), kLossless);
   for (size_t n = 0; n < bytes.size(); ++n) {
     SCOPED_TRACE("first " + std::to_string(n) + " bytes");
     const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + long(n));
@@ -97,7 +100,7 @@ TEST(SvecBinaryErrors, TruncatedOrCorruptZstdFrame) {
   expect_binary_error(file.b, ErrorCode::kBadFile, {"truncated zstd frame"});
 
   // A flipped bit in a compressed frame: the frame checksum (or the decoder) catches it.
-  std::vector<uint8_t> bytes = to_svec_binary(rich_image());
+  std::vector<uint8_t> bytes = to_svec_binary(rich_image(), kLossless);
   bytes[bytes.size() - 2] ^= 0x10;
   expect_binary_error(bytes, ErrorCode::kBadFile, {"corrupt zstd frame"});
 }

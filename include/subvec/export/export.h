@@ -1,0 +1,57 @@
+// Vector exports of a vector image (docs/export.md): the limit surface (paper §3, as rendered in
+// §7.1) refined into small triangles until drawing them flat-sided is within a tolerance, then
+//  - PDF: one ShadingType 4 (free-form Gouraud-shaded triangle mesh) shading, thin bands along the
+//    tears that anti-alias them where a viewer does not anti-alias shadings, strokes as filled
+//    paths;
+//  - SVG: every triangle filled with its mean color and stroked in the same color, which hides the
+//    anti-aliasing seams viewers leave between adjacent shapes (librsvg, Chromium, Inkscape).
+// Outputs are deterministic: the same image and options give the same bytes.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+struct ExportOptions {
+  int level = 0;       // level of detail
+  double scale = 1;    // output units (PDF points, SVG pixels) per image pixel
+  // The triangles are refined until the piecewise-linear surface deviates from the limit surface
+  // by at most `tolerance` output units in position and `color_tolerance` levels (0-255 scale) in
+  // color, measured at the midpoints of the refined edges, at all but 1% of them (the error only
+  // halves per level at the surface's singular points: tear corners, junctions).
+  double tolerance = 0.25;
+  double color_tolerance = 1.0;
+  int depth = -1;      // 0..8: this subdivision depth instead of the tolerance rule
+  int max_depth = 6;   // the tolerance rule stops here (and below 2^24 triangles)
+  // PDF: along both sides of every tear, a band one output unit wide in that side's color, so that
+  // viewers that do not anti-alias shadings (poppler) still show anti-aliased tears.
+  bool tear_hints = true;
+};
+
+struct ExportReport {
+  int depth = 0;
+  int64_t triangles = 0;
+  // Measured at `depth` by the tolerance rule (zero with an explicit depth): the largest
+  // deviations (output units, levels) and the fraction of refined edges over a tolerance.
+  double max_position_error = 0;
+  double max_color_error = 0;
+  double over_tolerance = 0;
+};
+
+// Throws Error(kInvalidArgument) for a bad level, scale, tolerance or depth, Error(kInvalidMesh)
+// when the level fails validation.
+std::string to_pdf(const VectorImage& image, const ExportOptions& options = {},
+                   ExportReport* report = nullptr);
+std::string to_svg(const VectorImage& image, const ExportOptions& options = {},
+                   ExportReport* report = nullptr);
+
+// By extension (.pdf, .svg, case-insensitive), written atomically.
+bool is_vector_export(const std::filesystem::path& path);
+void write_vector_export(const std::filesystem::path& path, const VectorImage& image,
+                         const ExportOptions& options = {}, ExportReport* report = nullptr);
+
+}  // namespace subvec

@@ -1,0 +1,165 @@
+// PDF export (export.h, docs/export.md): one page of W x H image pixels times the scale, in points;
+// the limit mesh as a ShadingType 4 shading (PDF 32000-1:2008, 8.7.4.5.5) painted with `sh`, then
+// tear hints (export_p.h) and strokes as filled paths. The shading's vertices are packed as 8-bit
+// flags, 24-bit coordinates (Decode maps them onto [0, W] x [0, H] image pixels) and 16-bit color
+// components, in strips (flags 1 and 2 reuse the previous triangle's vertices), Flate-compressed.
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "export/export_p.h"
+#include "export/limit_mesh_p.h"
+#include "subvec/core/error.h"
+#include "subvec/export/export.h"
+
+namespace subvec {
+namespace {
+
+std::vector<uint8_t> deflate(const std::vector<uint8_t>& data) {
+  uLongf size = compressBound(static_cast<uLong>(data.size()));
+  std::vector<uint8_t> out(size);
+  if (compress2(out.data(), &size, data.data(), static_cast<uLong>(data.size()), 9) != Z_OK)
+    throw Error(ErrorCode::kIo, "zlib compression failed");
+  out.resize(size);
+  return out;
+}
+
+// A PDF text string: printable ASCII as a literal (parentheses and backslashes escaped), anything
+// else as UTF-16BE with a byte order mark, in hex (invalid UTF-8 becomes U+FFFD).
+std::string pdf_string(const std::string& s) {
+  if (std::all_of(s.begin(), s.end(), [](char c) { return c >= 0x20 && c <= 0x7E; })) {
+    std::string out = "(";
+    for (const char c : s) {
+      if (c == '(' || c == ')' || c == '\\') out += '\\';
+      out += c;
+    }
+    return out + ")";
+  }
+  std::string out = "<FEFF";
+  auto unit = [&](uint32_t u) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "%04X", u);
+    out += buf;
+  };
+  for (size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    const int n = b < 0x80 ? 1 : (b >> 5) == 6 ? 2 : (b >> 4) == 14 ? 3 : (b >> 3) == 30 ? 4 : 0;
+    uint32_t cp = n == 1 ? b : n == 2 ? b & 0x1F : n == 3 ? b & 0x0F : b & 0x07;
+    bool ok = n > 0 && i + n <= s.size();
+    for (int k = 1; ok && k < n; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + k]);
+      ok = (c >> 6) == 2;
+      cp = (cp << 6) | (c & 0x3F);
+    }
+    if (!ok || cp > 0x10FFFF || (cp >= 0xD800 && cp < 0xE000)) cp = 0xFFFD;
+    i += ok ? n : 1;
+    if (cp >= 0x10000) {
+      unit(0xD800 + ((cp - 0x10000) >> 10));
+      unit(0xDC00 + ((cp - 0x10000) & 0x3FF));
+    } else {
+      unit(cp);
+    }
+  }
+  return out + ">";
+}
+
+}  // namespace
+
+std::string to_pdf(const VectorImage& image, const ExportOptions& options, ExportReport* report) {
+  ExportReport local;
+  ExportReport& r = report ? *report : local;
+  const RefinedMesh mesh =
+      detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
+  const double w = image.width, h = image.height, s = options.scale;
+
+  // The shading stream.
+  const detail::Strips strips = detail::make_strips(mesh);
+  std::vector<uint8_t> data;
+  data.reserve(strips.flags.size() * 13);
+  constexpr double kCoordinateMax = double((1 << 24) - 1);
+  auto put = [&](uint64_t v, int bytes) {
+    for (int k = bytes - 1; k >= 0; --k) data.push_back(static_cast<uint8_t>(v >> (8 * k)));
+  };
+  for (size_t i = 0; i < strips.flags.size(); ++i) {
+    const auto [t, k] = strips.corners[i];
+    const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
+    put(strips.flags[i], 1);
+    put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), 3);
+    put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
+        3);
+    for (int ch = 0; ch < 3; ++ch) {
+      const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
+      put(uint64_t(std::lround(value * 65535.0)), 2);
+    }
+  }
+  const std::vector<uint8_t> shading = deflate(data);
+
+  // The page: image pixels to points, y up.
+  std::string content = "q " + detail::fixed(s, 6) + " 0 0 " + detail::fixed(-s, 6) + " 0 " +
+                        detail::fixed(h * s, 6) + " cm\n/Sh0 sh\n";
+  if (options.tear_hints) {
+    for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
+      for (const double c : band.color)
+        content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
+      content += "rg";
+      for (int k = 0; k < 4; ++k) {
+        content += " " + detail::fixed(band.corners[k].x, 3) + " " +
+                   detail::fixed(band.corners[k].y, 3) + (k == 0 ? " m" : " l");
+      }
+      content += " h f\n";
+    }
+  }
+  for (const Stroke& stroke : image.strokes) {
+    if (stroke.level != options.level) continue;
+    const std::vector<Vec2> outline = detail::stroke_outline(stroke);
+    if (outline.empty()) continue;
+    const float rgb[3] = {stroke.color.r, stroke.color.g, stroke.color.b};
+    for (const float c : rgb) content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
+    content += "rg\n";
+    for (size_t i = 0; i < outline.size(); ++i) {
+      content += detail::fixed(outline[i].x, 3) + " " + detail::fixed(outline[i].y, 3) +
+                 (i == 0 ? " m\n" : " l\n");
+    }
+    content += "h f\n";
+  }
+  content += "Q\n";
+
+  std::string pdf = "%PDF-1.4\n%\xE2\xE3\xCF\xD3\n";
+  std::vector<size_t> offsets;
+  auto object = [&](const std::string& body) {
+    offsets.push_back(pdf.size());
+    pdf += std::to_string(offsets.size()) + " 0 obj\n" + body + "\nendobj\n";
+  };
+  std::string title;
+  for (const auto& [key, value] : image.metadata)
+    if (key == "title") title = value;
+  object("<< /Type /Catalog /Pages 2 0 R >>");
+  object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
+  object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
+         detail::fixed(h * s, 6) +
+         "] /Contents 4 0 R /Resources << /Shading << /Sh0 5 0 R >> >> >>");
+  const std::vector<uint8_t> packed = deflate(std::vector<uint8_t>(content.begin(), content.end()));
+  object("<< /Filter /FlateDecode /Length " + std::to_string(packed.size()) + " >>\nstream\n" +
+         std::string(packed.begin(), packed.end()) + "\nendstream");
+  object("<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24 /BitsPerComponent 16"
+         " /BitsPerFlag 8 /Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6) +
+         " 0 1 0 1 0 1] /Filter /FlateDecode /Length " + std::to_string(shading.size()) +
+         " >>\nstream\n" + std::string(shading.begin(), shading.end()) + "\nendstream");
+  object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
+  const size_t xref = pdf.size();
+  pdf += "xref\n0 " + std::to_string(offsets.size() + 1) + "\n0000000000 65535 f \n";
+  for (const size_t o : offsets) {
+    char line[24];
+    std::snprintf(line, sizeof line, "%010zu 00000 n \n", o);
+    pdf += line;
+  }
+  pdf += "trailer\n<< /Size " + std::to_string(offsets.size() + 1) +
+         " /Root 1 0 R /Info 6 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
+  return pdf;
+}
+
+}  // namespace subvec

@@ -1,0 +1,906 @@
+// Compact levels of `.svec` version 2 (docs/format.md, "Compact levels").
+//
+// Design note. A level is coded as six sections (the larger ones each in their own zstd block, so
+// that they get their own entropy tables):
+//  1. connectivity: the mesh, closed into a sphere by one virtual vertex joined to every border
+//     edge, is visited by region growing from triangle 0. A frontier (cyclic lists of boundary
+//     edges) separates visited from unvisited triangles; each step takes the triangle across the
+//     frontier's gate edge (u, w) and names its third vertex x with one of five operations, as in
+//     Rossignac's Edgebreaker: C (x is new), R (x follows w on the frontier), L (x precedes u),
+//     E (the loop closes) and S (x is elsewhere on the loop, which splits in two; the position is
+//     stored as an offset). On a sphere a vertex appears at most once per loop, so these cover
+//     every case. Three operations share a byte: about 2 bits per triangle before zstd.
+//  2. split offsets: the virtual vertex's number, then one varint per S.
+//  3. positions: integers on the 2^-p pixel grid, in the order vertices were met, each predicted
+//     by the mean of the parallelograms a + b - c over the already decoded triangles around it
+//     (multi-parallelogram prediction), or from the gate it was met across.
+//  4-5. creases and features: a feature is its start vertex and, per step, the rank of the next
+//     vertex among the current vertex's neighbors sorted by how straight they continue the chain
+//     (mostly rank 0); the ranks have their own section.
+//  6. colors: integers on the 2^-c level grid, in canonical face-varying order (first use by the
+//     triangles in traversal order; tears are known by then), each predicted by the mean of the
+//     decoded values it shares a triangle with, the residual written as green, red - green and
+//     blue - green.
+// Decoding mirrors each step with the same frontier code, so both sides stay in lock step; every
+// count, offset and index read is checked before use.
+#include "io/svec_compact_p.h"
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <span>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+#include "subvec/mesh/topology.h"
+
+namespace subvec::svec_detail {
+namespace {
+
+constexpr uint8_t kOpC = 0, kOpL = 1, kOpR = 2, kOpE = 3, kOpS = 4;
+constexpr int kOpsPerByte = 3;  // base 5: op0 + 5 op1 + 25 op2 < 125
+
+// ---------------------------------------------------------------------------------------------
+// The frontier, shared by the encoder and the decoder.
+
+class Frontier {
+ public:
+  // A loop entry stands for the frontier edge v -> v(next), oriented as in the unvisited triangle
+  // across it; `apex` is the third vertex of the visited triangle on the other side.
+  struct Node {
+    int32_t v, next, prev, apex;
+  };
+
+  // Starts from the visited seed triangle (a, b, c): the loop b -> a -> c.
+  Frontier(int32_t a, int32_t b, int32_t c) {
+    nodes_.push_back({b, 1, 2, c});
+    nodes_.push_back({a, 2, 0, b});
+    nodes_.push_back({c, 0, 1, a});
+    gate_ = 0;
+    size_ = 3;
+  }
+
+  int32_t u() const { return nodes_[gate_].v; }
+  int32_t w() const { return nodes_[next(gate_)].v; }
+  int32_t after_w() const { return nodes_[next(next(gate_))].v; }
+  int32_t before_u() const { return nodes_[prev(gate_)].v; }
+  int32_t gate_apex() const { return nodes_[gate_].apex; }
+  int64_t size() const { return size_; }
+
+  // C: the new triangle (u, w, x) with a new vertex x.
+  void add_vertex(int32_t x) {
+    const int32_t g = gate_, n = next(g);
+    const int32_t u0 = nodes_[g].v, w0 = nodes_[n].v;
+    const auto nx = static_cast<int32_t>(nodes_.size());
+    nodes_.push_back({x, n, g, u0});
+    nodes_[n].prev = nx;
+    nodes_[g].next = nx;
+    nodes_[g].apex = w0;
+    ++size_;
+    gate_ = nx;
+  }
+  // R: x follows w; w leaves the loop.
+  void close_right() {
+    const int32_t g = gate_, n = next(g);
+    nodes_[g].apex = nodes_[n].v;
+    unlink(n);
+    --size_;
+  }
+  // L: x precedes u; u leaves the loop.
+  void close_left() {
+    const int32_t g = gate_, p = prev(g);
+    nodes_[p].apex = nodes_[g].v;
+    unlink(g);
+    --size_;
+    gate_ = p;
+  }
+  // E: the loop was one triangle; continues with the last loop put aside. False when none is left.
+  bool close_loop() {
+    if (stack_.empty()) return false;
+    std::tie(gate_, size_) = stack_.back();
+    stack_.pop_back();
+    return true;
+  }
+  // The vertex `pos` steps forward from the gate (walking the shorter way round).
+  int32_t vertex_at(int64_t pos) const { return nodes_[node_at(pos)].v; }
+  // Forward steps from the gate to the entry of x, or -1.
+  int64_t find(int32_t x) const {
+    int32_t n = gate_;
+    for (int64_t pos = 0; pos < size_; ++pos, n = next(n))
+      if (nodes_[n].v == x) return pos;
+    return -1;
+  }
+  // S: x is the vertex `pos` (3 .. size - 2) steps forward. The loop splits into
+  // x -> w -> ... -> (before x), continued now, and u -> x -> ... -> (before u), put aside.
+  void split(int64_t pos) {
+    const int32_t g = gate_, n = next(g), at = node_at(pos), before = prev(at);
+    const int32_t u0 = nodes_[g].v, w0 = nodes_[n].v;
+    const auto nx = static_cast<int32_t>(nodes_.size());
+    nodes_.push_back({nodes_[at].v, n, before, u0});
+    nodes_[n].prev = nx;
+    nodes_[before].next = nx;
+    nodes_[g].next = at;
+    nodes_[at].prev = g;
+    nodes_[g].apex = w0;
+    stack_.emplace_back(g, size_ - pos + 1);
+    size_ = pos;
+    gate_ = nx;
+  }
+
+ private:
+  int32_t next(int32_t n) const { return nodes_[n].next; }
+  int32_t prev(int32_t n) const { return nodes_[n].prev; }
+  int32_t node_at(int64_t pos) const {
+    int32_t n = gate_;
+    if (pos <= size_ / 2) {
+      for (int64_t i = 0; i < pos; ++i) n = next(n);
+    } else {
+      for (int64_t i = pos; i < size_; ++i) n = prev(n);
+    }
+    return n;
+  }
+  void unlink(int32_t n) {
+    nodes_[prev(n)].next = next(n);
+    nodes_[next(n)].prev = prev(n);
+  }
+
+  std::vector<Node> nodes_;
+  int32_t gate_ = 0;
+  int64_t size_ = 0;
+  std::vector<std::pair<int32_t, int64_t>> stack_;  // gate and size of loops put aside
+};
+
+// S offsets: the shorter way round, forward (even codes) or backward (odd codes).
+uint64_t split_code(int64_t pos, int64_t size) {
+  const int64_t forward = pos - 3, backward = size - pos - 2;
+  return backward < forward ? 2 * uint64_t(backward) + 1 : 2 * uint64_t(forward);
+}
+int64_t split_position(uint64_t code, int64_t size) {
+  const auto half = static_cast<int64_t>(std::min<uint64_t>(code / 2, uint64_t{1} << 62));
+  return code % 2 ? size - 2 - half : half + 3;
+}
+
+// ---------------------------------------------------------------------------------------------
+// What the traversal yields, in the decoder's numbering (vertices 0..V, one of them virtual).
+
+struct Traversal {
+  int32_t virtual_vertex = -1;
+  std::vector<Tri> faces;               // visit order, (u, w, x) with (u, w) the gate edge
+  std::vector<std::array<int32_t, 3>> vertex_basis;  // per vertex: (u, w, apex) when it was met
+};
+
+// The level in traversal order plus what prediction needs.
+struct Canonical {
+  ControlMesh mesh;                  // vertices, triangles in visit order; colors filled later
+  std::vector<int32_t> final_index;  // decode number -> vertex of `mesh` (-1: virtual)
+  std::vector<int32_t> decode_index;  // vertex of `mesh` -> decode number
+};
+
+Canonical make_canonical(const Traversal& tr, int num_vertices) {
+  Canonical c;
+  c.final_index.assign(tr.vertex_basis.size(), -1);
+  c.decode_index.reserve(num_vertices);
+  for (int32_t d = 0; d < static_cast<int32_t>(tr.vertex_basis.size()); ++d) {
+    if (d == tr.virtual_vertex) continue;
+    c.final_index[d] = static_cast<int32_t>(c.decode_index.size());
+    c.decode_index.push_back(d);
+  }
+  std::vector<int32_t> real(tr.faces.size(), -1);
+  for (size_t f = 0; f < tr.faces.size(); ++f) {
+    const Tri& t = tr.faces[f];
+    if (t[0] == tr.virtual_vertex || t[1] == tr.virtual_vertex || t[2] == tr.virtual_vertex)
+      continue;
+    real[f] = c.mesh.num_triangles();
+    c.mesh.triangles.push_back({c.final_index[t[0]], c.final_index[t[1]], c.final_index[t[2]]});
+  }
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Prediction.
+
+uint64_t key(int32_t a, int32_t b) {
+  return (uint64_t{static_cast<uint32_t>(a)} << 32) | static_cast<uint32_t>(b);
+}
+
+using Point = std::array<int64_t, 2>;
+using Rgb = std::array<int64_t, 3>;
+
+int64_t floor_div(int64_t a, int64_t b) {
+  const int64_t q = a / b;
+  return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+}
+
+// Positions in decode order, each predicted from the vertices decoded before it: the mean of
+// every parallelogram a + b - c over an edge (a, b) with triangles (x, a, b) and (b, a, c), all
+// three known (multi-parallelogram prediction); for the few vertices with none, from the gate
+// they were met across.
+class PositionPredictor {
+ public:
+  explicit PositionPredictor(const Traversal& tr) : tr_(tr) {
+    const size_t n = tr.vertex_basis.size();
+    offsets_.assign(n + 1, 0);
+    for (const Tri& t : tr.faces)
+      if (real(t))
+        for (int32_t v : t) ++offsets_[v + 1];
+    for (size_t v = 0; v < n; ++v) offsets_[v + 1] += offsets_[v];
+    faces_.resize(offsets_[n]);
+    std::vector<int32_t> fill(offsets_.begin(), offsets_.end() - 1);
+    for (int32_t f = 0; f < static_cast<int32_t>(tr.faces.size()); ++f) {
+      const Tri& t = tr.faces[f];
+      if (!real(t)) continue;
+      for (int k = 0; k < 3; ++k) {
+        faces_[fill[t[k]]++] = f;
+        half_edges_.emplace_back(key(t[k], t[(k + 1) % 3]), f);
+      }
+    }
+    std::sort(half_edges_.begin(), half_edges_.end());
+  }
+
+  Point predict(int32_t x, const std::vector<Point>& p, const Point& previous,
+                const Point& max) const {
+    Point sum{0, 0};
+    int64_t n = 0;
+    for (int32_t i = offsets_[x]; i < offsets_[x + 1]; ++i) {
+      const Tri& t = tr_.faces[faces_[i]];
+      const int k = t[0] == x ? 0 : t[1] == x ? 1 : 2;
+      const int32_t a = t[(k + 1) % 3], b = t[(k + 2) % 3];
+      if (a > x || b > x) continue;
+      const auto it = std::lower_bound(half_edges_.begin(), half_edges_.end(),
+                                       std::pair<uint64_t, int32_t>(key(b, a), -1));
+      if (it == half_edges_.end() || it->first != key(b, a)) continue;
+      const Tri& o = tr_.faces[it->second];
+      const int32_t c = o[0] != a && o[0] != b ? o[0] : o[1] != a && o[1] != b ? o[1] : o[2];
+      if (c > x) continue;
+      for (int j = 0; j < 2; ++j) sum[j] += p[a][j] + p[b][j] - p[c][j];
+      ++n;
+    }
+    Point q;
+    if (n > 0) {
+      q = {floor_div(2 * sum[0] + n, 2 * n), floor_div(2 * sum[1] + n, 2 * n)};
+    } else {
+      q = from_gate(tr_.vertex_basis[x], p, previous);
+    }
+    return {std::clamp<int64_t>(q[0], 0, max[0]), std::clamp<int64_t>(q[1], 0, max[1])};
+  }
+
+ private:
+  bool real(const Tri& t) const {
+    return t[0] != tr_.virtual_vertex && t[1] != tr_.virtual_vertex && t[2] != tr_.virtual_vertex;
+  }
+  // From the gate (u, w) with apex a that the vertex was met across.
+  Point from_gate(const std::array<int32_t, 3>& basis, const std::vector<Point>& p,
+                  const Point& previous) const {
+    const auto [u, w, a] = basis;
+    const int32_t virt = tr_.virtual_vertex;
+    if (u < 0) return previous;  // the seed
+    if (u == virt) return p[w];  // a border vertex next to w
+    if (w == virt) return p[u];
+    if (a == virt) {
+      // Across a border edge: the apex of an equilateral triangle on its inner side.
+      const int64_t dx = p[w][0] - p[u][0], dy = p[w][1] - p[u][1];
+      return {floor_div(p[u][0] + p[w][0], 2) - floor_div(dy * 7, 8),
+              floor_div(p[u][1] + p[w][1], 2) + floor_div(dx * 7, 8)};
+    }
+    return {p[u][0] + p[w][0] - p[a][0], p[u][1] + p[w][1] - p[a][1]};
+  }
+
+  const Traversal& tr_;
+  std::vector<int32_t> offsets_, faces_;
+  std::vector<std::pair<uint64_t, int32_t>> half_edges_;
+};
+
+// Neighbors of each vertex, sorted by index (CSR).
+struct Neighbors {
+  std::vector<int32_t> offsets, list;
+  std::span<const int32_t> of(int v) const {
+    return {list.data() + offsets[v], list.data() + offsets[v + 1]};
+  }
+};
+
+// Color value `ci` from the known values it shares a triangle with (their rounded mean).
+Rgb predict_color(std::span<const int32_t> adjacent, const std::vector<char>& known,
+                        const std::vector<Rgb>& colors, const Rgb& previous) {
+  Rgb sum{0, 0, 0};
+  int64_t n = 0;
+  for (const int32_t j : adjacent) {
+    if (!known[j]) continue;
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += colors[j][ch];
+    ++n;
+  }
+  if (n == 0) return previous;
+  for (int ch = 0; ch < 3; ++ch) sum[ch] = floor_div(2 * sum[ch] + n, 2 * n);
+  return sum;
+}
+
+Neighbors neighbors(const std::vector<Tri>& triangles, size_t n_vertices) {
+  std::vector<std::pair<int32_t, int32_t>> pairs;
+  pairs.reserve(triangles.size() * 6);
+  for (const Tri& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      pairs.emplace_back(t[k], t[(k + 1) % 3]);
+      pairs.emplace_back(t[(k + 1) % 3], t[k]);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  Neighbors n;
+  n.offsets.assign(n_vertices + 1, 0);
+  for (const auto& [a, b] : pairs) ++n.offsets[a + 1];
+  for (size_t v = 0; v < n_vertices; ++v) n.offsets[v + 1] += n.offsets[v];
+  n.list.reserve(pairs.size());
+  for (const auto& [a, b] : pairs) n.list.push_back(b);
+  return n;
+}
+
+// Candidates for the step after `from` -> `at` of a chain, best first: by the cosine of the turn
+// (straightest first), then by index. Positions are integers, so the cosine is computed from
+// exact integer dot products and correctly rounded operations: the same order on every machine.
+std::vector<int32_t> ranked_steps(const Neighbors& nb, const std::vector<Point>& p, int32_t from,
+                                  int32_t at) {
+  const std::span<const int32_t> cand = nb.of(at);
+  std::vector<int32_t> out(cand.begin(), cand.end());
+  if (from < 0) return out;
+  const int64_t dx = p[at][0] - p[from][0], dy = p[at][1] - p[from][1];
+  std::vector<std::pair<double, int32_t>> keyed;
+  keyed.reserve(out.size());
+  for (const int32_t q : out) {
+    const int64_t ex = p[q][0] - p[at][0], ey = p[q][1] - p[at][1];
+    const double dot = static_cast<double>(dx * ex + dy * ey);
+    const double len = std::sqrt(static_cast<double>(ex * ex + ey * ey));
+    keyed.emplace_back(len > 0 ? -dot / len : 0.0, q);
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (size_t i = 0; i < keyed.size(); ++i) out[i] = keyed[i].second;
+  return out;
+}
+
+int32_t rank_of(const std::vector<int32_t>& ranked, int32_t v) {
+  const auto it = std::find(ranked.begin(), ranked.end(), v);
+  return it == ranked.end() ? -1 : static_cast<int32_t>(it - ranked.begin());
+}
+
+int64_t to_grid(double v, int bits) { return std::llround(std::ldexp(v, bits)); }
+double from_grid(int64_t v, int bits) { return std::ldexp(static_cast<double>(v), -bits); }
+
+
+// Section framing: u32 byte length, then the bytes.
+void put_section(ByteWriter& out, const std::vector<uint8_t>& bytes, const char* what,
+                 std::vector<size_t>& block_ends) {
+  out.count(bytes.size(), what);
+  out.bytes.insert(out.bytes.end(), bytes.begin(), bytes.end());
+  block_ends.push_back(out.bytes.size());
+}
+
+}  // namespace
+
+ControlMesh quantize_positions(const ControlMesh& mesh, int width, int height,
+                               int position_bits) {
+  ControlMesh q = mesh;
+  const int32_t nv = mesh.num_vertices();
+  const Point max = {int64_t{width} << position_bits, int64_t{height} << position_bits};
+
+  // Positions: the nearest grid point, interior vertices kept off the border lines.
+  std::vector<Point> g(nv);
+  std::vector<std::array<bool, 2>> fixed(nv);
+  for (int32_t v = 0; v < nv; ++v) {
+    const double xy[2] = {mesh.positions[v].x, mesh.positions[v].y};
+    for (int k = 0; k < 2; ++k) {
+      fixed[v][k] = xy[k] == 0 || xy[k] == (k == 0 ? width : height);
+      g[v][k] = to_grid(xy[k], position_bits);
+      if (!fixed[v][k]) g[v][k] = std::clamp<int64_t>(g[v][k], 1, max[k] - 1);
+    }
+  }
+  // Triangles that rounding flipped or collapsed: move their vertices, one at a time, to the
+  // nearest grid point within two cells that leaves fewer of their triangles non-positive.
+  std::vector<int32_t> offsets(size_t(nv) + 1, 0), faces;
+  for (const Tri& t : mesh.triangles)
+    for (int32_t v : t) ++offsets[v + 1];
+  for (int32_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  faces.resize(offsets[nv]);
+  {
+    std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (int32_t f = 0; f < mesh.num_triangles(); ++f)
+      for (int32_t v : mesh.triangles[f]) faces[fill[v]++] = f;
+  }
+  auto positive = [&](int32_t f) {
+    const Tri& t = mesh.triangles[f];
+    const Point &a = g[t[0]], &b = g[t[1]], &c = g[t[2]];
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0;
+  };
+  auto bad_around = [&](int32_t v) {
+    return std::count_if(faces.begin() + offsets[v], faces.begin() + offsets[v + 1],
+                         [&](int32_t f) { return !positive(f); });
+  };
+  std::vector<std::array<int64_t, 2>> moves;
+  for (int64_t dy = -2; dy <= 2; ++dy)
+    for (int64_t dx = -2; dx <= 2; ++dx) moves.push_back({dx, dy});
+  for (int round = 0; round < 8; ++round) {
+    std::vector<int32_t> bad;
+    for (int32_t f = 0; f < mesh.num_triangles(); ++f)
+      if (!positive(f)) bad.insert(bad.end(), mesh.triangles[f].begin(), mesh.triangles[f].end());
+    if (bad.empty()) break;
+    std::sort(bad.begin(), bad.end());
+    bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+    for (const int32_t v : bad) {
+      const double exact[2] = {std::ldexp(mesh.positions[v].x, position_bits),
+                               std::ldexp(mesh.positions[v].y, position_bits)};
+      const Point base = {to_grid(mesh.positions[v].x, position_bits),
+                          to_grid(mesh.positions[v].y, position_bits)};
+      std::vector<std::pair<double, Point>> candidates;
+      for (const auto& m : moves) {
+        if ((fixed[v][0] && m[0] != 0) || (fixed[v][1] && m[1] != 0)) continue;
+        const Point c = {base[0] + m[0], base[1] + m[1]};
+        if ((!fixed[v][0] && (c[0] < 1 || c[0] > max[0] - 1)) ||
+            (!fixed[v][1] && (c[1] < 1 || c[1] > max[1] - 1)))
+          continue;
+        const double ex = double(c[0]) - exact[0], ey = double(c[1]) - exact[1];
+        candidates.emplace_back(ex * ex + ey * ey, c);
+      }
+      std::stable_sort(candidates.begin(), candidates.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      Point best = g[v];
+      auto best_bad = bad_around(v);
+      for (const auto& [d, c] : candidates) {
+        g[v] = c;
+        const auto n = bad_around(v);
+        if (n < best_bad) {
+          best = c;
+          best_bad = n;
+          if (n == 0) break;
+        }
+      }
+      g[v] = best;
+    }
+  }
+  for (int32_t v = 0; v < nv; ++v) {
+    q.positions[v] = {from_grid(g[v][0], position_bits), from_grid(g[v][1], position_bits)};
+  }
+
+  return q;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Encoder.
+
+void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
+                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends) {
+  const int32_t nv = mesh.num_vertices(), virt = nv;
+  // The closed mesh: real triangles, then one virtual triangle (b, a, virtual) per border edge
+  // a -> b.
+  std::vector<Tri> closed = mesh.triangles;
+  std::unordered_map<uint64_t, int32_t> half_edges;
+  half_edges.reserve(closed.size() * 4);
+  for (int32_t f = 0; f < static_cast<int32_t>(mesh.triangles.size()); ++f)
+    for (int k = 0; k < 3; ++k) half_edges[key(closed[f][k], closed[f][(k + 1) % 3])] = f;
+  for (int32_t f = 0; f < static_cast<int32_t>(mesh.triangles.size()); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = mesh.triangles[f][k], b = mesh.triangles[f][(k + 1) % 3];
+      if (half_edges.count(key(b, a))) continue;
+      const auto g = static_cast<int32_t>(closed.size());
+      closed.push_back({b, a, virt});
+      half_edges[key(b, a)] = g;
+      half_edges[key(a, virt)] = g;
+      half_edges[key(virt, b)] = g;
+    }
+  }
+
+  // Traverse, numbering vertices as they are met.
+  std::vector<int32_t> code(size_t(nv) + 1, -1);
+  Traversal tr;
+  std::vector<uint8_t> ops;
+  std::vector<uint64_t> splits;
+  std::vector<char> visited(closed.size(), 0);
+  std::vector<std::array<int32_t, 3>> basis;  // original numbering
+  const Tri seed = closed[0];
+  for (int k = 0; k < 3; ++k) {
+    code[seed[k]] = k;
+    basis.push_back({-1, -1, -1});
+  }
+  visited[0] = 1;
+  std::vector<Tri> faces = {seed};
+  Frontier front(seed[0], seed[1], seed[2]);
+  for (;;) {
+    const int32_t u = front.u(), w = front.w();
+    const auto it = half_edges.find(key(u, w));
+    if (it == half_edges.end() || visited[it->second])
+      fail("internal error: the compact encoder lost its way", ErrorCode::kInvalidMesh);
+    const int32_t f = it->second;
+    visited[f] = 1;
+    const Tri& t = closed[f];
+    const int32_t x = t[0] != u && t[0] != w ? t[0] : t[1] != u && t[1] != w ? t[1] : t[2];
+    faces.push_back({u, w, x});
+    if (code[x] < 0) {
+      code[x] = static_cast<int32_t>(basis.size());
+      basis.push_back({u, w, front.gate_apex()});
+      ops.push_back(kOpC);
+      front.add_vertex(x);
+    } else if (front.size() == 3) {
+      ops.push_back(kOpE);
+      if (!front.close_loop()) break;
+    } else if (front.after_w() == x) {
+      ops.push_back(kOpR);
+      front.close_right();
+    } else if (front.before_u() == x) {
+      ops.push_back(kOpL);
+      front.close_left();
+    } else {
+      const int64_t pos = front.find(x);
+      if (pos < 3 || pos > front.size() - 2)
+        fail("internal error: the compact encoder lost its way", ErrorCode::kInvalidMesh);
+      ops.push_back(kOpS);
+      splits.push_back(split_code(pos, front.size()));
+      front.split(pos);
+    }
+  }
+  if (faces.size() != closed.size() || basis.size() != size_t(nv) + 1)
+    fail("internal error: the mesh is not a disk", ErrorCode::kInvalidMesh);
+
+  // In decode numbering.
+  tr.virtual_vertex = code[virt];
+  auto dc = [&](int32_t v) { return v < 0 ? -1 : code[v]; };
+  for (size_t f = 0; f < faces.size(); ++f) {
+    tr.faces.push_back({dc(faces[f][0]), dc(faces[f][1]), dc(faces[f][2])});
+  }
+  for (const auto& b : basis) tr.vertex_basis.push_back({dc(b[0]), dc(b[1]), dc(b[2])});
+  Canonical c = make_canonical(tr, nv);
+  std::vector<int32_t> final_of(nv);
+  for (int32_t v = 0; v < nv; ++v) final_of[v] = c.final_index[code[v]];
+  ControlMesh& m = c.mesh;
+  m.positions.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) m.positions[final_of[v]] = mesh.positions[v];
+  for (const EdgeVerts& e : mesh.creases) m.creases.push_back({final_of[e[0]], final_of[e[1]]});
+  for (const Feature& f : mesh.features) {
+    Feature g = f;
+    for (int32_t& v : g.vertices) v = final_of[v];
+    m.features.push_back(g);
+  }
+
+  // The two small sections share the block of the section after them.
+  std::vector<size_t> no_blocks;
+  // 1. Connectivity (the seed is implicit; 2V - 3 operations).
+  std::vector<uint8_t> bytes;
+  for (size_t i = 1; i < ops.size() + 1; i += kOpsPerByte) {
+    int b = 0, scale = 1;
+    for (size_t j = i; j < i + kOpsPerByte; ++j, scale *= 5)
+      if (j - 1 < ops.size()) b += ops[j - 1] * scale;
+    bytes.push_back(static_cast<uint8_t>(b));
+  }
+  put_section(out, bytes, "connectivity bytes", block_ends);
+
+  // 2. The virtual vertex, split offsets.
+  bytes.clear();
+  put_varint(bytes, uint64_t(tr.virtual_vertex));
+  for (const uint64_t s : splits) put_varint(bytes, s);
+  put_section(out, bytes, "split offset bytes", no_blocks);
+
+  // 3. Positions, in decode order.
+  const size_t n_decode = tr.vertex_basis.size();
+  std::vector<Point> p(n_decode, Point{0, 0});
+  for (int32_t v = 0; v < nv; ++v) {
+    p[code[v]] = {to_grid(mesh.positions[v].x, position_bits),
+                  to_grid(mesh.positions[v].y, position_bits)};
+  }
+  const Point max = {int64_t{width} << position_bits, int64_t{height} << position_bits};
+  bytes.clear();
+  Point previous{0, 0};
+  const PositionPredictor predictor(tr);
+  for (size_t d = 0; d < n_decode; ++d) {
+    if (int32_t(d) == tr.virtual_vertex) continue;
+    const Point q = predictor.predict(int32_t(d), p, previous, max);
+    put_varint(bytes, zigzag(p[d][0] - q[0]));
+    put_varint(bytes, zigzag(p[d][1] - q[1]));
+    previous = p[d];
+  }
+  put_section(out, bytes, "position bytes", block_ends);
+
+  // 4. Creases and features. Prediction works on final vertex numbers with positions on the grid.
+  std::vector<Point> fp(nv);
+  for (int32_t v = 0; v < nv; ++v) fp[v] = p[c.decode_index[v]];
+  const Neighbors nb = neighbors(m.triangles, m.positions.size());
+  bytes.clear();
+  std::vector<uint8_t> steps;  // their own block: mostly small ranks
+  for (const EdgeVerts& e : m.creases) {
+    put_varint(bytes, uint64_t(e[0]));
+    put_varint(steps, uint64_t(rank_of(ranked_steps(nb, fp, -1, e[0]), e[1])));
+  }
+  int64_t previous_id = -1;
+  for (const Feature& f : m.features) {
+    put_varint(bytes, zigzag(int64_t{f.id} - previous_id - 1));
+    previous_id = f.id;
+    if (f.saliency == 0 && !std::signbit(f.saliency)) {
+      bytes.push_back(0);
+    } else if (static_cast<double>(static_cast<float>(f.saliency)) == f.saliency) {
+      bytes.push_back(1);
+      const auto bits = std::bit_cast<uint32_t>(static_cast<float>(f.saliency));
+      for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<uint8_t>(bits >> (8 * k)));
+    } else {
+      bytes.push_back(2);
+      const auto bits = std::bit_cast<uint64_t>(f.saliency);
+      for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<uint8_t>(bits >> (8 * k)));
+    }
+    put_varint(bytes, f.vertices.size() - 2);
+    put_varint(bytes, uint64_t(f.vertices[0]));
+    for (size_t i = 1; i < f.vertices.size(); ++i) {
+      const int32_t from = i >= 2 ? f.vertices[i - 2] : -1;
+      put_varint(steps,
+                 uint64_t(rank_of(ranked_steps(nb, fp, from, f.vertices[i - 1]), f.vertices[i])));
+    }
+  }
+  put_section(out, bytes, "feature bytes", no_blocks);
+  put_section(out, steps, "feature step bytes", block_ends);
+
+  // 5. Colors, in canonical face-varying order.
+  const MeshTopology topo = MeshTopology::build(m, width, height);
+  int num_colors = 0;
+  const std::vector<Tri> fv = face_varying_indices(m, topo, num_colors);
+  // Targets on the grid scale, in canonical order.
+  std::vector<std::array<double, 3>> target(num_colors);
+  std::vector<int32_t> origin(mesh.triangles.size());  // canonical triangle -> visited face
+  {
+    int32_t t = 0;
+    for (size_t f = 0; f < faces.size(); ++f)
+      if (faces[f][0] != virt && faces[f][1] != virt && faces[f][2] != virt) origin[t++] = int32_t(f);
+  }
+  for (int32_t t = 0; t < m.num_triangles(); ++t) {
+    const Tri& orig_face = faces[origin[t]];  // (u, w, x) in original vertex numbers
+    const int32_t of = half_edges.at(key(orig_face[0], orig_face[1]));
+    for (int k = 0; k < 3; ++k) {
+      int j = 0;
+      while (mesh.triangles[of][j] != orig_face[k]) ++j;
+      const Color& col = mesh.colors[mesh.triangle_colors[of][j]];
+      target[fv[t][k]] = {std::ldexp(double(col.r), color_bits),
+                          std::ldexp(double(col.g), color_bits),
+                          std::ldexp(double(col.b), color_bits)};
+    }
+  }
+  // Values are coded in index order (the order of first use). Each one's rounding error is taken
+  // off the targets of its neighbors still to come (error diffusion), so that nearby errors
+  // cancel: the rendered color is a local average of control colors, and moves less than the
+  // values themselves.
+  bytes.clear();
+  const Neighbors cadj = neighbors(fv, size_t(num_colors));
+  std::vector<Rgb> colors(num_colors);
+  std::vector<char> known(num_colors, 0);
+  const int64_t mid = to_grid(128.0, color_bits);
+  Rgb last{mid, mid, mid};
+  for (int32_t ci = 0; ci < num_colors; ++ci) {
+    const Rgb q = predict_color(cadj.of(ci), known, colors, last);
+    Rgb d;
+    for (int ch = 0; ch < 3; ++ch) {
+      colors[ci][ch] = std::llround(target[ci][ch]);
+      d[ch] = colors[ci][ch] - q[ch];
+    }
+    int later = 0;
+    for (const int32_t j : cadj.of(ci)) later += j > ci;
+    if (later > 0) {
+      for (int ch = 0; ch < 3; ++ch) {
+        const double error = double(colors[ci][ch]) - target[ci][ch];
+        for (const int32_t j : cadj.of(ci))
+          if (j > ci) target[j][ch] -= error / later;
+      }
+    }
+    // The residual as green, red - green, blue - green: in photographs most of a local change is
+    // in luminance, common to the three channels.
+    put_varint(bytes, zigzag(d[1]));
+    put_varint(bytes, zigzag(d[0] - d[1]));
+    put_varint(bytes, zigzag(d[2] - d[1]));
+    known[ci] = 1;
+    last = colors[ci];
+  }
+  put_section(out, bytes, "color bytes", block_ends);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Decoder.
+
+ControlMesh decode_compact_level(Cursor& in, int level, int width, int height) {
+  const std::string name = "level " + str(uint64_t(level)) + " ";
+  in.set_context(name + "counts");
+  const size_t nv = in.count(name + "vertices", 0);
+  const size_t num_colors = in.count(name + "colors", 0);
+  const size_t num_triangles = in.count(name + "triangles", 0);
+  const size_t num_creases = in.count(name + "creases", 0);
+  const size_t num_features = in.count(name + "features", 0);
+  in.set_context(name + "precision");
+  const int position_bits = in.u8(), color_bits = static_cast<int8_t>(in.u8());
+  if (position_bits > kMaxPositionBits || color_bits < kMinColorBits ||
+      color_bits > kMaxColorBits) {
+    fail(name + "precision: position bits " + std::to_string(position_bits) + ", color bits " +
+         std::to_string(color_bits) + " (expected 0 to " + std::to_string(kMaxPositionBits) +
+         " and " + std::to_string(kMinColorBits) + " to " + std::to_string(kMaxColorBits) + ")");
+  }
+  if (nv < 3) fail(name + "vertices: " + str(nv) + " (a level has at least 3)");
+
+  auto section = [&](const std::string& what) {
+    const std::string label = name + what;
+    const size_t n = in.count(label, 1, Limits::kMaxElements * 64);
+    in.set_context(label);
+    Cursor s(std::span<const uint8_t>(in.take(n), n));
+    s.set_context(label);
+    return s;
+  };
+  auto finish = [&](const Cursor& s, const std::string& what) {
+    if (s.remaining() != 0)
+      fail(str(s.remaining()) + " unexpected bytes at the end of " + name + what);
+  };
+  auto corrupt = [&](const std::string& what) { fail(name + "connectivity: " + what); };
+
+  // 1-2. Connectivity: 2V - 3 operations after the seed.
+  const size_t num_ops = 2 * nv - 3;
+  Cursor ops = section("connectivity");
+  if (ops.remaining() != (num_ops + kOpsPerByte - 1) / kOpsPerByte) {
+    fail(name + "connectivity: " + str(ops.remaining()) + " bytes for " + str(nv) +
+         " vertices (expected " + str((num_ops + kOpsPerByte - 1) / kOpsPerByte) + ")");
+  }
+  Cursor offsets = section("split offsets");
+  const uint64_t virt64 = offsets.varint();
+  if (virt64 < 3 || virt64 > nv) corrupt("virtual vertex " + str(virt64) + " out of range");
+  Traversal tr;
+  tr.virtual_vertex = static_cast<int32_t>(virt64);
+  for (int k = 0; k < 3; ++k) tr.vertex_basis.push_back({-1, -1, -1});
+  tr.faces.push_back({0, 1, 2});
+  Frontier front(0, 1, 2);
+  uint8_t packed = 0;
+  bool done = false;
+  for (size_t i = 0; i < num_ops; ++i) {
+    if (done) corrupt("the traversal ends before the last operation");
+    if (i % kOpsPerByte == 0) {
+      packed = ops.u8();
+      if (packed >= 125) corrupt("byte " + str(i / kOpsPerByte) + " is not three operations");
+    }
+    const int op = packed % 5;
+    packed = static_cast<uint8_t>(packed / 5);
+    const int32_t u = front.u(), w = front.w();
+    int32_t x = -1;
+    if (op == kOpC) {
+      if (tr.vertex_basis.size() > nv) corrupt("more vertices than the " + str(nv) + " declared");
+      x = static_cast<int32_t>(tr.vertex_basis.size());
+      tr.vertex_basis.push_back({u, w, front.gate_apex()});
+      front.add_vertex(x);
+    } else if (op == kOpE) {
+      if (front.size() != 3) corrupt("operation " + str(i) + " closes a loop of " +
+                                     str(uint64_t(front.size())) + " edges");
+      x = front.after_w();
+      done = !front.close_loop();
+    } else if (op == kOpR || op == kOpL) {
+      if (front.size() <= 3) corrupt("operation " + str(i) + " on a loop of 3 edges");
+      x = op == kOpR ? front.after_w() : front.before_u();
+      op == kOpR ? front.close_right() : front.close_left();
+    } else {
+      const int64_t pos = split_position(offsets.varint(), front.size());
+      if (pos < 3 || pos > front.size() - 2) corrupt("split offset out of range");
+      x = front.vertex_at(pos);
+      front.split(pos);
+    }
+    if (x == u || x == w) corrupt("operation " + str(i) + " makes a degenerate triangle");
+    tr.faces.push_back({u, w, x});
+  }
+  if (!done) corrupt("the traversal leaves triangles unvisited");
+  if (tr.vertex_basis.size() != nv + 1) {
+    corrupt(str(tr.vertex_basis.size() - 1) + " vertices, but " + str(nv) + " are declared");
+  }
+  finish(offsets, "split offsets");
+  Canonical c = make_canonical(tr, static_cast<int>(nv));
+  ControlMesh& m = c.mesh;
+  if (size_t(m.num_triangles()) != num_triangles) {
+    corrupt(str(uint64_t(m.num_triangles())) + " triangles, but " + str(num_triangles) +
+            " are declared");
+  }
+
+  // 3. Positions.
+  Cursor ps = section("positions");
+  std::vector<Point> p(nv + 1, Point{0, 0});
+  const Point max = {int64_t{width} << position_bits, int64_t{height} << position_bits};
+  constexpr int64_t kLimit = int64_t{1} << 40;
+  Point previous{0, 0};
+  const PositionPredictor predictor(tr);
+  for (size_t d = 0; d < nv + 1; ++d) {
+    if (int32_t(d) == tr.virtual_vertex) continue;
+    const Point q = predictor.predict(int32_t(d), p, previous, max);
+    for (int k = 0; k < 2; ++k) {
+      const int64_t r = ps.svarint();
+      if (r < -kLimit || r > kLimit) fail(name + "positions: residual out of range");
+      p[d][k] = q[k] + r;
+    }
+    previous = p[d];
+  }
+  finish(ps, "positions");
+  m.positions.resize(nv);
+  std::vector<Point> fp(nv);
+  for (size_t v = 0; v < nv; ++v) {
+    fp[v] = p[c.decode_index[v]];
+    m.positions[v] = {from_grid(fp[v][0], position_bits), from_grid(fp[v][1], position_bits)};
+  }
+
+  // 4. Creases and features.
+  Cursor fs = section("features");
+  Cursor st = section("feature steps");
+  const Neighbors nb = neighbors(m.triangles, m.positions.size());
+  auto vertex = [&](uint64_t v, const std::string& what) {
+    if (v >= nv) fail(name + what + ": vertex " + str(v) + " out of range");
+    return static_cast<int32_t>(v);
+  };
+  auto step = [&](int32_t from, int32_t at, const std::string& what) {
+    const std::vector<int32_t> ranked = ranked_steps(nb, fp, from, at);
+    const uint64_t r = st.varint();
+    if (r >= ranked.size()) fail(name + what + ": step " + str(r) + " out of range");
+    return ranked[r];
+  };
+  for (size_t i = 0; i < num_creases; ++i) {
+    const std::string what = "crease " + str(i);
+    const int32_t a = vertex(fs.varint(), what);
+    m.creases.push_back({a, step(-1, a, what)});
+  }
+  int64_t previous_id = -1;
+  for (size_t i = 0; i < num_features; ++i) {
+    const std::string what = "feature " + str(i);
+    fs.set_context(name + what);
+    Feature f;
+    const int64_t id = previous_id + 1 + fs.svarint();
+    if (id < INT32_MIN || id > INT32_MAX) fail(name + what + ": id out of range");
+    f.id = static_cast<int32_t>(id);
+    previous_id = id;
+    const uint8_t tag = fs.u8();
+    if (tag == 1) {
+      f.saliency = std::bit_cast<float>(fs.u32());
+    } else if (tag == 2) {
+      f.saliency = fs.f64();
+    } else if (tag != 0) {
+      fail(name + what + ": unknown saliency tag " + str(tag));
+    }
+    const uint64_t n = fs.varint();
+    if (n > st.remaining()) fail(name + what + ": " + str(n + 2) + " vertices, too few bytes");
+    f.vertices.push_back(vertex(fs.varint(), what));
+    for (uint64_t k = 0; k <= n; ++k) {
+      const int32_t from = f.vertices.size() >= 2 ? f.vertices[f.vertices.size() - 2] : -1;
+      f.vertices.push_back(step(from, f.vertices.back(), what));
+    }
+    m.features.push_back(std::move(f));
+  }
+  finish(fs, "features");
+  finish(st, "feature steps");
+
+  // 5. Colors.
+  Cursor cs = section("colors");
+  const MeshTopology topo = MeshTopology::build(m, width, height);
+  int nc = 0;
+  m.triangle_colors = face_varying_indices(m, topo, nc);
+  if (size_t(nc) != num_colors) {
+    fail(name + "colors: the tears give " + str(uint64_t(nc)) + " color values, but " +
+         str(num_colors) + " are declared");
+  }
+  std::vector<Rgb> colors(nc);
+  const Neighbors cadj = neighbors(m.triangle_colors, size_t(nc));
+  std::vector<char> known(nc, 0);
+  const int64_t mid = to_grid(128.0, color_bits);
+  Rgb last{mid, mid, mid};
+  constexpr int64_t kColorLimit = int64_t{1} << 48;
+  for (int32_t ci = 0; ci < nc; ++ci) {
+    const Rgb q = predict_color(cadj.of(ci), known, colors, last);
+    Rgb d;
+    for (int64_t& r : d) {
+      r = cs.svarint();
+      if (r < -kColorLimit || r > kColorLimit) fail(name + "colors: residual out of range");
+    }
+    d = {d[1] + d[0], d[0], d[2] + d[0]};
+    for (int ch = 0; ch < 3; ++ch) {
+      if (std::abs(q[ch]) > kColorLimit) fail(name + "colors: value out of range");
+      colors[ci][ch] = q[ch] + d[ch];
+    }
+    known[ci] = 1;
+    last = colors[ci];
+  }
+  finish(cs, "colors");
+  m.colors.resize(nc);
+  for (int32_t i = 0; i < nc; ++i) {
+    m.colors[i] = {static_cast<float>(from_grid(colors[i][0], color_bits)),
+                   static_cast<float>(from_grid(colors[i][1], color_bits)),
+                   static_cast<float>(from_grid(colors[i][2], color_bits))};
+  }
+  return std::move(c.mesh);
+}
+
+}  // namespace subvec::svec_detail

@@ -1,0 +1,270 @@
+// PDF and SVG export: the depth rule, the strips, the documents' structure, and what real viewers
+// draw from them against subvec's own renderer: poppler's pdftoppm for PDF, librsvg's rsvg-convert
+// and headless Chromium for SVG (each skipped with a message when the tool is not installed;
+// scripts/setup installs them).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "export/export_p.h"
+#include "export/limit_mesh_p.h"
+#include "subvec/core/error.h"
+#include "subvec/core/metrics.h"
+#include "subvec/export/export.h"
+#include "subvec/io/image_io.h"
+#include "subvec/io/svec.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/render/renderer.h"
+#include "support/synthetic.h"
+
+namespace subvec {
+namespace {
+
+namespace fs = std::filesystem;
+
+// poppler (pdftoppm) against the renderer, MAE on the 0-255 scale (docs/export.md explains the gap).
+constexpr double kPdfMae = 0.9;
+
+VectorImage example(const std::string& name) {
+  return read_svec(fs::path(SUBVEC_SOURCE_DIR) / "examples" / (name + ".svec.json"));
+}
+
+// A vectorization-like image: a jittered mesh with closed and open tears over random smooth colors.
+VectorImage synthetic() {
+  test::SyntheticOptions options;
+  options.width = 200;
+  options.height = 150;
+  options.vertices = 800;
+  return test::make_synthetic_image(options);
+}
+
+bool have(const std::string& tool) {
+  return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0;
+}
+
+class ExportViewers : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("subvec_export_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Writes `text` to dir_/name and returns the path.
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+  // MAE of a viewer's PNG (its top-left corner of the image's size) against subvec's render.
+  double mae_against_render(const VectorImage& image, const fs::path& png) {
+    const Image8 full = read_image(png);
+    if (full.width < image.width || full.height < image.height) {
+      ADD_FAILURE() << png << " is " << full.width << " x " << full.height;
+      return 255;
+    }
+    Image8 viewer(image.width, image.height, 3);
+    for (int y = 0; y < image.height; ++y)
+      std::copy_n(full.row(y), 3 * image.width, viewer.row(y));
+    RenderOptions options;
+    options.width = viewer.width;
+    options.height = viewer.height;
+    return compare(render(image, options), viewer).mae_mean;
+  }
+  bool run(const std::string& command) { return std::system(command.c_str()) == 0; }
+
+  fs::path dir_;
+};
+
+// ---- the depth rule and the strips ---------------------------------------------------------
+
+TEST(Export, DepthFollowsTheToleranceAndTheScale) {
+  const VectorImage image = example("01-disk");
+  ExportReport coarse, fine, zoomed;
+  ExportOptions options;
+  options.tolerance = 1;
+  options.color_tolerance = 8;
+  const int d1 = detail::export_depth(image, options, coarse);
+  options.tolerance = 0.05;
+  options.color_tolerance = 0.25;
+  const int d2 = detail::export_depth(image, options, fine);
+  EXPECT_LT(d1, d2);
+  EXPECT_LE(fine.over_tolerance, 0.01);
+  options = {};
+  const int d3 = detail::export_depth(image, options, coarse);
+  options.scale = 8;
+  EXPECT_GT(detail::export_depth(image, options, zoomed), d3);
+  options.depth = 2;
+  EXPECT_EQ(detail::export_depth(image, options, coarse), 2);
+}
+
+TEST(Export, RejectsBadOptions) {
+  const VectorImage image = example("01-disk");
+  auto fails = [&](ExportOptions o) { EXPECT_THROW((void)to_pdf(image, o), Error); };
+  fails({.level = 1});
+  fails({.scale = 0});
+  fails({.tolerance = -1});
+  fails({.depth = 9});
+  EXPECT_THROW(write_vector_export(fs::temp_directory_path() / "x.eps", image), Error);
+}
+
+TEST(Export, StripsCoverEveryRefinedTriangleOnce) {
+  const VectorImage image = synthetic();
+  ExportReport report;
+  const RefinedMesh mesh = detail::export_limit_mesh(image, 0, 2, report);
+  const detail::Strips strips = detail::make_strips(mesh);
+  // Replay the flags as a PDF reader does; each triangle must be a refined one, with its corners
+  // (positions and colors), and all of them must come out exactly once.
+  using Corner = std::pair<int32_t, int32_t>;  // vertex, color value
+  auto corner = [&](size_t i) {
+    const auto [t, k] = strips.corners[i];
+    return Corner{mesh.triangles[t][k], mesh.triangle_colors[t][k]};
+  };
+  std::multiset<std::set<Corner>> expected, seen;
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    expected.insert(std::set<Corner>{Corner{mesh.triangles[t][0], mesh.triangle_colors[t][0]},
+                                     Corner{mesh.triangles[t][1], mesh.triangle_colors[t][1]},
+                                     Corner{mesh.triangles[t][2], mesh.triangle_colors[t][2]}});
+  }
+  std::array<Corner, 3> last{};
+  for (size_t i = 0; i < strips.flags.size();) {
+    if (strips.flags[i] == 0) {
+      ASSERT_LE(i + 3, strips.flags.size());
+      last = {corner(i), corner(i + 1), corner(i + 2)};
+      i += 3;
+    } else {
+      last = strips.flags[i] == 1 ? std::array<Corner, 3>{last[1], last[2], corner(i)}
+                                  : std::array<Corner, 3>{last[0], last[2], corner(i)};
+      ++i;
+    }
+    seen.insert(std::set<Corner>{last[0], last[1], last[2]});
+  }
+  EXPECT_EQ(seen, expected);
+  EXPECT_LT(double(strips.flags.size()) / mesh.num_triangles(), 1.6);  // strips share vertices
+}
+
+// ---- documents ------------------------------------------------------------------------------
+
+TEST(Export, PdfIsWellFormed) {
+  VectorImage image = example("02-open-tear");
+  const std::string pdf = to_pdf(image, {.scale = 2});
+  ASSERT_EQ(pdf.rfind("%PDF-1.4\n", 0), 0u);
+  EXPECT_NE(pdf.find("/ShadingType 4"), std::string::npos);
+  EXPECT_NE(pdf.find("/MediaBox [0 0 " + std::to_string(2 * image.width) + " " +
+                     std::to_string(2 * image.height) + "]"),
+            std::string::npos);
+  // Every object starts where the cross-reference table says.
+  const size_t xref = std::stoul(pdf.substr(pdf.rfind("startxref\n") + 10));
+  ASSERT_EQ(pdf.compare(xref, 5, "xref\n"), 0);
+  std::istringstream table(pdf.substr(xref));
+  std::string line;
+  std::getline(table, line);
+  int first = 0, count = 0;
+  table >> first >> count;
+  std::getline(table, line);
+  std::getline(table, line);  // the free entry
+  for (int i = 1; i < count; ++i) {
+    std::getline(table, line);
+    const size_t offset = std::stoul(line.substr(0, 10));
+    EXPECT_EQ(pdf.compare(offset, std::to_string(i).size() + 6, std::to_string(i) + " 0 obj"), 0)
+        << "object " << i;
+  }
+  EXPECT_EQ(to_pdf(image, {.scale = 2}), pdf);  // deterministic
+}
+
+TEST(Export, SvgIsWellFormedAndDrawsEveryTriangle) {
+  const VectorImage image = example("03-junction");
+  ExportReport report;
+  const std::string svg = to_svg(image, {}, &report);
+  EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
+  EXPECT_NE(svg.find("viewBox=\"0 0 " + std::to_string(image.width) + " " +
+                     std::to_string(image.height) + "\""),
+            std::string::npos);
+  EXPECT_EQ(svg.substr(svg.size() - 7), "</svg>\n");
+  // One closed subpath per refined triangle inside the crisp group.
+  const size_t begin = svg.find("<g shape-rendering=\"crispEdges\""), end = svg.find("</g>");
+  ASSERT_NE(begin, std::string::npos);
+  const std::string group = svg.substr(begin, end - begin);
+  EXPECT_EQ(std::count(group.begin(), group.end(), 'z'), report.triangles);
+  EXPECT_EQ(to_svg(image), svg);
+}
+
+TEST(Export, StrokesAreDrawn) {
+  VectorImage image = example("02-open-tear");
+  Stroke stroke;
+  stroke.points = {{10, 10}, {40, 20}, {60, 50}};
+  stroke.width = 3;
+  stroke.color = {10, 200, 30};
+  image.strokes.push_back(stroke);
+  const std::vector<Vec2> outline = detail::stroke_outline(stroke);
+  ASSERT_GT(outline.size(), 10u);
+  EXPECT_NEAR(outline.front().x, 10, 1e-9);  // tapered to a point at the first control point
+  EXPECT_NEAR(outline.front().y, 10, 1e-9);
+  EXPECT_NE(to_svg(image).find("fill=\"#0ac81e\""), std::string::npos);
+  EXPECT_NE(to_pdf(image).find("/ShadingType 4"), std::string::npos);
+}
+
+// ---- what viewers draw ----------------------------------------------------------------------
+
+TEST_F(ExportViewers, PopplerDrawsThePdfLikeTheRenderer) {
+  if (!have("pdftoppm")) GTEST_SKIP() << "pdftoppm (poppler-utils) is not installed; scripts/setup installs it";
+  std::map<std::string, VectorImage> images = {{"01-disk", example("01-disk")},
+                                               {"02-open-tear", example("02-open-tear")},
+                                               {"03-junction", example("03-junction")},
+                                               {"synthetic", synthetic()}};
+  for (const auto& [name, image] : images) {
+    const fs::path pdf = write(name + ".pdf", to_pdf(image));
+    ASSERT_TRUE(run("pdftoppm -r 72 -png -singlefile '" + pdf.string() + "' '" +
+                    (dir_ / name).string() + "'"));
+    const double mae = mae_against_render(image, dir_ / (name + ".png"));
+    RecordProperty(name + "_pdf_mae", std::to_string(mae));
+    EXPECT_LE(mae, kPdfMae) << name;
+  }
+}
+
+TEST_F(ExportViewers, LibrsvgDrawsTheSvgLikeTheRenderer) {
+  if (!have("rsvg-convert")) GTEST_SKIP() << "rsvg-convert (librsvg2-bin) is not installed; scripts/setup installs it";
+  for (const auto& [name, image] : std::map<std::string, VectorImage>{
+           {"01-disk", example("01-disk")}, {"03-junction", example("03-junction")},
+           {"synthetic", synthetic()}}) {
+    const fs::path svg = write(name + ".svg", to_svg(image));
+    ASSERT_TRUE(run("rsvg-convert '" + svg.string() + "' -o '" + (dir_ / name).string() + ".png'"));
+    const double mae = mae_against_render(image, dir_ / (name + ".png"));
+    RecordProperty(name + "_rsvg_mae", std::to_string(mae));
+    EXPECT_LE(mae, 1.5) << name;
+  }
+}
+
+TEST_F(ExportViewers, ChromiumDrawsTheSvgLikeTheRenderer) {
+  std::string chromium;
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"})
+    if (chromium.empty() && have(name)) chromium = name;
+  if (chromium.empty()) GTEST_SKIP() << "no Chromium installed; scripts/setup installs it";
+  for (const auto& [name, image] : std::map<std::string, VectorImage>{
+           {"01-disk", example("01-disk")}, {"synthetic", synthetic()}}) {
+    const fs::path svg = write(name + ".svg", to_svg(image));
+    const fs::path png = dir_ / (name + ".png");
+    ASSERT_TRUE(run("timeout 120 " + chromium +
+                    " --headless --no-sandbox --disable-gpu --hide-scrollbars"
+                    " --force-device-scale-factor=1 --run-all-compositor-stages-before-draw"
+                    " --virtual-time-budget=10000 --user-data-dir='" + (dir_ / "profile").string() +
+                    // A window larger than the image: the viewport is smaller than the window.
+                    "' --window-size=" + std::to_string(image.width + 200) + "," +
+                    std::to_string(image.height + 200) + " --screenshot='" + png.string() + "' 'file://" +
+                    svg.string() + "' >/dev/null 2>&1"));
+    const double mae = mae_against_render(image, png);
+    RecordProperty(name + "_chromium_mae", std::to_string(mae));
+    EXPECT_LE(mae, 1.5) << name;
+  }
+}
+
+}  // namespace
+}  // namespace subvec
