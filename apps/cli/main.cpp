@@ -446,6 +446,7 @@ struct VectorizeArgs {
   int64_t max_pixels = int64_t{1} << 23;
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
+  int grid_step = 0;     // 0: automatic
   bool json = false;
 };
 
@@ -463,6 +464,7 @@ void run_vectorize(const VectorizeArgs& a) {
   subvec::VectorizeOptions options;
   options.ratio = a.ratio;
   options.vertices = a.vertices;
+  options.initial_mesh.grid_step = a.grid_step;
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
   if (!a.segment.empty()) {
@@ -741,6 +743,11 @@ int run(int argc, char** argv) {
             return parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
+  vectorize
+      ->add_option("--grid-step", va.grid_step,
+                   "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
+                   "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
+      ->check(CLI::Range(0, 2));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   vectorize->footer(
       "Examples:\n"
