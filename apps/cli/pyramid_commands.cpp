@@ -67,10 +67,11 @@ void run_filter(const FilterArgs& a, bool eta_given) {
                                                  std::to_string(bands) + (bands == 1 ? " band" : " bands"));
   }
   subvec::FilterOptions options;
-  // Neither flag: both channels. One flag: that channel only.
-  const bool both = !a.geometry && !a.color;
-  if (both || a.geometry) options.geometry_eta = etas;
-  if (both || a.color) options.color_eta = etas;
+  // Colors by default (the image's frequencies live there); --geometry-eta adds or, alone, selects
+  // the positions.
+  const bool color = a.color || !a.geometry;
+  if (a.geometry) options.geometry_eta = etas;
+  if (color) options.color_eta = etas;
   subvec::FilterReport report;
   const subvec::VectorImage out = subvec::filter(image, options, &report);
   subvec::write_svec(a.output, out);
@@ -81,9 +82,7 @@ void run_filter(const FilterArgs& a, bool eta_given) {
     list += buf;
   }
   std::printf("%s -> %s: %d bands, eta %s on %s%s\n", a.input.c_str(), a.output.c_str(), report.bands,
-              list.c_str(), both ? "geometry and color" : a.geometry && a.color ? "geometry and color"
-                                                          : a.geometry        ? "geometry"
-                                                                              : "color",
+              list.c_str(), a.geometry && color ? "geometry and color" : a.geometry ? "geometry" : "color",
               report.restored_vertices > 0
                   ? (", " + std::to_string(report.restored_vertices) + " vertices held back from folding").c_str()
                   : "");
@@ -158,12 +157,14 @@ void add_pyramid_commands(CLI::App& app) {
               },
               "A,B,...", "etas"));
   eta->excludes(eta_levels);
-  filter->add_flag("--geometry-eta", fa.geometry, "Scale the position details only (default: positions and colors)");
-  filter->add_flag("--color-eta", fa.color, "Scale the color details only (default: positions and colors)");
+  filter->add_flag("--geometry-eta", fa.geometry,
+                   "Scale the position details (alone: positions only; with --color-eta: both)");
+  filter->add_flag("--color-eta", fa.color, "Scale the color details (the default when neither flag is given)");
   filter->footer(
       "Examples:\n"
       "  subvec filter photo.svec -o smooth.svec --eta 0.3            # low-pass\n"
-      "  subvec filter photo.svec -o sharp.svec --eta 1.8 --color-eta # enhance color detail\n"
+      "  subvec filter photo.svec -o sharp.svec --eta 1.8             # enhance color detail\n"
+      "  subvec filter photo.svec -o calm.svec --eta 0.5 --geometry-eta --color-eta  # both\n"
       "  subvec filter photo.svec -o band.svec --eta-levels 0.2,1      # damp the finest band only");
   filter->callback([eta] { run_filter(fa, eta->count() > 0); });
 }

@@ -166,7 +166,7 @@ int run(int argc, char** argv) {
   });
   VectorImage smooth;
   FilterOptions f03;
-  f03.geometry_eta = f03.color_eta = {0.3};
+  f03.color_eta = {0.3};  // colors, the command's default
   const double filter_s = median_seconds(runs, [&] { smooth = filter(image, f03); });
 
   std::string levels_json;
@@ -231,7 +231,7 @@ int run(int argc, char** argv) {
     write_png(figures + "-levels.png", from_mat(sheet));
     // Fig. 13: raster, smoothed, difference; vector, enhanced, difference.
     FilterOptions f18;
-    f18.geometry_eta = f18.color_eta = {1.8};
+    f18.color_eta = {1.8};
     const Image8 sharp = render_level(filter(image, f18), 0);
     cv::Mat r1, r2, fig;
     cv::hconcat(std::vector<cv::Mat>{tile(as_mat(photo), w, "raster"), tile(as_mat(after), w, "eta 0.3"),

@@ -242,7 +242,25 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   } else {
     r.position_ring = ring;
   }
-  // Wedges: the corners u shares a face with, by u's color in that face.
+  // Wedges: the corners u shares a face with, by u's color in that face. A tear vertex's sides are
+  // predicted along its chain, from neighbours that are two-sided there too: a chain end whose one
+  // color serves both sides would pull the jump toward zero. Failing those, from the rest of the
+  // same side.
+  std::array<bool, 2> one_sided{false, false};
+  if (tear_slot >= 0) {
+    for (int i = 0; i < 2; ++i) {
+      int32_t seen = -1;
+      bool single = true;
+      for (int32_t f : vfaces_[u]) {
+        for (int k = 0; k < 3; ++k) {
+          if (tri_[f][k] != chain_nbrs[i]) continue;
+          if (seen >= 0 && tcol_[f][k] != seen) single = false;
+          seen = tcol_[f][k];
+        }
+      }
+      one_sided[i] = single;
+    }
+  }
   std::vector<int32_t> colors;
   for (int32_t f : vfaces_[u])
     for (int k = 0; k < 3; ++k)
@@ -259,8 +277,20 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
       for (int k = 0; k < 3; ++k) {
         if (k == ku) continue;
         const int32_t x = tri_[f][k];
-        if (tear_slot >= 0 && x != chain_nbrs[0] && x != chain_nbrs[1]) continue;  // along the chain only
         w.neighbours.push_back({x, tcol_[f][k]});
+      }
+    }
+    if (tear_slot >= 0) {
+      auto along = [&](const std::pair<int32_t, int32_t>& n) {
+        return (n.first == chain_nbrs[0] && !one_sided[0]) || (n.first == chain_nbrs[1] && !one_sided[1]);
+      };
+      auto single = [&](const std::pair<int32_t, int32_t>& n) {
+        return (n.first == chain_nbrs[0] && one_sided[0]) || (n.first == chain_nbrs[1] && one_sided[1]);
+      };
+      if (std::any_of(w.neighbours.begin(), w.neighbours.end(), along)) {
+        std::erase_if(w.neighbours, [&](const auto& n) { return !along(n); });
+      } else {
+        std::erase_if(w.neighbours, single);
       }
     }
     std::sort(w.neighbours.begin(), w.neighbours.end());

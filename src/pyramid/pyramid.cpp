@@ -25,11 +25,20 @@ struct Band {
   std::vector<int32_t> parents;                // coarse vertex -> fine vertex
   std::vector<int32_t> coarse_color_merged;    // coarse color -> merged color
   std::vector<int32_t> merged_coarse;          // live merged color -> a coarse color, else -1
+  // A kept vertex is the same vertex in both levels: what differs is only how each level expresses
+  // it (the coarse level's colors were refitted for its coarser surface; positions may differ by the
+  // file grid). These differences are applied in full, whatever eta: they are no band of detail.
+  // (Scaling them would put control values fitted for the coarse surface under the fine one, whose
+  // limit follows its control values more closely: ripples, not smoothing.)
   std::vector<Vec2> survivor_detail;           // fine position of a kept vertex minus its coarse one
   std::vector<Rgb> refit_detail;               // merged value of a kept color minus its refitted one
   std::vector<CollapseRecord> records;
   std::vector<std::array<double, 2>> position_detail;  // per record, in its local frame
   std::vector<std::vector<Rgb>> color_detail;          // per record, per wedge
+  // A tear vertex of a kept feature: its two sides as a mean (predicted, detail scaled by eta) and
+  // half the jump between them, which is kept as it is: a kept tear never fades nor sharpens.
+  std::vector<uint8_t> tear_pair;                      // per record
+  std::vector<Rgb> half_jump;                          // per record (zero unless tear_pair)
   std::vector<Rgb> merged_values;                      // merged colors as the step made them
   std::vector<Kind> kinds;                             // of every fine vertex
   std::vector<uint8_t> sides;                          // image sides of every fine vertex
@@ -125,6 +134,19 @@ Band analyze(const ControlMesh& fine, const ControlMesh& coarse, int width, int 
       const Rgb p = predict_color(w, fine.positions[u], fine.positions, merged);
       cd.push_back({merged[w.color][0] - p[0], merged[w.color][1] - p[1], merged[w.color][2] - p[2]});
     }
+    const bool pair = c.kind(u) == Kind::kTear && r.wedges.size() == 2;
+    Rgb half{0, 0, 0};
+    if (pair) {
+      // L = m + j + d, R = m - j + d with m the mean of the two side predictions.
+      for (int ch = 0; ch < 3; ++ch) {
+        const double l = merged[r.wedges[0].color][ch], rr = merged[r.wedges[1].color][ch];
+        const double pred_l = l - cd[0][ch], pred_r = rr - cd[1][ch];
+        half[ch] = (l - rr) / 2;
+        cd[0][ch] = cd[1][ch] = (l + rr) / 2 - (pred_l + pred_r) / 2;
+      }
+    }
+    b.tear_pair.push_back(pair ? 1 : 0);
+    b.half_jump.push_back(half);
     b.color_detail.push_back(std::move(cd));
     b.records.push_back(std::move(r));
   }
@@ -207,14 +229,14 @@ void reconstruct(const Band& b, const ControlMesh& coarse, double eta_g, double 
   // (A merged value that neither a kept vertex nor a removed one carries keeps the step's value.)
   std::vector<Rgb> merged = b.merged_values;
   for (size_t i = 0; i < b.parents.size(); ++i) {
-    pos[b.parents[i]] = {coarse.positions[i].x + eta_g * b.survivor_detail[i].x,
-                         coarse.positions[i].y + eta_g * b.survivor_detail[i].y};
+    pos[b.parents[i]] = {coarse.positions[i].x + b.survivor_detail[i].x,
+                         coarse.positions[i].y + b.survivor_detail[i].y};
   }
   for (size_t k = 0; k < coarse.colors.size(); ++k) {
     const int32_t m = b.coarse_color_merged[k];
     if (m < 0 || b.merged_coarse[m] != static_cast<int32_t>(k)) continue;
     const Rgb q = rgb(coarse.colors[k]);
-    for (int i = 0; i < 3; ++i) merged[m][i] = q[i] + eta_c * b.refit_detail[k][i];
+    for (int i = 0; i < 3; ++i) merged[m][i] = q[i] + b.refit_detail[k][i];
   }
   for (size_t i = b.records.size(); i-- > 0;) {
     const CollapseRecord& r = b.records[i];
@@ -229,6 +251,15 @@ void reconstruct(const Band& b, const ControlMesh& coarse, double eta_g, double 
     if (s & 2) p.y = 0;
     if (s & 8) p.y = height;
     pos[r.removed] = p;
+    if (b.tear_pair[i]) {
+      const Rgb ql = predict_color(r.wedges[0], p, pos, merged), qr = predict_color(r.wedges[1], p, pos, merged);
+      for (int c = 0; c < 3; ++c) {
+        const double mean = (ql[c] + qr[c]) / 2 + eta_c * b.color_detail[i][0][c];
+        merged[r.wedges[0].color][c] = mean + b.half_jump[i][c];
+        merged[r.wedges[1].color][c] = mean - b.half_jump[i][c];
+      }
+      continue;
+    }
     for (size_t w = 0; w < r.wedges.size(); ++w) {
       const Rgb q = predict_color(r.wedges[w], p, pos, merged);
       for (int c = 0; c < 3; ++c) merged[r.wedges[w].color][c] = q[c] + eta_c * b.color_detail[i][w][c];

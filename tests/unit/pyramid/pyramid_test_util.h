@@ -11,7 +11,7 @@
 
 namespace subvec::test {
 
-// Shapes over a smooth background, anti-aliased by 4x4 supersampling: a large high-contrast disk,
+// Shapes over a textured background, anti-aliased by 4x4 supersampling: a large high-contrast disk,
 // a rectangle, and small blobs of falling contrast, so that saliency orders them.
 inline Image8 shapes_image(int w = 192, int h = 144) {
   Image8 img(w, h, 3);
@@ -32,7 +32,10 @@ inline Image8 shapes_image(int w = 192, int h = 144) {
       for (int sy = 0; sy < 4; ++sy) {
         for (int sx = 0; sx < 4; ++sx) {
           const double px = x + (sx + 0.5) / 4, py = y + (sy + 0.5) / 4;
-          double c[3] = {90 + 60.0 * px / w, 110 + 30 * std::sin(py / 17), 120 - 50.0 * py / h};
+          // A smooth background with fine texture (a few pixels across, like foliage or fabric):
+          // the detail that smoothing should take away.
+          const double texture = 14 * std::sin(px * 0.9 + 2 * std::sin(py * 0.31)) * std::sin(py * 0.7);
+          double c[3] = {90 + 60.0 * px / w + texture, 110 + 30 * std::sin(py / 17) + texture, 120 - 50.0 * py / h};
           for (const Blob& b : blobs) {
             const double dx = (px - b.cx) / b.rx, dy = (py - b.cy) / b.ry;
             const bool in = b.box ? std::abs(dx) < 1 && std::abs(dy) < 1 : dx * dx + dy * dy < 1;
