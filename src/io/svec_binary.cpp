@@ -205,6 +205,8 @@ void decode_trailer(Cursor& in, VectorImage& image) {
   }
   // Optional: the pyramid records of levels 1 and up (docs/format.md, "Levels and the pyramid").
   // Files written before them end here.
+  if (in.remaining() != 0 && in.remaining() < 4)  // too short for a record count: stray bytes
+    fail(str(in.remaining()) + " unexpected bytes after the payload's metadata");
   if (in.remaining() != 0) {
     in.set_context("pyramid records");
     const size_t n = in.count("pyramid records", 3, Limits::kMaxLevels);

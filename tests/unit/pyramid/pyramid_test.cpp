@@ -314,6 +314,9 @@ TEST(Pyramid, FilesKeepThePyramid) {
   VectorImage bad = image;
   bad.levels[1].parent_vertices[0] = image.levels[0].num_vertices();
   EXPECT_THROW(parse_svec_json(to_svec_json(bad)), Error);
+  SvecWriteOptions lossless;
+  lossless.lossless = true;
+  EXPECT_THROW(parse_svec_binary(to_svec_binary(bad, lossless)), Error);
   bad = image;
   bad.levels[1].collapses.pop_back();
   EXPECT_THROW(validate(bad), Error);
