@@ -115,8 +115,8 @@ void add_level_options(CLI::App* vectorize, LevelArgs& args) {
 }
 
 subvec::LevelReport build_levels(const LevelArgs& args, subvec::VectorImage& image, const subvec::Image8& photo) {
+  // With one level this only stores each feature's saliency.
   subvec::LevelReport report;
-  if (args.levels <= 1 && args.feature_levels.empty()) return report;
   subvec::LevelOptions options;
   options.levels = args.levels;
   options.saliency_weight = args.saliency_weight;

@@ -23,7 +23,8 @@ struct LevelArgs {
 // Adds --levels, --saliency-weight, --level-reduction and --feature-level to `vectorize`.
 void add_level_options(CLI::App* vectorize, LevelArgs& args);
 
-// Builds the levels of `image` (vectorized from `photo`) as the arguments ask; nothing for one level.
+// Builds the levels of `image` (vectorized from `photo`) as the arguments ask and stores every
+// feature's saliency (also with one level).
 subvec::LevelReport build_levels(const LevelArgs& args, subvec::VectorImage& image,
                                  const subvec::Image8& photo);
 
