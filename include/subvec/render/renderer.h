@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
@@ -24,6 +25,12 @@ struct Window {
 
 enum class Overlay { kNone, kMesh, kFeatures };
 
+// Where the color field is drawn. kGpu evaluates the limit stencils and rasterizes the refined
+// triangles through OpenGL 4.3 in a headless EGL context (docs/gpu.md); overlays and strokes are
+// then drawn over the read-back frame on the CPU. When no context can be created (no EGL, no
+// driver, a build without SUBVEC_GPU) rendering falls back to the CPU: see gpu_unavailable_reason().
+enum class Backend { kCpu, kGpu };
+
 struct RenderOptions {
   int width = 0;                 // output width; 0: the window's width in image pixels
   int height = 0;                // output height; 0: keep the window's aspect ratio
@@ -34,7 +41,13 @@ struct RenderOptions {
   int threads = 0;               // <= 0: all cores
   int depth = -1;                // subdivision depth 0..10; -1: from the output scale
   double max_edge_pixels = 2.5;  // depth rule: refine until refined edges average at most this
+  Backend backend = Backend::kCpu;
 };
+
+// Why Backend::kGpu would fall back to the CPU in this process: "" when an OpenGL 4.3 context can
+// be created through EGL, else a one-line reason. The first call tries once; later calls return the
+// same answer.
+std::string gpu_unavailable_reason();
 
 // The depth rule (docs/performance.md): with L the mean control edge length, in output pixels, of
 // the faces whose limit surface may touch the window, the depth is the smallest k in 0..8 with
@@ -66,6 +79,8 @@ class Renderer {
   // Edits that keep topology: the cached refinement is kept and only re-evaluated.
   void set_positions(int level, std::span<const Vec2> positions);
   void set_colors(int level, std::span<const Color> colors);
+  // The backend that drew the last frame (kCpu when kGpu was asked for and is unavailable).
+  Backend last_backend() const;
 
  private:
   struct Impl;
