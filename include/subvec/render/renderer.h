@@ -1,4 +1,4 @@
-// Rasterization of a vector image (paper §7.1) on the CPU.
+// Rasterization of a vector image (paper §7.1) on the CPU, or on the GPU through OpenGL (Backend).
 //
 // The renderer refines only the control faces whose limit surface touches the view window, to a
 // depth chosen from the output scale, pushes the refined vertices to the limit and draws the
@@ -27,8 +27,10 @@ enum class Overlay { kNone, kMesh, kFeatures };
 
 // Where the color field is drawn. kGpu evaluates the limit stencils and rasterizes the refined
 // triangles through OpenGL 4.3 in a headless EGL context (docs/gpu.md); overlays and strokes are
-// then drawn over the read-back frame on the CPU. When no context can be created (no EGL, no
-// driver, a build without SUBVEC_GPU) rendering falls back to the CPU: see gpu_unavailable_reason().
+// then drawn over the read-back frame on the CPU. The frame equals the CPU's to rounding (the GPU
+// reproduces its vertices, samples and fill rule). When no context can be created (no EGL, no
+// driver, a build without SUBVEC_GPU), or a view's refinement does not fit the driver's buffers,
+// the frame is drawn on the CPU: see gpu_unavailable_reason() and Renderer::last_backend().
 enum class Backend { kCpu, kGpu };
 
 struct RenderOptions {
