@@ -100,6 +100,17 @@ TEST(GpuRender, MatchesTheCpuOnTheExamples) {
   }
 }
 
+// Over 4096 output pixels wide the 4x4 pass no longer fits one target: the frame is drawn in
+// column tiles and copied row by row.
+TEST(GpuRender, WideOutputsAreDrawnInTiles) {
+  REQUIRE_GPU();
+  const VectorImage image = read_svec(source_dir() / "examples" / "02-open-tear.svec.json");
+  RenderOptions o;
+  o.window = Window{0, 0, 128, 6};
+  o.width = 4500;
+  expect_match(image, o, "02-open-tear, 4500 wide");
+}
+
 TEST(GpuRender, MatchesTheCpuOnTheSyntheticImage) {
   REQUIRE_GPU();
   expect_match_in_views(test::make_synthetic_image(), "synthetic 3,000 vertices");
