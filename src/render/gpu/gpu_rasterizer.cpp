@@ -12,8 +12,10 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
-#include <mutex>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
