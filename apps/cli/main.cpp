@@ -110,6 +110,7 @@ struct RenderArgs {
   int threads = 0;
   int depth = -1;
   double tolerance = 0.25;  // .pdf and .svg only
+  bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
 };
 
 // Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
@@ -200,6 +201,16 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
   options.antialias = !a.no_aa;
   options.threads = a.threads;
   options.depth = a.depth;
+  // --gpu (docs/gpu.md): OpenGL through headless EGL; without a context, one line and the CPU.
+  if (a.gpu) {
+    const std::string why = subvec::gpu_unavailable_reason();
+    if (why.empty()) {
+      options.backend = subvec::Backend::kGpu;
+    } else {
+      std::fprintf(stderr, "subvec: GPU rendering unavailable (%s); rendering on the CPU\n",
+                   why.c_str());
+    }
+  }
 
   const subvec::Image8 raster = subvec::render(image, options);
   subvec::write_png(a.output, raster);
@@ -667,6 +678,9 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"none", "mesh", "features"}, CLI::ignore_case))
       ->default_str("none");
   render->add_flag("--no-aa", ra.no_aa, "Disable anti-aliasing of tears and the image border");
+  render->add_flag("--gpu", ra.gpu,
+                   "Render .png output with OpenGL through headless EGL (falls back to the CPU, with "
+                   "a message, when no GPU context can be created)");
   render->add_option("--threads", ra.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   render

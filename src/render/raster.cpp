@@ -1083,6 +1083,16 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   });
 }
 
+void draw_overlay(Image8& out, std::span<const OverlayLayer> overlay, int threads) {
+  if (overlay.empty()) return;
+  constexpr int kBand = 64;
+  parallel_for((out.height + kBand - 1) / kBand, std::max(threads, 1), [&](int band) {
+    thread_local std::vector<float> coverage;
+    draw_overlay_band(out, band * kBand, std::min(out.height, (band + 1) * kBand), overlay,
+                      coverage);
+  });
+}
+
 std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransform& view,
                                      bool subsamples) {
   const int width = view.width, height = view.height;

@@ -98,6 +98,10 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
 void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                     std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out);
 
+// Composites overlay layers over a finished frame (what rasterize() does band by band), for frames
+// drawn elsewhere (the GPU path).
+void draw_overlay(Image8& out, std::span<const OverlayLayer> overlay, int threads);
+
 // Test hook: runs the coverage traversal of rasterize() over every triangle and counts how many
 // triangles claim each sample. Returns #H*W counts of the pixel-centre samples, or with
 // `subsamples` #H*W*16 counts of the 4x4 subsamples of every pixel (row-major within the pixel).

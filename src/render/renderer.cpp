@@ -23,6 +23,7 @@
 #include <string>
 
 #include "core/parallel_p.h"
+#include "render/gpu/gpu_p.h"
 #include "render/raster_p.h"
 #include "render/renderer_p.h"
 #include "render/strokes_p.h"
@@ -238,6 +239,7 @@ struct RefineCache {
   RefinedMesh refined;
   std::vector<detail::TriangleBlock> blocks;  // up to 64 triangles of one control face each
   bool positions_stale = false, colors_stale = false;
+  bool on_gpu = false;  // limit values live on the GPU (refined holds no values then)
 };
 
 // Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
@@ -277,6 +279,11 @@ struct State {
   std::vector<LevelState> levels;
   RefineCache cache;
   detail::RasterScratch scratch;
+  // The GPU path: created on the first kGpu frame; when that fails (or a refinement does not fit
+  // the driver's buffers), kGpu frames of this state are drawn on the CPU.
+  std::unique_ptr<detail::GpuRasterizer> gpu;
+  bool gpu_tried = false;
+  Backend last_backend = Backend::kCpu;
 };
 
 LevelState& level_state(const VectorImage& image, State& state, int level) {
@@ -308,11 +315,60 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
   if (plan.all_faces) plan.faces.clear();
 
   RefineCache& c = state.cache;
+  bool use_gpu = false;
+  if (options.backend == Backend::kGpu) {
+    if (!state.gpu_tried) {
+      state.gpu_tried = true;
+      std::string error;
+      state.gpu = detail::GpuRasterizer::create(error);
+    }
+    use_gpu = state.gpu != nullptr;
+  }
   const bool reuse =
-      c.subdivision && c.level == options.level && c.depth == plan.depth &&
+      c.subdivision && c.on_gpu == use_gpu && c.level == options.level && c.depth == plan.depth &&
       (c.faces.empty() || (!plan.all_faces && std::includes(c.faces.begin(), c.faces.end(),
                                                             plan.faces.begin(), plan.faces.end())));
-  if (!reuse) {
+  if (use_gpu) {
+    try {
+      if (!reuse) {
+        c.subdivision.reset();
+        c.refined = RefinedMesh{};
+        c.blocks.clear();
+        c.subdivision.emplace(mesh, *ls.topology, plan.depth, plan.faces);
+        c.level = options.level;
+        c.depth = plan.depth;
+        c.faces = plan.faces;  // plan.faces is still needed if this view falls back to the CPU
+        c.on_gpu = true;
+        state.gpu->set_refinement(*c.subdivision);
+        c.positions_stale = c.colors_stale = true;
+      }
+      if (c.positions_stale) state.gpu->set_positions(mesh.positions);
+      if (c.colors_stale) state.gpu->set_colors(mesh.colors);
+      c.positions_stale = c.colors_stale = false;
+      state.gpu->draw(plan.view, plan.channels, options.antialias, out);
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::kLimit) throw;
+      // Over the driver's buffers or memory: this view is drawn on the CPU.
+      c.subdivision.reset();
+      use_gpu = false;
+    }
+  }
+  state.last_backend = use_gpu ? Backend::kGpu : Backend::kCpu;
+  if (use_gpu) {
+    std::vector<detail::OverlayLayer> overlay;
+    if (options.overlay == Overlay::kMesh)
+      overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
+    if (options.overlay == Overlay::kFeatures) {
+      RefinedMesh curves;
+      curves.tear_edges = c.subdivision->topology().tear_edges;
+      state.gpu->read_positions(curves.positions);
+      overlay = detail::feature_overlay(curves, plan.view);
+    }
+    detail::draw_overlay(out, overlay, threads);
+    detail::draw_strokes(image.strokes, options.level, plan.view, out);
+    return;
+  }
+  if (c.on_gpu || !reuse) {
     c.subdivision.reset();
     c.refined = RefinedMesh{};
     c.blocks.clear();
@@ -321,6 +377,7 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
     c.level = options.level;
     c.depth = plan.depth;
     c.faces = std::move(plan.faces);
+    c.on_gpu = false;
     update_blocks(c, threads);
   } else if (c.positions_stale && c.colors_stale) {
     c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
@@ -380,6 +437,10 @@ Image8 Renderer::render(const RenderOptions& options) {
 void Renderer::render(const RenderOptions& options, Image8& out) {
   render_with(impl_->image, impl_->state, options, out);
 }
+
+Backend Renderer::last_backend() const { return impl_->state.last_backend; }
+
+std::string gpu_unavailable_reason() { return detail::gpu_probe(); }
 
 void Renderer::set_positions(int level, std::span<const Vec2> positions) {
   VectorImage& image = impl_->image;

@@ -1,4 +1,4 @@
-// Rasterization of a vector image (paper §7.1) on the CPU.
+// Rasterization of a vector image (paper §7.1) on the CPU, or on the GPU through OpenGL (Backend).
 //
 // The renderer refines only the control faces whose limit surface touches the view window, to a
 // depth chosen from the output scale, pushes the refined vertices to the limit and draws the
@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
@@ -24,6 +25,14 @@ struct Window {
 
 enum class Overlay { kNone, kMesh, kFeatures };
 
+// Where the color field is drawn. kGpu evaluates the limit stencils and rasterizes the refined
+// triangles through OpenGL 4.3 in a headless EGL context (docs/gpu.md); overlays and strokes are
+// then drawn over the read-back frame on the CPU. The frame equals the CPU's to rounding (the GPU
+// reproduces its vertices, samples and fill rule). When no context can be created (no EGL, no
+// driver, a build without SUBVEC_GPU), or a view's refinement does not fit the driver's buffers,
+// the frame is drawn on the CPU: see gpu_unavailable_reason() and Renderer::last_backend().
+enum class Backend { kCpu, kGpu };
+
 struct RenderOptions {
   int width = 0;                 // output width; 0: the window's width in image pixels
   int height = 0;                // output height; 0: keep the window's aspect ratio
@@ -34,7 +43,13 @@ struct RenderOptions {
   int threads = 0;               // <= 0: all cores
   int depth = -1;                // subdivision depth 0..10; -1: from the output scale
   double max_edge_pixels = 2.5;  // depth rule: refine until refined edges average at most this
+  Backend backend = Backend::kCpu;
 };
+
+// Why Backend::kGpu would fall back to the CPU in this process: "" when an OpenGL 4.3 context can
+// be created through EGL, else a one-line reason. The first call tries once; later calls return the
+// same answer.
+std::string gpu_unavailable_reason();
 
 // The depth rule (docs/performance.md): with L the mean control edge length, in output pixels, of
 // the faces whose limit surface may touch the window, the depth is the smallest k in 0..8 with
@@ -66,6 +81,8 @@ class Renderer {
   // Edits that keep topology: the cached refinement is kept and only re-evaluated.
   void set_positions(int level, std::span<const Vec2> positions);
   void set_colors(int level, std::span<const Color> colors);
+  // The backend that drew the last frame (kCpu when kGpu was asked for and is unavailable).
+  Backend last_backend() const;
 
  private:
   struct Impl;
