@@ -39,6 +39,8 @@
 #include "subvec/vectorize/vectorize.h"
 
 #include "edit_commands.h"
+// serve (issue 7): the browser editor, apps/serve/
+#include "serve_command.h"
 
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
@@ -751,6 +753,7 @@ int run(int argc, char** argv) {
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 
   subvec_cli::add_edit_commands(app);  // edit, stylize
+  subvec_serve::add_serve_command(app);  // serve (issue 7, apps/serve/)
 
   try {
     app.parse(argc, argv);
