@@ -3,6 +3,7 @@
 #include "serve_command.h"
 
 #include <csignal>
+#include <cstdlib>
 #include <iostream>
 #include <pthread.h>
 #include <thread>
@@ -35,6 +36,10 @@ void run_serve(const ServeOptions& options) {
   // run() also returns when listening fails; wake the waiter either way.
   pthread_kill(waiter.native_handle(), SIGTERM);
   waiter.join();
+  // Nothing is left to write (Save writes synchronously and atomically); leave without waiting
+  // for a vectorization still running in the background.
+  std::cout.flush();
+  std::_Exit(0);
 }
 
 }  // namespace

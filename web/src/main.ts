@@ -618,7 +618,7 @@ async function waitForDocument() {
 async function poll() {
   try {
     const s = await getJson('/api/status');
-    if (s.state === 'ready' && s.version !== state.version && state.busy === 0 && !state.drag) {
+    if (s.state === 'ready' && s.version > state.version && state.busy === 0 && !state.drag) {
       await reloadAll(`the document changed in another tab: now version ${s.version}`);
     }
   } catch {
