@@ -300,6 +300,8 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
 
 Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
                            bool strokes_changed) {
+  // A drag preview moves positions only: its colors are those the view already holds.
+  const bool colors = preview == nullptr;
   Delta delta;
   delta.strokes_changed = strokes_changed;
   if (!session.view) return delta;
@@ -308,7 +310,7 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
   const std::vector<Vec2>& positions = preview ? *preview : mesh.positions;
   delta.view_id = v.mesh.id;
   v.subdivision->evaluate_positions(positions, v.refined_positions);
-  v.subdivision->evaluate_colors(mesh.colors, v.refined_colors);
+  if (colors) v.subdivision->evaluate_colors(mesh.colors, v.refined_colors);
   const size_t ng = v.gl_vertex.size();
   for (size_t g = 0; g < ng; ++g) {
     const size_t rv = static_cast<size_t>(v.gl_vertex[g]);
@@ -318,6 +320,7 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
       v.mesh.positions[2 * g + 1] = y;
       delta.position_indices.push_back(static_cast<uint32_t>(g));
     }
+    if (!colors) continue;
     const size_t rc = static_cast<size_t>(v.gl_color[g]);
     bool changed = false;
     for (int c = 0; c < 3; ++c) {

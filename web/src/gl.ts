@@ -33,6 +33,17 @@ export interface Overlays {
   features: boolean;
 }
 
+// Whether WebGL draws on the CPU (SwiftShader, llvmpipe): such a renderer pays per triangle and
+// per multisample, so the page refines less and turns MSAA off there (docs/serve.md).
+export function softwareWebGL(): boolean {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  gl.getExtension('WEBGL_lose_context')?.loseContext();
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
 function compile(gl: WebGL2RenderingContext, type: number, source: string): WebGLShader {
   const shader = gl.createShader(type)!;
   gl.shaderSource(shader, source);
@@ -73,8 +84,8 @@ export class Renderer {
   positions = new Float32Array(0);
   colors = new Uint8Array(0);
 
-  constructor(readonly canvas: HTMLCanvasElement) {
-    const gl = canvas.getContext('webgl2', { antialias: true, premultipliedAlpha: false });
+  constructor(readonly canvas: HTMLCanvasElement, antialias: boolean) {
+    const gl = canvas.getContext('webgl2', { antialias, premultipliedAlpha: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
     const program = gl.createProgram()!;

@@ -6,7 +6,7 @@
 // A poll of /api/status notices changes made elsewhere the same way.
 
 import { ApiError, Frame, getJson, postFrame, postJson } from './api';
-import { Renderer, Transform } from './gl';
+import { Renderer, Transform, softwareWebGL } from './gl';
 
 type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color';
 
@@ -52,6 +52,17 @@ const state = {
 };
 
 let renderer: Renderer;
+
+// Refinement target: refined edges at most this many canvas pixels long, and MSAA. A GPU draws
+// the fine setting for nothing; a software WebGL pays per triangle, so it gets the coarse one
+// (about a quarter of the triangles: a drag then redraws within 50 ms). ?quality=fine|coarse
+// overrides the choice.
+const quality = (() => {
+  const asked = new URLSearchParams(location.search).get('quality');
+  const software = softwareWebGL();
+  const coarse = asked ? asked === 'coarse' : software;
+  return { edge: coarse ? 8 : 3, antialias: !coarse, software };
+})();
 
 function status(message: string, error = false) {
   statusBox.textContent = message;
@@ -101,7 +112,9 @@ function fit() {
 }
 
 function updateZoomLabel() {
-  $('zoom-out').textContent = `zoom ${(state.transform.zoom / (window.devicePixelRatio || 1)).toFixed(2)}×`;
+  $('zoom-out').textContent = `zoom ${(state.transform.zoom / (window.devicePixelRatio || 1)).toFixed(2)}×, ` +
+    `depth ${state.view.depth < 0 ? '…' : state.view.depth}` +
+    (quality.antialias ? '' : ' (software WebGL: coarser, no MSAA)');
 }
 
 // Canvas coordinates of a pointer event, and image coordinates of a canvas point.
@@ -117,15 +130,15 @@ function toImage([x, y]: [number, number]): [number, number] {
 
 // ---- the refined view ----------------------------------------------------------------------
 
-// Depth: refine until refined edges are at most 4 canvas pixels long (the renderer's rule,
-// docs/performance.md); the whole level while that stays under ~1.5 M triangles, else the visible
+// Depth: refine until refined edges are at most quality.edge canvas pixels long on average (the
+// CPU renderer's rule, docs/performance.md, uses 2.5); the whole level while that stays under ~1.5 M triangles, else the visible
 // window with a margin.
 function wantedView(): { depth: number; window: number[] | null } {
   const doc = state.doc!;
   const level = doc.levels[state.level];
   const edge = level.mean_edge * state.transform.zoom;
   let depth = 0;
-  while (depth < 6 && edge / 2 ** depth > 4) ++depth;
+  while (depth < 6 && edge / 2 ** depth > quality.edge) ++depth;
   if (level.triangles * 4 ** depth <= 1.5e6) return { depth, window: null };
   const t = state.transform;
   const x0 = -t.panX / t.zoom, y0 = -t.panY / t.zoom;
@@ -170,6 +183,7 @@ function loadView(): Promise<void> {
       });
       renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
       state.view = { id: frame.header.view, depth: want.depth, partial: frame.header.partial, window: want.window };
+      updateZoomLabel();
       redraw();
     } finally {
       viewLoads--;
@@ -633,6 +647,7 @@ declare global {
 }
 window.subvec = {
   state,
+  renderer: () => renderer,
   ready: false,
   // RGBA of the canvas at image coordinates (x, y), after a synchronous redraw.
   pixelAt(x: number, y: number) {
@@ -655,7 +670,7 @@ window.subvec = {
 async function main() {
   wireControls();
   try {
-    renderer = new Renderer(canvas);
+    renderer = new Renderer(canvas, quality.antialias);
   } catch (e) {
     status(`cannot draw: ${e instanceof Error ? e.message : e}`, true);
     return;

@@ -3,6 +3,7 @@
 // (the page reads one pixel back after drawing, which waits for the frame).
 //
 //   node web/tests/bench-drag.mjs BUILD/bin/subvec IMAGE.svec [--moves N] [--width W --height H]
+//                                 [--quality fine|coarse]   (default: what the page picks)
 //
 // Grabs the longest feature at its middle vertex and drags it in N one-pixel steps, one at a
 // time (each move waits for its frame, so latencies do not queue). Prints the latencies' median,
@@ -15,6 +16,8 @@ const opt = (name, fallback) => {
   return i >= 0 ? Number(rest[i + 1]) : fallback;
 };
 const moves = opt('--moves', 40);
+const qi = rest.indexOf('--quality');
+const quality = qi >= 0 ? rest[qi + 1] : '';
 const viewport = { width: opt('--width', 1280), height: opt('--height', 800) };
 const chromium = findChromium();
 if (!binary || !input || !chromium) {
@@ -25,7 +28,7 @@ if (!binary || !input || !chromium) {
 const server = await serve(binary, [input]);
 const browser = await launch(chromium);
 try {
-  const { page } = await openEditor(browser, server.url, viewport);
+  const { page } = await openEditor(browser, server.url + (quality ? `?quality=${quality}` : ''), viewport);
   const info = await page.evaluate(async () => {
     const doc = await (await fetch('/api/document')).json();
     const control = await (await fetch('/api/control?level=0')).json();
@@ -52,12 +55,12 @@ try {
   await page.mouse.up();
   const latencies = await page.evaluate(() => window.subvec.latencies());
   const view = await page.evaluate(() => ({
-    depth: window.subvec.state.view.depth, canvas: [document.getElementById('canvas').width, document.getElementById('canvas').height],
+    depth: window.subvec.state.view.depth, zoom: document.getElementById('zoom-out').textContent, canvas: [document.getElementById('canvas').width, document.getElementById('canvas').height],
   }));
   const sorted = latencies.slice().sort((a, b) => a - b);
   const q = (p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
   console.log(`image ${info.size[0]}x${info.size[1]}, ${info.vertices} control vertices, ${info.triangles} triangles; ` +
-    `canvas ${view.canvas[0]}x${view.canvas[1]}, refinement depth ${view.depth} (${info.triangles * 4 ** view.depth} triangles drawn)`);
+    `canvas ${view.canvas[0]}x${view.canvas[1]}, refinement depth ${view.depth} (${info.triangles * 4 ** view.depth} triangles drawn; ${view.zoom})`);
   console.log(`drag redraw, ${latencies.length} moves: median ${q(0.5).toFixed(1)} ms, p90 ${q(0.9).toFixed(1)} ms, ` +
     `max ${sorted[sorted.length - 1].toFixed(1)} ms`);
 } finally {
