@@ -57,6 +57,14 @@ uint8_t to_byte(float v) {
   throw RequestError(status, e.what());
 }
 
+// apply_edit_ops names the operation of its ops file ("ops[0] (drag): ..."); the page applies one
+// operation at a time, so the prefix says nothing there.
+std::string without_op_prefix(const std::string& line) {
+  if (line.rfind("ops[0] (", 0) != 0) return line;
+  const size_t end = line.find("): ");
+  return end == std::string::npos ? line : line.substr(end + 3);
+}
+
 Vec2 clamp_to_image(Vec2 p, int width, int height) {
   return {std::clamp(p.x, 0.0, double(width)), std::clamp(p.y, 0.0, double(height))};
 }
@@ -548,9 +556,9 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
   VectorImage edited = image_;
   try {
     const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
-    log = lines.empty() ? std::string() : lines.front();
+    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
   } catch (const Error& e) {
-    refuse_edit(e);
+    refuse_edit(Error(e.code(), without_op_prefix(e.what())));
   }
   commit_locked(std::move(edited));
   return delta_locked(session, nullptr, false);
@@ -578,9 +586,9 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   VectorImage edited = image_;
   try {
     const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
-    log = lines.empty() ? std::string() : lines.front();
+    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
   } catch (const Error& e) {
-    refuse_edit(e);
+    refuse_edit(Error(e.code(), without_op_prefix(e.what())));
   }
   commit_locked(std::move(edited));
   return delta_locked(session, nullptr, false);

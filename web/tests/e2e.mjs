@@ -200,5 +200,34 @@ try {
   check('serve stops cleanly on SIGTERM', code === 0, `exit ${code}: ${server.stderr()}`);
   rmSync(dir, { recursive: true, force: true });
 }
+// A photograph is vectorized first: the page shows the progress, then the editor.
+try {
+  const photo = await serve(binary, [join(root, 'examples', '04-rocket.png'), '--vertices', '400']);
+  const b = await launch(chromium);
+  try {
+    const page = await b.newPage({ viewport: { width: 900, height: 600 } });
+    await page.goto(photo.url);
+    const first = await page.evaluate(async () => (await (await fetch('/api/status')).json()).state);
+    check('photograph: vectorizing when the page opens', first === 'vectorizing' || first === 'ready', first);
+    let sawProgress = false;
+    for (let i = 0; i < 600 && !(await page.evaluate(() => window.subvec && window.subvec.ready)); ++i) {
+      sawProgress ||= await page.evaluate(() => !document.getElementById('progress').hidden &&
+        /Vectorizing/.test(document.getElementById('progress-text').textContent));
+      await page.waitForTimeout(100);
+    }
+    check('photograph: progress shown in the page', sawProgress || first === 'ready');
+    const ready = await page.evaluate(() => window.subvec.ready);
+    const doc = ready ? await page.evaluate(async () => (await fetch('/api/document')).json()) : {};
+    check('photograph: the editor opens on the vectorized image', ready && doc.width === 384 && doc.levels[0].vertices > 100,
+      JSON.stringify(doc));
+    const sky = ready ? await pixel(page, 20, 20) : [0, 0, 0];
+    check('photograph: drawn', sky[3] === 255 && diff(sky, [32, 33, 36]) > 10, `${sky}`);
+  } finally {
+    await b.close();
+    await stop(photo);
+  }
+} catch (e) {
+  check('photograph: served', false, e && e.stack ? e.stack : String(e));
+}
 console.log(`${passed} passed, ${failed} failed`);
 process.exit(failed === 0 ? 0 : 1);
