@@ -185,6 +185,26 @@ try {
   });
   check('two tabs: a stale version is refused with 409', stale.status === 409 && /another tab/.test(stale.body.error), JSON.stringify(stale));
 
+  // Stylize: a stroke along the disk's outline (its one feature) darkens the outline.
+  const rim = await page.evaluate(async () => {
+    const c = await (await fetch('/api/control?level=0')).json();
+    // The limit curve at the middle of the chain (away from the stroke's tapered ends): the
+    // uniform cubic B-spline at a vertex is (previous + 4 vertex + next) / 6.
+    const chain = c.features[0];
+    const i = Math.floor(chain.length / 2);
+    const p = (k) => [c.positions[2 * chain[k]], c.positions[2 * chain[k] + 1]];
+    const [a, b, d] = [p(i - 1), p(i), p(i + 1)];
+    return [(a[0] + 4 * b[0] + d[0]) / 6, (a[1] + 4 * b[1] + d[1]) / 6];
+  });
+  const rimBefore = await pixel(page, ...rim);
+  await page.evaluate(() => { document.getElementById('threshold').value = '0'; });
+  await page.keyboard.press('y');
+  await idle(page);
+  await page.waitForTimeout(300);
+  const rimAfter = await pixel(page, ...rim);
+  check('stylize: a dark stroke on the outline', Math.max(...rimAfter.slice(0, 3)) < 60 && diff(rimAfter, rimBefore) > 60,
+    `${rimBefore} -> ${rimAfter} at ${rim}`);
+
   // Errors answer as JSON with a status.
   const bad = await page.evaluate(async () => {
     const r = await fetch('/api/select', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: '{"at": [1]}' });

@@ -115,6 +115,34 @@ TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   EXPECT_EQ(commit.control_positions.size(), expected.levels[0].positions.size() * 2);
 }
 
+// The move tool: translate and rotate a whole feature, committed as `subvec edit`'s move-feature.
+TEST(ServeEditor, MoveFeatureCommitMatchesSubvecEdit) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  DragStart start;
+  start.move_feature = true;
+  start.at = {76, 48};
+  editor.drag_start(s, 1, start);
+  editor.drag_move(s, {72, 50}, 15);
+  std::string log;
+  editor.drag_end(s, 1, {72, 50}, 15, log);
+  EXPECT_NE(log.find("rotated by 15"), std::string::npos) << log;
+  EXPECT_EQ(log.rfind("ops[", 0), std::string::npos) << log;  // no ops-file prefix on the page
+
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kMoveFeature;
+  op.at = {76, 48};
+  op.translate = {-4, 2};
+  op.rotate = 15;
+  VectorImage expected = original;
+  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
+  EXPECT_NE(expected.levels[0].positions, original.levels[0].positions);
+  // A drag that ended is over: another move is refused.
+  EXPECT_EQ(status_of([&] { editor.drag_move(s, {70, 50}, 0); }), kConflict);
+}
+
 TEST(ServeEditor, ViewIsUnweldedAtTearsAndColorDeltasAreSparse) {
   Editor editor(disk());
   const std::string s = editor.new_session();
