@@ -473,9 +473,16 @@ async function dragEnd(e: PointerEvent | null, cancel = false) {
       return;
     }
     await edit(async () => {
-      const f = await postFrame('/api/drag/end', {
-        session: state.session, version: state.version, to: drag.target, rotate: drag.rotate,
-      });
+      let f: Frame;
+      try {
+        f = await postFrame('/api/drag/end', {
+          session: state.session, version: state.version, to: drag.target, rotate: drag.rotate,
+        });
+      } catch (e) {
+        // Refused (a flip, say): the document did not change, so drop the preview.
+        await Promise.all([loadView(), loadControl()]);
+        throw e;
+      }
       applyDelta(f);
       status(f.header.log);
       if (state.view.partial) await loadView();
