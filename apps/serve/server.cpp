@@ -1,6 +1,8 @@
 // The HTTP front end of `subvec serve`: routes, request parsing, binary frames, downloads.
 #include "server.h"
 
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -306,6 +308,12 @@ void EditorServer::start() {
   }
 
   s.routes();
+  // SO_REUSEADDR alone: a restarted server can bind at once, but a port another server listens
+  // on is refused (cpp-httplib's default adds SO_REUSEPORT, which would let two servers share it).
+  s.server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   s.server.set_payload_max_length(kMaxBody);
   s.server.set_read_timeout(10, 0);
   s.server.set_write_timeout(30, 0);

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "editor.h"
+#include "subvec/core/error.h"
 #include "server.h"
 #include "subvec/edit/ops.h"
 #include "subvec/io/svec.h"
@@ -286,6 +287,14 @@ TEST_F(ServeHttp, SaveWritesOnlyTheNamedFile) {
   auto stale = client_->Post("/api/save", json{{"version", 1}}.dump(), "application/json");
   ASSERT_TRUE(stale);
   EXPECT_EQ(stale->status, 409);
+}
+
+TEST_F(ServeHttp, APortInUseIsRefused) {
+  ServeOptions options;
+  options.input = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "01-disk.svec.json";
+  options.port = server_->port();
+  EditorServer second(options);
+  EXPECT_THROW(second.start(), subvec::Error);
 }
 
 TEST_F(ServeHttp, DownloadsAreBuiltInMemory) {
