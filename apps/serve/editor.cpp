@@ -1,0 +1,652 @@
+// The editing state behind `subvec serve`: see editor.h for the design.
+#include "editor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "subvec/core/error.h"
+#include "subvec/edit/selection.h"
+#include "subvec/edit/stylize.h"
+#include "subvec/mesh/curves.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/validate.h"
+
+namespace subvec_serve {
+
+using subvec::EditOp;
+using subvec::EditSelect;
+using subvec::Error;
+using subvec::ErrorCode;
+using subvec::MeshTopology;
+
+struct Editor::View {
+  ViewMesh mesh;
+  std::unique_ptr<subvec::Subdivision> subdivision;
+  std::vector<int32_t> gl_vertex, gl_color;  // #G: refined vertex and color value of each GL vertex
+  std::vector<float> refined_positions, refined_colors;  // scratch
+  int num_control_vertices = 0;
+};
+
+struct Editor::Session {
+  std::string id;
+  std::unique_ptr<View> view;
+  struct Drag {
+    DragStart start;
+    int64_t version = 0;
+    int vertex = -1, feature = -1;
+    std::unique_ptr<subvec::ShapeEditor> shape;
+    std::vector<Vec2> preview;
+  };
+  std::unique_ptr<Drag> drag;
+};
+
+namespace {
+
+uint8_t to_byte(float v) {
+  if (!(v > 0)) return 0;
+  if (v >= 255) return 255;
+  return static_cast<uint8_t>(std::lround(v));
+}
+
+// A library error raised by a request's content: 422 (the request was well formed, the edit is
+// impossible on this image), except for errors that are ours.
+[[noreturn]] void refuse_edit(const Error& e) {
+  const int status = e.code() == ErrorCode::kInvalidArgument ? kUnprocessable : 500;
+  throw RequestError(status, e.what());
+}
+
+// apply_edit_ops names the operation of its ops file ("ops[0] (drag): ..."); the page applies one
+// operation at a time, so the prefix says nothing there.
+std::string without_op_prefix(const std::string& line) {
+  if (line.rfind("ops[0] (", 0) != 0) return line;
+  const size_t end = line.find("): ");
+  return end == std::string::npos ? line : line.substr(end + 3);
+}
+
+Vec2 clamp_to_image(Vec2 p, int width, int height) {
+  return {std::clamp(p.x, 0.0, double(width)), std::clamp(p.y, 0.0, double(height))};
+}
+
+bool is_image_corner(Vec2 p, int width, int height) {
+  return (p.x == 0 || p.x == width) && (p.y == 0 || p.y == height);
+}
+
+}  // namespace
+
+Editor::Editor(VectorImage image) : image_(std::move(image)) {
+  if (image_.levels.empty()) throw Error(ErrorCode::kInvalidArgument, "the image has no level");
+}
+
+Editor::~Editor() = default;
+
+int64_t Editor::version() const {
+  std::lock_guard lock(mutex_);
+  return version_;
+}
+
+std::pair<VectorImage, int64_t> Editor::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return {image_, version_};
+}
+
+DocumentInfo Editor::info() const {
+  std::lock_guard lock(mutex_);
+  DocumentInfo info;
+  info.version = version_;
+  info.width = image_.width;
+  info.height = image_.height;
+  for (const ControlMesh& mesh : image_.levels) {
+    DocumentInfo::Level level;
+    level.vertices = mesh.num_vertices();
+    level.triangles = mesh.num_triangles();
+    level.colors = mesh.num_colors();
+    level.features = static_cast<int>(mesh.features.size());
+    double sum = 0;
+    for (const subvec::Tri& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 a = mesh.positions[t[k]], b = mesh.positions[t[(k + 1) % 3]];
+        sum += std::hypot(b.x - a.x, b.y - a.y);
+      }
+    }
+    level.mean_edge = mesh.triangles.empty() ? 0 : sum / (3.0 * mesh.num_triangles());
+    info.levels.push_back(level);
+  }
+  info.undo = static_cast<int>(undo_.size());
+  info.redo = static_cast<int>(redo_.size());
+  info.strokes = static_cast<int>(image_.strokes.size());
+  return info;
+}
+
+std::string Editor::new_session() {
+  std::lock_guard lock(mutex_);
+  auto session = std::make_unique<Session>();
+  session->id = "s" + std::to_string(next_session_++);
+  std::string id = session->id;
+  sessions_.insert(sessions_.begin(), std::move(session));
+  // The least recently used session goes when there are too many: its tab then gets 404 and
+  // opens a new one (the document is not affected).
+  if (static_cast<int>(sessions_.size()) > kMaxSessions) sessions_.pop_back();
+  return id;
+}
+
+Editor::Session& Editor::session_locked(const std::string& id) {
+  auto it = std::find_if(sessions_.begin(), sessions_.end(),
+                         [&](const auto& s) { return s->id == id; });
+  if (it == sessions_.end()) {
+    throw RequestError(kNotFound, "unknown session '" + id + "' (reload the page)");
+  }
+  std::rotate(sessions_.begin(), it, it + 1);  // most recently used first
+  return *sessions_.front();
+}
+
+void Editor::check_version_locked(int64_t version) const {
+  if (version != version_) {
+    throw RequestError(kConflict, "the document changed in another tab (now version " +
+                                      std::to_string(version_) + ", this page showed " +
+                                      std::to_string(version) + "): reloaded, try again");
+  }
+}
+
+void Editor::check_level_locked(int level) const {
+  const int n = static_cast<int>(image_.levels.size());
+  if (level < 0 || level >= n) {
+    throw RequestError(kBadRequest, "level " + std::to_string(level) +
+                                        " is out of range (the image has " + std::to_string(n) +
+                                        (n == 1 ? " level)" : " levels)"));
+  }
+}
+
+Editor::ControlData Editor::control(int level) const {
+  std::lock_guard lock(mutex_);
+  check_level_locked(level);
+  const ControlMesh& mesh = image_.levels[level];
+  ControlData data;
+  for (const Vec2& p : mesh.positions) {
+    data.positions.push_back(static_cast<float>(p.x));
+    data.positions.push_back(static_cast<float>(p.y));
+  }
+  // Each interior edge appears in two triangles with opposite directions: keep a < b once, and
+  // border edges (one triangle) whichever way they come.
+  std::vector<std::pair<int32_t, int32_t>> edges;
+  for (const subvec::Tri& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = t[k], b = t[(k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges) {
+    data.edges.push_back(static_cast<uint32_t>(a));
+    data.edges.push_back(static_cast<uint32_t>(b));
+  }
+  for (const subvec::Feature& f : mesh.features) data.features.push_back(f.vertices);
+  return data;
+}
+
+ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_level_locked(request.level);
+  if (request.depth < 0 || request.depth > 8) {
+    throw RequestError(kBadRequest, "depth " + std::to_string(request.depth) +
+                                        " is out of range (0 to 8)");
+  }
+  const ControlMesh& mesh = image_.levels[request.level];
+  const MeshTopology topology =
+      MeshTopology::build(mesh, image_.width, image_.height);
+
+  // Faces whose limit surface may touch the window: the limit over a face lies in the convex
+  // hull of its one-ring, so test the bounding box of the vertices of every face around it.
+  std::vector<int32_t> faces;
+  const bool windowed = request.x1 > request.x0 && request.y1 > request.y0 &&
+                        (request.x0 > 0 || request.y0 > 0 || request.x1 < image_.width ||
+                         request.y1 < image_.height);
+  if (windowed) {
+    const int nv = mesh.num_vertices();
+    std::vector<std::array<double, 4>> vbox(nv, {std::numeric_limits<double>::max(),
+                                                 std::numeric_limits<double>::max(),
+                                                 std::numeric_limits<double>::lowest(),
+                                                 std::numeric_limits<double>::lowest()});
+    // Box of each vertex's star (its incident faces' vertices).
+    for (const subvec::Tri& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        auto& b = vbox[t[k]];
+        for (int j = 0; j < 3; ++j) {
+          const Vec2 p = mesh.positions[t[j]];
+          b = {std::min(b[0], p.x), std::min(b[1], p.y), std::max(b[2], p.x), std::max(b[3], p.y)};
+        }
+      }
+    }
+    for (int f = 0; f < mesh.num_triangles(); ++f) {
+      std::array<double, 4> b = vbox[mesh.triangles[f][0]];
+      for (int k = 1; k < 3; ++k) {
+        const auto& o = vbox[mesh.triangles[f][k]];
+        b = {std::min(b[0], o[0]), std::min(b[1], o[1]), std::max(b[2], o[2]), std::max(b[3], o[3])};
+      }
+      if (b[2] >= request.x0 && b[0] <= request.x1 && b[3] >= request.y0 && b[1] <= request.y1) {
+        faces.push_back(f);
+      }
+    }
+    if (faces.empty()) faces.push_back(0);  // nothing visible: one face keeps the view valid
+    if (static_cast<int>(faces.size()) == mesh.num_triangles()) faces.clear();
+  }
+  int depth = request.depth;
+  const int64_t base = faces.empty() ? mesh.num_triangles() : static_cast<int64_t>(faces.size());
+  while (depth > 0 && (base << (2 * depth)) > kMaxViewTriangles) --depth;
+
+  auto v = std::make_unique<View>();
+  try {
+    v->subdivision = std::make_unique<subvec::Subdivision>(mesh, topology, depth, faces);
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
+  const subvec::RefinedMesh& refined = v->subdivision->topology();
+  const int nr = v->subdivision->num_vertices();
+
+  // Unweld: GL vertex = (refined vertex, color value). The first color seen at a vertex takes
+  // the vertex's slot; the other sides of a tear get extra GL vertices.
+  std::vector<int32_t> first_color(nr, -1), vertex_gl(nr, -1);
+  std::unordered_map<int64_t, uint32_t> seam;
+  std::vector<uint32_t>& tris = v->mesh.triangles;
+  tris.reserve(refined.triangles.size() * 3);
+  for (size_t i = 0; i < refined.triangles.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t rv = refined.triangles[i][k], rc = refined.triangle_colors[i][k];
+      uint32_t g = 0;
+      if (first_color[rv] < 0) {
+        first_color[rv] = rc;
+        g = static_cast<uint32_t>(v->gl_vertex.size());
+        vertex_gl[rv] = static_cast<int32_t>(g);
+        v->gl_vertex.push_back(rv);
+        v->gl_color.push_back(rc);
+      } else if (first_color[rv] == rc) {
+        g = static_cast<uint32_t>(vertex_gl[rv]);
+      } else {
+        const int64_t key = (int64_t{rv} << 32) | static_cast<uint32_t>(rc);
+        auto [it, fresh] = seam.try_emplace(key, static_cast<uint32_t>(v->gl_vertex.size()));
+        if (fresh) {
+          v->gl_vertex.push_back(rv);
+          v->gl_color.push_back(rc);
+        }
+        g = it->second;
+      }
+      tris.push_back(g);
+    }
+  }
+  for (const subvec::EdgeVerts& e : refined.tear_edges) {
+    if (vertex_gl[e[0]] < 0 || vertex_gl[e[1]] < 0) continue;
+    v->mesh.tear_lines.push_back(static_cast<uint32_t>(vertex_gl[e[0]]));
+    v->mesh.tear_lines.push_back(static_cast<uint32_t>(vertex_gl[e[1]]));
+  }
+
+  // Limit values, gathered per GL vertex.
+  const size_t ng = v->gl_vertex.size();
+  v->refined_positions.resize(size_t(nr) * 2);
+  v->refined_colors.resize(size_t(v->subdivision->num_colors()) * 3);
+  v->subdivision->evaluate_positions(mesh.positions, v->refined_positions);
+  v->subdivision->evaluate_colors(mesh.colors, v->refined_colors);
+  v->mesh.positions.resize(ng * 2);
+  v->mesh.colors.resize(ng * 4);
+  for (size_t g = 0; g < ng; ++g) {
+    const size_t rv = static_cast<size_t>(v->gl_vertex[g]), rc = static_cast<size_t>(v->gl_color[g]);
+    v->mesh.positions[2 * g] = v->refined_positions[2 * rv];
+    v->mesh.positions[2 * g + 1] = v->refined_positions[2 * rv + 1];
+    for (int c = 0; c < 3; ++c) v->mesh.colors[4 * g + c] = to_byte(v->refined_colors[3 * rc + c]);
+    v->mesh.colors[4 * g + 3] = 255;
+  }
+  v->mesh.id = next_view_++;
+  v->mesh.level = request.level;
+  v->mesh.depth = depth;
+  v->mesh.partial = !faces.empty();
+  v->num_control_vertices = mesh.num_vertices();
+  session.view = std::move(v);
+  return session.view->mesh;
+}
+
+Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
+                           bool strokes_changed) {
+  // A drag preview moves positions only: its colors are those the view already holds.
+  const bool colors = preview == nullptr;
+  Delta delta;
+  delta.strokes_changed = strokes_changed;
+  if (!session.view) return delta;
+  View& v = *session.view;
+  const ControlMesh& mesh = image_.levels[v.mesh.level];
+  const std::vector<Vec2>& positions = preview ? *preview : mesh.positions;
+  delta.view_id = v.mesh.id;
+  v.subdivision->evaluate_positions(positions, v.refined_positions);
+  if (colors) v.subdivision->evaluate_colors(mesh.colors, v.refined_colors);
+  const size_t ng = v.gl_vertex.size();
+  for (size_t g = 0; g < ng; ++g) {
+    const size_t rv = static_cast<size_t>(v.gl_vertex[g]);
+    const float x = v.refined_positions[2 * rv], y = v.refined_positions[2 * rv + 1];
+    if (x != v.mesh.positions[2 * g] || y != v.mesh.positions[2 * g + 1]) {
+      v.mesh.positions[2 * g] = x;
+      v.mesh.positions[2 * g + 1] = y;
+      delta.position_indices.push_back(static_cast<uint32_t>(g));
+    }
+    if (!colors) continue;
+    const size_t rc = static_cast<size_t>(v.gl_color[g]);
+    bool changed = false;
+    for (int c = 0; c < 3; ++c) {
+      const uint8_t b = to_byte(v.refined_colors[3 * rc + c]);
+      changed |= b != v.mesh.colors[4 * g + c];
+      v.mesh.colors[4 * g + c] = b;
+    }
+    if (changed) delta.color_indices.push_back(static_cast<uint32_t>(g));
+  }
+  // Sparse while it is smaller: an index (4 bytes) per changed value against 8 / 4 bytes each.
+  if (delta.position_indices.size() * 2 > ng) {
+    delta.dense_positions = true;
+    delta.position_indices.clear();
+    delta.positions = v.mesh.positions;
+  } else {
+    for (uint32_t g : delta.position_indices) {
+      delta.positions.push_back(v.mesh.positions[2 * g]);
+      delta.positions.push_back(v.mesh.positions[2 * g + 1]);
+    }
+  }
+  if (delta.color_indices.size() * 2 > ng) {
+    delta.dense_colors = true;
+    delta.color_indices.clear();
+    delta.colors = v.mesh.colors;
+  } else {
+    for (uint32_t g : delta.color_indices) {
+      delta.colors.insert(delta.colors.end(), v.mesh.colors.begin() + 4 * g,
+                          v.mesh.colors.begin() + 4 * g + 4);
+    }
+  }
+  delta.control_positions.reserve(positions.size() * 2);
+  for (const Vec2& p : positions) {
+    delta.control_positions.push_back(static_cast<float>(p.x));
+    delta.control_positions.push_back(static_cast<float>(p.y));
+  }
+  return delta;
+}
+
+std::vector<StrokeGeometry> Editor::strokes(int level) const {
+  std::lock_guard lock(mutex_);
+  check_level_locked(level);
+  std::vector<StrokeGeometry> out;
+  for (const subvec::Stroke& s : image_.strokes) {
+    if (s.level != level || s.points.size() < 2) continue;
+    const std::vector<Vec2> line = subvec::sample_bspline(s.points, false, 8);
+    std::vector<double> at(line.size(), 0);
+    for (size_t i = 1; i < line.size(); ++i) {
+      at[i] = at[i - 1] + std::hypot(line[i].x - line[i - 1].x, line[i].y - line[i - 1].y);
+    }
+    // The renderer's taper (render/strokes.cpp): half * min(1, s / (taper L), (L - s) / (taper L)).
+    const double length = at.back(), ramp = s.taper * length;
+    StrokeGeometry g;
+    g.color = s.color;
+    for (size_t i = 0; i < line.size(); ++i) {
+      double f = 1;
+      if (ramp > 0) f = std::min({1.0, at[i] / ramp, (length - at[i]) / ramp});
+      g.points.push_back(static_cast<float>(line[i].x));
+      g.points.push_back(static_cast<float>(line[i].y));
+      g.half_widths.push_back(static_cast<float>(0.5 * s.width * std::max(f, 0.0)));
+    }
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
+SelectResult Editor::select(const SelectRequest& request) const {
+  std::lock_guard lock(mutex_);
+  check_level_locked(request.level);
+  const ControlMesh& mesh = image_.levels[request.level];
+  const MeshTopology topology = MeshTopology::build(mesh, image_.width, image_.height);
+  SelectResult result;
+  try {
+    subvec::ColorSelection colors;
+    if (request.select == EditSelect::kVertex) {
+      result.vertex = subvec::nearest_vertex(mesh, request.at);
+      const Vec2 p = mesh.positions[result.vertex];
+      result.distance = std::hypot(p.x - request.at.x, p.y - request.at.y);
+      colors = subvec::select_vertex_colors(mesh, topology, request.at, request.radius);
+    } else {
+      const subvec::FeaturePick pick = subvec::nearest_feature(mesh, topology, request.at);
+      if (pick.feature < 0) {
+        throw RequestError(kUnprocessable, "nothing to select: level " +
+                                               std::to_string(request.level) + " has no features");
+      }
+      result.feature = pick.feature;
+      result.distance = pick.distance;
+      result.chain = mesh.features[pick.feature].vertices;
+      colors = subvec::select_feature_colors(mesh, topology, request.at, request.radius);
+    }
+    result.colors = static_cast<int>(colors.colors.size());
+    std::vector<char> in(mesh.num_colors(), 0);
+    for (int32_t c : colors.colors) in[c] = 1;
+    std::vector<char> vin(mesh.num_vertices(), 0);
+    for (int f = 0; f < mesh.num_triangles(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (in[mesh.triangle_colors[f][k]]) vin[mesh.triangles[f][k]] = 1;
+      }
+    }
+    for (int i = 0; i < mesh.num_vertices(); ++i) {
+      if (vin[i]) result.region.push_back(i);
+    }
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
+  return result;
+}
+
+SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
+                                const DragStart& start) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  check_level_locked(start.level);
+  if (!(start.sigma > 0) || !std::isfinite(start.sigma)) {
+    throw RequestError(kBadRequest, "sigma must be a positive number of pixels");
+  }
+  if (!(start.region >= 0) || !std::isfinite(start.region)) {
+    throw RequestError(kBadRequest, "region must be a non-negative number of pixels");
+  }
+  const ControlMesh& mesh = image_.levels[start.level];
+  auto drag = std::make_unique<Session::Drag>();
+  drag->start = start;
+  drag->start.at = clamp_to_image(start.at, image_.width, image_.height);
+  drag->version = version;
+  SelectResult result;
+  if (!start.move_feature && start.select == EditSelect::kVertex) {
+    drag->vertex = subvec::nearest_vertex(mesh, drag->start.at);
+    if (is_image_corner(mesh.positions[drag->vertex], image_.width, image_.height)) {
+      throw RequestError(kUnprocessable, "nothing to drag: the nearest control vertex is an image "
+                                         "corner, which stays fixed");
+    }
+    result.vertex = drag->vertex;
+  } else {
+    const MeshTopology topology = MeshTopology::build(mesh, image_.width, image_.height);
+    const subvec::FeaturePick pick = subvec::nearest_feature(mesh, topology, drag->start.at);
+    if (pick.feature < 0) {
+      throw RequestError(kUnprocessable, "nothing to select: level " +
+                                             std::to_string(start.level) + " has no features");
+    }
+    drag->feature = pick.feature;
+    result.feature = pick.feature;
+    result.distance = pick.distance;
+    result.chain = mesh.features[pick.feature].vertices;
+  }
+  try {
+    drag->shape = std::make_unique<subvec::ShapeEditor>(mesh, image_.width, image_.height);
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
+  session.drag = std::move(drag);
+  // Factor the ARAP systems for this handle set now (a zero move), so that every move of the
+  // drag only back-substitutes.
+  (void)drag_move_locked(session, session.drag->start.at, 0);
+  return result;
+}
+
+Delta Editor::drag_move(const std::string& session_id, Vec2 to, double rotate) {
+  std::lock_guard lock(mutex_);
+  return drag_move_locked(session_locked(session_id), to, rotate);
+}
+
+Delta Editor::drag_move_locked(Session& session, Vec2 to, double rotate) {
+  if (!session.drag) throw RequestError(kConflict, "no drag in progress");
+  Session::Drag& drag = *session.drag;
+  if (drag.version != version_) {
+    const int64_t stale = drag.version;
+    session.drag.reset();
+    check_version_locked(stale);
+  }
+  if (!std::isfinite(to.x) || !std::isfinite(to.y) || !std::isfinite(rotate)) {
+    throw RequestError(kBadRequest, "drag target must be finite");
+  }
+  to = clamp_to_image(to, image_.width, image_.height);
+  const ControlMesh& mesh = image_.levels[drag.start.level];
+  const Vec2 d{to.x - drag.start.at.x, to.y - drag.start.at.y};
+  subvec::Handles handles;
+  if (drag.start.move_feature) {
+    handles = subvec::move_feature(mesh, mesh.features[drag.feature], d, rotate);
+  } else if (drag.vertex >= 0) {
+    handles = subvec::drag_vertex(mesh, drag.vertex, d);
+  } else {
+    handles = subvec::drag_feature(mesh, mesh.features[drag.feature], drag.start.at, d,
+                                   drag.start.sigma);
+  }
+  handles.region = drag.start.region;
+  try {
+    drag.shape->deform(handles, drag.preview);
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
+  if (!session.view || session.view->mesh.level != drag.start.level) {
+    Delta none;
+    return none;
+  }
+  return delta_locked(session, &drag.preview, false);
+}
+
+Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, double rotate,
+                       std::string& log) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  if (!session.drag) throw RequestError(kConflict, "no drag in progress");
+  std::unique_ptr<Session::Drag> drag = std::move(session.drag);
+  check_version_locked(version);
+  check_version_locked(drag->version);
+  if (!std::isfinite(to.x) || !std::isfinite(to.y) || !std::isfinite(rotate)) {
+    throw RequestError(kBadRequest, "drag target must be finite");
+  }
+  to = clamp_to_image(to, image_.width, image_.height);
+  EditOp op;
+  op.level = drag->start.level;
+  op.region = drag->start.region;
+  if (drag->start.move_feature) {
+    op.kind = EditOp::Kind::kMoveFeature;
+    op.at = drag->start.at;
+    op.translate = {to.x - drag->start.at.x, to.y - drag->start.at.y};
+    op.rotate = rotate;
+  } else {
+    op.kind = EditOp::Kind::kDrag;
+    op.select = drag->vertex >= 0 ? EditSelect::kVertex : EditSelect::kFeature;
+    op.from = drag->start.at;
+    op.to = to;
+    op.sigma = drag->start.sigma;
+  }
+  VectorImage edited = image_;
+  try {
+    const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
+    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
+  } catch (const Error& e) {
+    refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+  }
+  commit_locked(std::move(edited));
+  return delta_locked(session, nullptr, false);
+}
+
+void Editor::drag_cancel(const std::string& session_id) {
+  std::lock_guard lock(mutex_);
+  session_locked(session_id).drag.reset();
+}
+
+void Editor::commit_locked(VectorImage image) {
+  undo_.push_back(std::move(image_));
+  if (static_cast<int>(undo_.size()) > kMaxUndo) undo_.erase(undo_.begin());
+  redo_.clear();
+  image_ = std::move(image);
+  ++version_;
+}
+
+Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp& op,
+                    std::string& log) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  check_level_locked(op.level);
+  VectorImage edited = image_;
+  try {
+    const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
+    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
+  } catch (const Error& e) {
+    refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+  }
+  commit_locked(std::move(edited));
+  return delta_locked(session, nullptr, false);
+}
+
+Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
+                      std::optional<double> threshold, uint64_t seed, double probability,
+                      std::string& log) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  check_level_locked(level);
+  subvec::StylizeOptions options;
+  options.level = level;
+  options.threshold = threshold;
+  options.seed = seed;
+  options.probability = probability;
+  subvec::StylizeReport report;
+  VectorImage edited = image_;
+  try {
+    std::vector<subvec::Stroke> strokes = subvec::stylize(edited, options, &report);
+    edited.strokes.insert(edited.strokes.end(), strokes.begin(), strokes.end());
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
+  log = std::to_string(report.strokes) + " strokes on " +
+        std::to_string(report.above + report.chosen) + " of " + std::to_string(report.in_region) +
+        " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")";
+  commit_locked(std::move(edited));
+  return delta_locked(session, nullptr, true);
+}
+
+Delta Editor::undo(const std::string& session_id, int64_t version) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  if (undo_.empty()) throw RequestError(kConflict, "nothing to undo");
+  const bool strokes_changed = undo_.back().strokes.size() != image_.strokes.size();
+  redo_.push_back(std::move(image_));
+  image_ = std::move(undo_.back());
+  undo_.pop_back();
+  ++version_;
+  session.drag.reset();
+  return delta_locked(session, nullptr, strokes_changed);
+}
+
+Delta Editor::redo(const std::string& session_id, int64_t version) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  if (redo_.empty()) throw RequestError(kConflict, "nothing to redo");
+  const bool strokes_changed = redo_.back().strokes.size() != image_.strokes.size();
+  undo_.push_back(std::move(image_));
+  image_ = std::move(redo_.back());
+  redo_.pop_back();
+  ++version_;
+  session.drag.reset();
+  return delta_locked(session, nullptr, strokes_changed);
+}
+
+}  // namespace subvec_serve

@@ -1,0 +1,205 @@
+// The editing state behind `subvec serve` (docs/serve.md), independent of HTTP.
+//
+// Design note. One Editor holds one *versioned document*: the vector image the user named, an
+// undo and a redo stack of whole images, and a version number that every change increments.
+// Browser tabs are *sessions*: a session owns what only its page needs (the refined mesh it draws,
+// at the depth and over the window its zoom asks for, and the state of a drag in progress), never
+// the document. Every request that changes the document names the version the page shows; a
+// request made from a stale version is refused (Conflict), so two tabs can never overwrite each
+// other's edits unseen: the refused tab reloads and the user sees the other tab's work. The
+// version is also what a tab polls to notice a change made elsewhere.
+//
+// Edits go through the library exactly as `subvec edit` does (apply_edit_ops with one EditOp), so a
+// session's history is also a valid ops file. A drag is previewed with the same calls
+// (drag_feature / drag_vertex / move_feature, then ShapeEditor::deform with the factorization
+// cached for the drag's handle set) and committed with apply_edit_ops when the mouse is released.
+//
+// Redraw data. A view is the control faces of one level refined `depth` times and pushed to the
+// limit (subdiv/subdivision.h), unwelded into "GL vertices" (one per refined vertex and color value
+// pair, so a tear is a seam), with RGBA8 colors and float positions in image pixels. After an edit
+// a session answers with a Delta: the GL vertices whose position or color changed (sparse when few
+// changed, dense otherwise), never the topology again.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "subvec/edit/ops.h"
+#include "subvec/edit/shape.h"
+#include "subvec/mesh/vector_image.h"
+#include "subvec/subdiv/subdivision.h"
+
+namespace subvec_serve {
+
+using subvec::Color;
+using subvec::ControlMesh;
+using subvec::Vec2;
+using subvec::VectorImage;
+
+// A refused request: `status` is the HTTP status the server answers with.
+class RequestError : public std::runtime_error {
+ public:
+  RequestError(int status, const std::string& message)
+      : std::runtime_error(message), status_(status) {}
+  int status() const { return status_; }
+
+ private:
+  int status_;
+};
+
+// Status codes used by the editor (RFC 9110 names).
+inline constexpr int kBadRequest = 400, kNotFound = 404, kConflict = 409, kUnprocessable = 422,
+                     kNotImplemented = 501, kUnavailable = 503;
+
+struct ViewRequest {
+  int level = 0;
+  int depth = 2;
+  // Image-space window the page shows (with a margin); empty (x1 <= x0): the whole image.
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// The refined mesh a session draws, unwelded for WebGL.
+struct ViewMesh {
+  int64_t id = 0;
+  int level = 0;
+  int depth = 0;
+  bool partial = false;             // only the faces near the window were refined
+  std::vector<float> positions;     // #G x 2, image pixels
+  std::vector<uint8_t> colors;      // #G x 4, RGBA8 (alpha 255)
+  std::vector<uint32_t> triangles;  // #T x 3 GL vertex indices
+  std::vector<uint32_t> tear_lines; // pairs of GL vertex indices along the feature curves
+  int num_gl_vertices() const { return static_cast<int>(positions.size() / 2); }
+};
+
+// What changed in a view after an edit. Sparse: the indices and the new values of the changed GL
+// vertices; dense (`dense_*` true): every GL vertex, in order, `*_indices` empty.
+struct Delta {
+  int64_t view_id = 0;
+  bool dense_positions = false, dense_colors = false;
+  std::vector<uint32_t> position_indices;
+  std::vector<float> positions;
+  std::vector<uint32_t> color_indices;
+  std::vector<uint8_t> colors;
+  std::vector<float> control_positions;  // #V x 2 of the view's level (for the overlay)
+  bool strokes_changed = false;
+};
+
+// A stroke as the page draws it: a polyline with a half-width per point.
+struct StrokeGeometry {
+  std::vector<float> points;  // #P x 2
+  std::vector<float> half_widths;
+  Color color;
+};
+
+struct DocumentInfo {
+  int64_t version = 0;
+  int width = 0, height = 0;
+  struct Level {
+    int vertices = 0, triangles = 0, colors = 0, features = 0;
+    double mean_edge = 0;  // mean control edge length, pixels
+  };
+  std::vector<Level> levels;
+  int undo = 0, redo = 0;
+  int strokes = 0;
+};
+
+// One drag in progress (drag tool or move-feature tool).
+struct DragStart {
+  int level = 0;
+  bool move_feature = false;             // else: a drag
+  subvec::EditSelect select = subvec::EditSelect::kFeature;
+  Vec2 at;
+  double sigma = 20;
+  double region = 0;
+};
+
+struct SelectRequest {
+  int level = 0;
+  subvec::EditSelect select = subvec::EditSelect::kVertex;
+  Vec2 at;
+  double radius = 0;
+};
+
+struct SelectResult {
+  int vertex = -1, feature = -1;
+  double distance = 0;
+  std::vector<int32_t> chain;       // control vertices of the feature (empty for a vertex)
+  std::vector<int32_t> region;      // control vertices whose color values the region holds
+  int colors = 0;                   // color values in the region
+};
+
+class Editor {
+ public:
+  // Limits that keep one request bounded in time and memory.
+  static constexpr int kMaxSessions = 32;
+  static constexpr int kMaxUndo = 200;
+  static constexpr int64_t kMaxViewTriangles = int64_t{1} << 22;
+
+  explicit Editor(VectorImage image);
+  ~Editor();
+  Editor(const Editor&) = delete;
+  Editor& operator=(const Editor&) = delete;
+
+  DocumentInfo info() const;
+  int64_t version() const;
+  // A copy of the document (for saving and exporting) and its version.
+  std::pair<VectorImage, int64_t> snapshot() const;
+
+  // Sessions: a new one per tab; unknown ids throw RequestError(404).
+  std::string new_session();
+
+  // Control mesh of a level for the overlay: positions, unique edges, feature chains.
+  struct ControlData {
+    std::vector<float> positions;
+    std::vector<uint32_t> edges;
+    std::vector<std::vector<int32_t>> features;
+  };
+  ControlData control(int level) const;
+
+  // Builds the session's view and returns it (the session keeps it for deltas).
+  ViewMesh view(const std::string& session, const ViewRequest& request);
+  std::vector<StrokeGeometry> strokes(int level) const;
+
+  SelectResult select(const SelectRequest& request) const;
+
+  // Drag: start (picks the handle; version must be current), move (preview, changes nothing in
+  // the document), end (commits through apply_edit_ops; returns the log line).
+  SelectResult drag_start(const std::string& session, int64_t version, const DragStart& start);
+  Delta drag_move(const std::string& session, Vec2 to, double rotate);
+  Delta drag_end(const std::string& session, int64_t version, Vec2 to, double rotate,
+                 std::string& log);
+  void drag_cancel(const std::string& session);
+
+  // A color edit or any op through apply_edit_ops; the delta for the session's view.
+  Delta apply(const std::string& session, int64_t version, const subvec::EditOp& op,
+              std::string& log);
+  Delta stylize(const std::string& session, int64_t version, int level, std::optional<double> threshold,
+                uint64_t seed, double probability, std::string& log);
+  Delta undo(const std::string& session, int64_t version);
+  Delta redo(const std::string& session, int64_t version);
+
+ private:
+  struct Session;
+  struct View;
+  Session& session_locked(const std::string& id);
+  void check_version_locked(int64_t version) const;
+  void check_level_locked(int level) const;
+  void commit_locked(VectorImage image);
+  Delta drag_move_locked(Session& session, Vec2 to, double rotate);
+  Delta delta_locked(Session& session, const std::vector<Vec2>* preview, bool strokes_changed);
+
+  mutable std::mutex mutex_;
+  VectorImage image_;
+  int64_t version_ = 1;
+  std::vector<VectorImage> undo_, redo_;
+  std::vector<std::unique_ptr<Session>> sessions_;  // most recently used first
+  int64_t next_session_ = 1, next_view_ = 1;
+};
+
+}  // namespace subvec_serve

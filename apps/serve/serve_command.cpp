@@ -1,0 +1,84 @@
+// `subvec serve IN [-o OUT] [--port P] [--host H]`: the options, the banner, and a clean stop on
+// Ctrl+C (SIGINT) or SIGTERM through a thread that waits for the signal.
+#include "serve_command.h"
+
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+#include <pthread.h>
+#include <thread>
+
+#include "server.h"
+
+namespace subvec_serve {
+
+namespace {
+
+void run_serve(const ServeOptions& options) {
+  // Block the stop signals in every thread (the server's pool inherits the mask) and wait for
+  // them in one thread, which stops the server: no work in a signal handler.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  EditorServer server(options);
+  server.start();
+  std::cout << "subvec: editing " << options.input.string() << " at " << server.url()
+            << "  (Ctrl+C stops)" << std::endl;
+  std::thread waiter([&server, signals] {
+    int received = 0;
+    sigwait(&signals, &received);
+    server.stop();
+  });
+  server.run();
+  // run() also returns when listening fails; wake the waiter either way.
+  pthread_kill(waiter.native_handle(), SIGTERM);
+  waiter.join();
+  // Nothing is left to write (Save writes synchronously and atomically); leave without waiting
+  // for a vectorization still running in the background.
+  std::cout.flush();
+  std::_Exit(0);
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  static ServeOptions options;  // lives until the callback has run
+  CLI::App* serve = app.add_subcommand(
+      "serve", "Edit a vector image (or a photograph, vectorized first) in the browser");
+  serve->add_option("input", options.input, "Vector image (.svec, .svec.json) or raster image")
+      ->required();
+  serve->add_option("-o,--output", options.output,
+                    "Where Save writes (.svec or .svec.json); without it, Save downloads")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            const bool ok = text.ends_with(".svec") || text.ends_with(".svec.json") ||
+                            text.ends_with(".json");
+            return ok ? std::string() : "expected a .svec or .svec.json path, got '" + text + "'";
+          },
+          "OUT", "svec path"));
+  serve->add_option("--port", options.port, "TCP port (default 8080; 0: any free port)")
+      ->check(CLI::Range(0, 65535));
+  serve->add_option("--host", options.host,
+                    "Address to listen on (default 127.0.0.1: this machine only)");
+  CLI::Option* ratio =
+      serve->add_option("--ratio", options.ratio,
+                        "Raster input: control vertices as a fraction of the pixel count (0.01)")
+          ->check(CLI::Range(1e-9, 1.0));
+  CLI::Option* vertices =
+      serve->add_option("--vertices", options.vertices, "Raster input: control vertex count")
+          ->check(CLI::Range(4, 1 << 26));
+  ratio->excludes(vertices);
+  serve->add_option("--max-pixels", options.max_pixels, "Raster input: refuse larger images")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  serve->footer(
+      "Examples:\n"
+      "  subvec serve examples/01-disk.svec.json              # then open the printed URL\n"
+      "  subvec serve photo.png --vertices 3000               # vectorized first, progress in the page\n"
+      "  subvec serve in.svec -o edited.svec --port 0         # Save writes edited.svec; any free port");
+  serve->callback([] { run_serve(options); });
+}
+
+}  // namespace subvec_serve

@@ -1,0 +1,676 @@
+// The HTTP front end of `subvec serve`: routes, request parsing, binary frames, downloads.
+#include "server.h"
+
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "assets.h"
+#include "editor.h"
+#include "subvec/core/error.h"
+#include "subvec/export/export.h"
+#include "subvec/io/image_io.h"
+#include "subvec/io/svec.h"
+#include "subvec/render/renderer.h"
+
+// After the library headers: <httplib.h> brings <resolv.h>, whose _res macro breaks Eigen.
+#include <httplib.h>
+
+namespace subvec_serve {
+
+using nlohmann::json;
+using subvec::Error;
+using subvec::ErrorCode;
+
+namespace {
+
+constexpr size_t kMaxBody = 64 * 1024;
+
+// ---- binary frames -------------------------------------------------------------------------
+// A frame is "SVB1", the byte length of a JSON header (u32, little-endian), the header padded
+// with spaces to a multiple of 4 bytes, then the sections the header lists ("sections": name,
+// type f32 / u32 / u8, count), each padded with zeros to a multiple of 4 bytes. The page reads the
+// sections as typed arrays without copying.
+class Frame {
+ public:
+  template <class T>
+  void add(const std::string& name, const std::vector<T>& values) {
+    const char* type = std::is_same_v<T, float> ? "f32" : std::is_same_v<T, uint32_t> ? "u32" : "u8";
+    sections_.push_back({{"name", name}, {"type", type}, {"count", values.size()}});
+    const size_t bytes = values.size() * sizeof(T);
+    const size_t at = body_.size();
+    body_.resize(at + ((bytes + 3) & ~size_t{3}), '\0');
+    if (bytes > 0) std::memcpy(body_.data() + at, values.data(), bytes);
+  }
+  std::string finish(json header) const {
+    header["sections"] = sections_;
+    std::string text = header.dump();
+    text.resize((text.size() + 3) & ~size_t{3}, ' ');
+    std::string out = "SVB1";
+    const uint32_t n = static_cast<uint32_t>(text.size());
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((n >> (8 * i)) & 0xFF));
+    out += text;
+    out += body_;
+    return out;
+  }
+
+ private:
+  json sections_ = json::array();
+  std::string body_;
+};
+
+std::string delta_frame(const Delta& d, json header) {
+  Frame f;
+  f.add("position_indices", d.position_indices);
+  f.add("positions", d.positions);
+  f.add("color_indices", d.color_indices);
+  f.add("colors", d.colors);
+  f.add("control", d.control_positions);
+  header["view"] = d.view_id;
+  header["dense_positions"] = d.dense_positions;
+  header["dense_colors"] = d.dense_colors;
+  header["strokes_changed"] = d.strokes_changed;
+  return f.finish(std::move(header));
+}
+
+// ---- request parsing -----------------------------------------------------------------------
+json body_json(const httplib::Request& req) {
+  json j = json::parse(req.body, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    throw RequestError(kBadRequest, "request body is not a JSON object");
+  }
+  return j;
+}
+
+const json& field(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end()) throw RequestError(kBadRequest, std::string("missing key \"") + key + "\"");
+  return *it;
+}
+
+double number(const json& j, const char* key, std::optional<double> fallback = std::nullopt) {
+  if (!j.contains(key) && fallback) return *fallback;
+  const json& v = field(j, key);
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    throw RequestError(kBadRequest, std::string("\"") + key + "\" must be a finite number");
+  }
+  return v.get<double>();
+}
+
+int64_t integer(const json& j, const char* key, std::optional<int64_t> fallback = std::nullopt) {
+  if (!j.contains(key) && fallback) return *fallback;
+  const json& v = field(j, key);
+  if (!v.is_number_integer()) {
+    throw RequestError(kBadRequest, std::string("\"") + key + "\" must be an integer");
+  }
+  return v.get<int64_t>();
+}
+
+int small_int(const json& j, const char* key, int fallback) {
+  const int64_t v = integer(j, key, fallback);
+  if (v < -1000000 || v > 1000000) {
+    throw RequestError(kBadRequest, std::string("\"") + key + "\" is out of range");
+  }
+  return static_cast<int>(v);
+}
+
+std::string text(const json& j, const char* key) {
+  const json& v = field(j, key);
+  if (!v.is_string()) throw RequestError(kBadRequest, std::string("\"") + key + "\" must be a string");
+  return v.get<std::string>();
+}
+
+subvec::Vec2 point(const json& j, const char* key) {
+  const json& v = field(j, key);
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() ||
+      !std::isfinite(v[0].get<double>()) || !std::isfinite(v[1].get<double>())) {
+    throw RequestError(kBadRequest, std::string("\"") + key + "\" must be [x, y] (finite numbers)");
+  }
+  return {v[0].get<double>(), v[1].get<double>()};
+}
+
+subvec::EditSelect select_mode(const json& j) {
+  const std::string s = j.contains("select") ? text(j, "select") : "feature";
+  if (s == "vertex") return subvec::EditSelect::kVertex;
+  if (s == "feature") return subvec::EditSelect::kFeature;
+  throw RequestError(kBadRequest, "\"select\" must be \"vertex\" or \"feature\", got \"" + s + "\"");
+}
+
+int query_int(const httplib::Request& req, const char* key, int fallback) {
+  if (!req.has_param(key)) return fallback;
+  const std::string v = req.get_param_value(key);
+  int out = 0;
+  size_t used = 0;
+  try {
+    out = std::stoi(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != v.size()) {
+    throw RequestError(kBadRequest, std::string("query parameter ") + key + " must be an integer");
+  }
+  return out;
+}
+
+void send_json(httplib::Response& res, const json& j, int status = 200) {
+  res.status = status;
+  res.set_content(j.dump(), "application/json");
+}
+
+void send_error(httplib::Response& res, int status, const std::string& message) {
+  send_json(res, json{{"error", message}, {"status", status}}, status);
+}
+
+bool is_loopback_host(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "::1" || host == "[::1]" ||
+         host.rfind("127.", 0) == 0;
+}
+
+std::string png_bytes(const subvec::Image8& image) {
+  cv::Mat mat(image.height, image.width, image.channels == 4 ? CV_8UC4 : CV_8UC3,
+              const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat bgr;
+  cv::cvtColor(mat, bgr, image.channels == 4 ? cv::COLOR_RGBA2BGRA : cv::COLOR_RGB2BGR);
+  std::vector<uchar> out;
+  if (!cv::imencode(".png", bgr, out)) throw Error(ErrorCode::kIo, "PNG encoding failed");
+  return std::string(out.begin(), out.end());
+}
+
+}  // namespace
+
+bool looks_like_raster(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[12] = {};
+  in.read(reinterpret_cast<char*>(b), sizeof b);
+  const auto n = in.gcount();
+  if (n < 4) return false;
+  const bool png = b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G';
+  const bool jpeg = b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF;
+  const bool webp = n >= 12 && std::memcmp(b, "RIFF", 4) == 0 && std::memcmp(b + 8, "WEBP", 4) == 0;
+  const bool tiff = (b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0) ||
+                    (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42);
+  const bool bmp = b[0] == 'B' && b[1] == 'M';
+  return png || jpeg || webp || tiff || bmp;
+}
+
+struct EditorServer::Impl {
+  ServeOptions options;
+  httplib::Server server;
+  int port = 0;
+  std::thread worker;  // vectorization of a raster input
+
+  // Document state: loading until the editor exists.
+  mutable std::mutex state_mutex;
+  std::shared_ptr<Editor> editor;
+  std::string stage = "starting";
+  double fraction = 0;
+  std::string failure;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  std::atomic<bool> stopping{false};
+
+  std::shared_ptr<Editor> ready_editor() {
+    std::lock_guard lock(state_mutex);
+    if (editor) return editor;
+    if (!failure.empty()) throw RequestError(500, "vectorization failed: " + failure);
+    throw RequestError(kUnavailable, "still vectorizing the input (" + stage + ")");
+  }
+
+  std::string name() const { return options.input.filename().string(); }
+  std::string stem() const {
+    std::string s = options.input.filename().string();
+    for (const char* ext : {".svec.json", ".svec", ".json"}) {
+      const std::string e = ext;
+      if (s.size() > e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0) {
+        return s.substr(0, s.size() - e.size());
+      }
+    }
+    const auto dot = s.rfind('.');
+    return dot == std::string::npos || dot == 0 ? s : s.substr(0, dot);
+  }
+
+  void routes();
+};
+
+EditorServer::EditorServer(ServeOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+}
+
+EditorServer::~EditorServer() {
+  stop();
+  if (impl_->worker.joinable()) impl_->worker.join();
+}
+
+int EditorServer::port() const { return impl_->port; }
+
+std::string EditorServer::url() const {
+  std::string host = impl_->options.host;
+  if (host == "0.0.0.0" || host.empty()) host = "127.0.0.1";
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  return "http://" + host + ":" + std::to_string(impl_->port) + "/";
+}
+
+void EditorServer::stop() {
+  impl_->stopping = true;
+  impl_->server.stop();
+}
+
+void EditorServer::run() { impl_->server.listen_after_bind(); }
+
+void EditorServer::start() {
+  Impl& s = *impl_;
+  const auto& in = s.options.input;
+  if (!std::filesystem::is_regular_file(in)) {
+    throw Error(ErrorCode::kIo, "cannot read '" + in.string() + "': no such file");
+  }
+  if (s.options.output && s.options.output->has_filename()) {
+    subvec::svec_format_for(*s.options.output);  // throws for an unknown extension
+  }
+  if (looks_like_raster(in)) {
+    // Decode now, so a bad file fails before the server starts; vectorize in the background.
+    auto image = std::make_shared<subvec::Image8>(subvec::read_image(in, s.options.max_pixels));
+    s.stage = "vectorizing";
+    s.worker = std::thread([&s, image] {
+      subvec::VectorizeOptions vo;
+      vo.ratio = s.options.ratio;
+      vo.vertices = s.options.vertices;
+      vo.progress = [&s](const std::string& stage, double fraction) {
+        std::lock_guard lock(s.state_mutex);
+        s.stage = stage;
+        s.fraction = fraction;
+      };
+      try {
+        auto editor = std::make_shared<Editor>(subvec::vectorize(*image, vo));
+        std::lock_guard lock(s.state_mutex);
+        s.editor = std::move(editor);
+        s.stage = "ready";
+        s.fraction = 1;
+      } catch (const std::exception& e) {
+        std::lock_guard lock(s.state_mutex);
+        s.failure = e.what();
+        s.stage = "failed";
+      }
+    });
+  } else {
+    s.editor = std::make_shared<Editor>(subvec::read_svec(in));
+    s.stage = "ready";
+    s.fraction = 1;
+  }
+
+  s.routes();
+  // SO_REUSEADDR alone: a restarted server can bind at once, but a port another server listens
+  // on is refused (cpp-httplib's default adds SO_REUSEPORT, which would let two servers share it).
+  s.server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
+  s.server.set_payload_max_length(kMaxBody);
+  s.server.set_read_timeout(10, 0);
+  s.server.set_write_timeout(30, 0);
+  if (s.options.port == 0) {
+    s.port = s.server.bind_to_any_port(s.options.host);
+  } else {
+    s.port = s.server.bind_to_port(s.options.host, s.options.port) ? s.options.port : -1;
+  }
+  if (s.port <= 0) {
+    throw Error(ErrorCode::kIo, "cannot listen on " + s.options.host + ":" +
+                                    std::to_string(s.options.port) +
+                                    " (in use, or not an address of this machine)");
+  }
+}
+
+void EditorServer::Impl::routes() {
+  const bool loopback = is_loopback_host(options.host);
+
+  server.set_pre_routing_handler([loopback](const httplib::Request& req, httplib::Response& res) {
+    if (loopback) {
+      std::string host = req.get_header_value("Host");
+      if (!host.empty() && host.front() == '[') {
+        host = host.substr(0, host.find(']') + 1);
+      } else {
+        host = host.substr(0, host.find(':'));
+      }
+      if (!is_loopback_host(host)) {
+        send_error(res, 403, "this server answers only requests for a loopback address");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+    }
+    if (req.method == "POST" &&
+        req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
+      send_error(res, 415, "POST requests must have Content-Type: application/json");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+
+  server.set_error_handler(httplib::Server::HandlerWithResponse(
+      [](const httplib::Request&, httplib::Response& res) {
+        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+        std::string message = "HTTP error " + std::to_string(res.status);
+        if (res.status == 400) message = "malformed request";
+        if (res.status == 404) message = "no such page or API";
+        if (res.status == 413) message = "request too large (at most 64 KiB)";
+        if (res.status == 414) message = "request URI too long";
+        send_error(res, res.status, message);
+        return httplib::Server::HandlerResponse::Handled;
+      }));
+
+  server.set_exception_handler(
+      [](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+        try {
+          std::rethrow_exception(ep);
+        } catch (const RequestError& e) {
+          send_error(res, e.status(), e.what());
+        } catch (const Error& e) {
+          send_error(res, e.code() == ErrorCode::kInvalidArgument ? kUnprocessable : 500, e.what());
+        } catch (const std::bad_alloc&) {
+          send_error(res, 500, "out of memory");
+        } catch (const std::exception& e) {
+          send_error(res, 500, e.what());
+        } catch (...) {
+          send_error(res, 500, "unknown error");
+        }
+      });
+
+  // ---- the page ----
+  auto serve_asset = [](const std::string& path, httplib::Response& res) {
+    const EmbeddedAsset* asset = find_asset(path);
+    if (!asset) throw RequestError(kNotFound, "no such file: " + path);
+    res.set_content(reinterpret_cast<const char*>(asset->data), asset->size, asset->content_type);
+    res.set_header("Cache-Control", "no-cache");
+  };
+  server.Get("/", [serve_asset](const httplib::Request&, httplib::Response& res) {
+    serve_asset("index.html", res);
+  });
+  server.Get("/assets/(.+)", [serve_asset](const httplib::Request& req, httplib::Response& res) {
+    serve_asset("assets/" + req.matches[1].str(), res);
+  });
+
+  // ---- state ----
+  server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
+    std::lock_guard lock(state_mutex);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    json j = {{"name", name()},
+              {"state", editor ? "ready" : !failure.empty() ? "failed" : "vectorizing"},
+              {"stage", stage},
+              {"fraction", fraction},
+              {"seconds", seconds},
+              {"version", editor ? editor->version() : 0}};
+    if (!failure.empty()) j["error"] = failure;
+    send_json(res, j);
+  });
+
+  server.Get("/api/document", [this](const httplib::Request&, httplib::Response& res) {
+    const DocumentInfo info = ready_editor()->info();
+    json levels = json::array();
+    for (const auto& l : info.levels) {
+      levels.push_back({{"vertices", l.vertices},
+                        {"triangles", l.triangles},
+                        {"colors", l.colors},
+                        {"features", l.features},
+                        {"mean_edge", l.mean_edge}});
+    }
+    json save = nullptr;
+    if (options.output) save = options.output->string();
+    send_json(res, {{"name", name()},
+                    {"stem", stem()},
+                    {"version", info.version},
+                    {"width", info.width},
+                    {"height", info.height},
+                    {"levels", levels},
+                    {"undo", info.undo},
+                    {"redo", info.redo},
+                    {"strokes", info.strokes},
+                    {"save_to", save},
+                    {"filter",
+                     {{"available", false},
+                      {"reason",
+                       "filtering needs the pyramid layer (levels of abstraction, issue 4), "
+                       "which this build does not have yet"}}}});
+  });
+
+  server.Post("/api/session", [this](const httplib::Request&, httplib::Response& res) {
+    send_json(res, {{"session", ready_editor()->new_session()}});
+  });
+
+  server.Get("/api/control", [this](const httplib::Request& req, httplib::Response& res) {
+    const Editor::ControlData c = ready_editor()->control(query_int(req, "level", 0));
+    send_json(res, {{"positions", c.positions}, {"edges", c.edges}, {"features", c.features}});
+  });
+
+  server.Get("/api/strokes", [this](const httplib::Request& req, httplib::Response& res) {
+    json out = json::array();
+    for (const StrokeGeometry& s : ready_editor()->strokes(query_int(req, "level", 0))) {
+      out.push_back({{"points", s.points},
+                     {"half_widths", s.half_widths},
+                     {"color", {s.color.r, s.color.g, s.color.b}}});
+    }
+    send_json(res, out);
+  });
+
+  server.Post("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    ViewRequest v;
+    v.level = small_int(j, "level", 0);
+    v.depth = small_int(j, "depth", 2);
+    if (j.contains("window") && !j["window"].is_null()) {
+      const json& w = j["window"];
+      if (!w.is_array() || w.size() != 4 ||
+          !std::all_of(w.begin(), w.end(), [](const json& x) {
+            return x.is_number() && std::isfinite(x.get<double>());
+          })) {
+        throw RequestError(kBadRequest, "\"window\" must be [x0, y0, x1, y1] (finite numbers)");
+      }
+      v.x0 = w[0].get<double>();
+      v.y0 = w[1].get<double>();
+      v.x1 = w[2].get<double>();
+      v.y1 = w[3].get<double>();
+    }
+    std::shared_ptr<Editor> doc = ready_editor();
+    const ViewMesh m = doc->view(text(j, "session"), v);
+    Frame f;
+    f.add("positions", m.positions);
+    f.add("colors", m.colors);
+    f.add("triangles", m.triangles);
+    f.add("tear_lines", m.tear_lines);
+    const std::string body = f.finish({{"view", m.id},
+                                       {"level", m.level},
+                                       {"depth", m.depth},
+                                       {"partial", m.partial},
+                                       {"version", doc->version()}});
+    res.set_content(body, "application/octet-stream");
+  });
+
+  server.Post("/api/select", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    SelectRequest s;
+    s.level = small_int(j, "level", 0);
+    s.select = select_mode(j);
+    s.at = point(j, "at");
+    s.radius = number(j, "radius", 0.0);
+    if (s.radius < 0) throw RequestError(kBadRequest, "\"radius\" must be >= 0");
+    const SelectResult r = ready_editor()->select(s);
+    send_json(res, {{"vertex", r.vertex},
+                    {"feature", r.feature},
+                    {"distance", r.distance},
+                    {"chain", r.chain},
+                    {"region", r.region},
+                    {"colors", r.colors}});
+  });
+
+  server.Post("/api/drag/start", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    DragStart d;
+    d.level = small_int(j, "level", 0);
+    const std::string tool = j.contains("tool") ? text(j, "tool") : "drag";
+    if (tool != "drag" && tool != "move") {
+      throw RequestError(kBadRequest, "\"tool\" must be \"drag\" or \"move\"");
+    }
+    d.move_feature = tool == "move";
+    d.select = select_mode(j);
+    d.at = point(j, "at");
+    d.sigma = number(j, "sigma", 20.0);
+    d.region = number(j, "region", 0.0);
+    const SelectResult r =
+        ready_editor()->drag_start(text(j, "session"), integer(j, "version"), d);
+    send_json(res, {{"vertex", r.vertex}, {"feature", r.feature}, {"chain", r.chain}});
+  });
+
+  server.Post("/api/drag/move", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    const Delta d =
+        ready_editor()->drag_move(text(j, "session"), point(j, "to"), number(j, "rotate", 0.0));
+    res.set_content(delta_frame(d, {{"preview", true}}), "application/octet-stream");
+  });
+
+  server.Post("/api/drag/end", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->drag_end(text(j, "session"), integer(j, "version"), point(j, "to"),
+                                     number(j, "rotate", 0.0), log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+
+  server.Post("/api/drag/cancel", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    ready_editor()->drag_cancel(text(j, "session"));
+    send_json(res, {{"ok", true}});
+  });
+
+  server.Post("/api/color", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kColor;
+    op.level = small_int(j, "level", 0);
+    op.select = select_mode(j);
+    op.at = point(j, "at");
+    op.radius = number(j, "radius", 0.0);
+    const std::string mode = j.contains("mode") ? text(j, "mode") : "blend";
+    if (mode != "blend" && mode != "transform") {
+      throw RequestError(kBadRequest, "\"mode\" must be \"blend\" or \"transform\"");
+    }
+    op.mode = mode == "blend" ? subvec::ColorMode::kBlend : subvec::ColorMode::kTransform;
+    const json& c = field(j, "color");
+    if (!c.is_array() || c.size() != 3 || !std::all_of(c.begin(), c.end(), [](const json& x) {
+          return x.is_number() && x.get<double>() >= 0 && x.get<double>() <= 255;
+        })) {
+      throw RequestError(kBadRequest, "\"color\" must be [r, g, b] with values 0 to 255");
+    }
+    op.color = {c[0].get<float>(), c[1].get<float>(), c[2].get<float>()};
+    op.amount = number(j, "amount", 0.5);
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+
+  server.Post("/api/stylize", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    std::optional<double> threshold;
+    if (j.contains("threshold") && !j["threshold"].is_null()) threshold = number(j, "threshold");
+    const int64_t seed = integer(j, "seed", 1);
+    if (seed < 0) throw RequestError(kBadRequest, "\"seed\" must be >= 0");
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->stylize(text(j, "session"), integer(j, "version"),
+                                    small_int(j, "level", 0), threshold,
+                                    static_cast<uint64_t>(seed), number(j, "probability", 0.3), log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+
+  auto history = [this](bool undo) {
+    return [this, undo](const httplib::Request& req, httplib::Response& res) {
+      const json j = body_json(req);
+      std::shared_ptr<Editor> doc = ready_editor();
+      const Delta d = undo ? doc->undo(text(j, "session"), integer(j, "version"))
+                           : doc->redo(text(j, "session"), integer(j, "version"));
+      res.set_content(delta_frame(d, {{"version", doc->version()}}),
+                      "application/octet-stream");
+    };
+  };
+  server.Post("/api/undo", history(true));
+  server.Post("/api/redo", history(false));
+
+  // Filtering of the pyramid's detail bands (paper §5): the request is specified now so that the
+  // page and the API are ready, and answered once the pyramid layer is part of the library.
+  server.Post("/api/filter", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    (void)ready_editor();
+    (void)j;
+    send_error(res, kNotImplemented,
+               "filtering needs the pyramid layer (levels of abstraction, issue 4), which this "
+               "build does not have yet");
+  });
+
+  server.Post("/api/save", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    std::shared_ptr<Editor> doc = ready_editor();
+    if (!options.output) {
+      throw RequestError(kConflict, "no output file was named (start with -o OUT.svec to save in "
+                                    "place; Download works without it)");
+    }
+    auto [image, version] = doc->snapshot();
+    if (j.contains("version") && integer(j, "version") != version) {
+      throw RequestError(kConflict, "the document changed in another tab (now version " +
+                                        std::to_string(version) + "): reloaded, save again");
+    }
+    subvec::write_svec(*options.output, image);
+    send_json(res, {{"saved", options.output->string()}, {"version", version}});
+  });
+
+  server.Get("/api/download", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string format = req.has_param("format") ? req.get_param_value("format") : "svec";
+    auto [image, version] = ready_editor()->snapshot();
+    const int level = query_int(req, "level", 0);
+    if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+      throw RequestError(kBadRequest, "level " + std::to_string(level) + " is out of range");
+    }
+    std::string body, type, ext = format;
+    if (format == "svec") {
+      const std::vector<uint8_t> bytes = subvec::to_svec_binary(image);
+      body.assign(bytes.begin(), bytes.end());
+      type = "application/octet-stream";
+    } else if (format == "svec.json") {
+      body = subvec::to_svec_json(image);
+      type = "application/json";
+    } else if (format == "png") {
+      subvec::RenderOptions ro;
+      ro.level = level;
+      body = png_bytes(subvec::render(image, ro));
+      type = "image/png";
+    } else if (format == "pdf" || format == "svg") {
+      subvec::ExportOptions eo;
+      eo.level = level;
+      body = format == "pdf" ? subvec::to_pdf(image, eo) : subvec::to_svg(image, eo);
+      type = format == "pdf" ? "application/pdf" : "image/svg+xml";
+    } else {
+      throw RequestError(kBadRequest, "unknown format '" + format +
+                                          "' (expected svec, svec.json, png, pdf or svg)");
+    }
+    std::string file = stem();
+    for (char& ch : file) {
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
+    }
+    res.set_header("Content-Disposition",
+                   "attachment; filename=\"" + file + "-v" + std::to_string(version) + "." +
+                       ext + "\"");
+    res.set_content(body, type);
+  });
+}
+
+}  // namespace subvec_serve

@@ -1,0 +1,316 @@
+// `subvec serve`: the editor's versioned document and its HTTP boundary (apps/serve).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "editor.h"
+#include "subvec/core/error.h"
+#include "server.h"
+#include "subvec/edit/ops.h"
+#include "subvec/io/svec.h"
+
+// After the library headers: <httplib.h> brings <resolv.h>, whose _res macro breaks Eigen.
+#include <httplib.h>
+
+namespace subvec_serve {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+VectorImage disk() {
+  return subvec::read_svec(fs::path(SUBVEC_SOURCE_DIR) / "examples" / "01-disk.svec.json");
+}
+
+subvec::EditOp color_op(Vec2 at, Color color) {
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kColor;
+  op.select = subvec::EditSelect::kFeature;
+  op.at = at;
+  op.radius = 40;
+  op.color = color;
+  op.amount = 1;
+  return op;
+}
+
+int status_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const RequestError& e) {
+    return e.status();
+  }
+  return 0;
+}
+
+TEST(ServeEditor, StaleVersionIsRefusedAndNothingChanges) {
+  Editor editor(disk());
+  const std::string a = editor.new_session(), b = editor.new_session();
+  std::string log;
+  editor.apply(a, 1, color_op({48, 48}, {0, 255, 0}), log);
+  EXPECT_EQ(editor.version(), 2);
+  const VectorImage after_a = editor.snapshot().first;
+  // Tab b still shows version 1: its edit must not overwrite a's.
+  EXPECT_EQ(status_of([&] { editor.apply(b, 1, color_op({48, 48}, {255, 0, 0}), log); }), kConflict);
+  EXPECT_EQ(editor.version(), 2);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_a.levels[0].colors);
+  EXPECT_EQ(status_of([&] { editor.undo(b, 1); }), kConflict);
+  EXPECT_EQ(status_of([&] { editor.apply("nope", 2, color_op({48, 48}, {}), log); }), kNotFound);
+}
+
+TEST(ServeEditor, UndoRedoRestoreExactly) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  std::string log;
+  editor.apply(s, 1, color_op({48, 48}, {0, 0, 255}), log);
+  const VectorImage edited = editor.snapshot().first;
+  ASSERT_NE(edited.levels[0].colors, original.levels[0].colors);
+  editor.undo(s, 2);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, original.levels[0].colors);
+  EXPECT_EQ(editor.info().redo, 1);
+  editor.redo(s, 3);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, edited.levels[0].colors);
+  EXPECT_EQ(status_of([&] { editor.redo(s, 4); }), kConflict);  // nothing to redo
+}
+
+// The committed drag is exactly what `subvec edit` makes of the same operation, and the last
+// preview the page drew is that result.
+TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  const ViewMesh view = editor.view(s, {0, 2});
+  DragStart start;
+  start.at = {76, 48};
+  start.sigma = 30;
+  const SelectResult picked = editor.drag_start(s, 1, start);
+  EXPECT_EQ(picked.feature, 0);
+  Delta preview;
+  for (int i = 1; i <= 8; ++i) preview = editor.drag_move(s, {76.0 + i, 48}, 0);
+  EXPECT_EQ(preview.view_id, view.id);
+  EXPECT_TRUE(preview.dense_positions);  // the whole mesh follows an ARAP drag
+  EXPECT_TRUE(preview.color_indices.empty());
+  std::string log;
+  const Delta commit = editor.drag_end(s, 1, {84, 48}, 0, log);
+  EXPECT_NE(log.find("dragged"), std::string::npos) << log;
+  // Nothing left to redraw after the release: the last preview was the committed shape.
+  EXPECT_TRUE(commit.position_indices.empty() && !commit.dense_positions);
+
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kDrag;
+  op.select = subvec::EditSelect::kFeature;
+  op.from = {76, 48};
+  op.to = {84, 48};
+  op.sigma = 30;
+  VectorImage expected = original;
+  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
+  EXPECT_EQ(commit.control_positions.size(), expected.levels[0].positions.size() * 2);
+}
+
+// The move tool: translate and rotate a whole feature, committed as `subvec edit`'s move-feature.
+TEST(ServeEditor, MoveFeatureCommitMatchesSubvecEdit) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  DragStart start;
+  start.move_feature = true;
+  start.at = {76, 48};
+  editor.drag_start(s, 1, start);
+  editor.drag_move(s, {72, 50}, 15);
+  std::string log;
+  editor.drag_end(s, 1, {72, 50}, 15, log);
+  EXPECT_NE(log.find("rotated by 15"), std::string::npos) << log;
+  EXPECT_EQ(log.rfind("ops[", 0), std::string::npos) << log;  // no ops-file prefix on the page
+
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kMoveFeature;
+  op.at = {76, 48};
+  op.translate = {-4, 2};
+  op.rotate = 15;
+  VectorImage expected = original;
+  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
+  EXPECT_NE(expected.levels[0].positions, original.levels[0].positions);
+  // A drag that ended is over: another move is refused.
+  EXPECT_EQ(status_of([&] { editor.drag_move(s, {70, 50}, 0); }), kConflict);
+}
+
+TEST(ServeEditor, ViewIsUnweldedAtTearsAndColorDeltasAreSparse) {
+  Editor editor(disk());
+  const std::string s = editor.new_session();
+  const ViewMesh view = editor.view(s, {0, 3});
+  ASSERT_GT(view.triangles.size(), 0u);
+  ASSERT_GT(view.tear_lines.size(), 0u);
+  const int ng = view.num_gl_vertices();
+  for (uint32_t i : view.triangles) ASSERT_LT(i, static_cast<uint32_t>(ng));
+  // The closed tear gives seam copies: two GL vertices at one position with different colors.
+  int seams = 0;
+  for (size_t k = 0; k < view.tear_lines.size(); ++k) {
+    const uint32_t g = view.tear_lines[k];
+    for (int h = 0; h < ng; ++h) {
+      if (static_cast<uint32_t>(h) != g && view.positions[2 * h] == view.positions[2 * g] &&
+          view.positions[2 * h + 1] == view.positions[2 * g + 1]) {
+        ++seams;
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(seams, static_cast<int>(view.tear_lines.size()));
+
+  // A color edit inside the disk changes colors inside only: sparse, no positions.
+  std::string log;
+  const Delta d = editor.apply(s, 1, color_op({48, 48}, {0, 255, 0}), log);
+  EXPECT_FALSE(d.dense_colors);
+  EXPECT_GT(d.color_indices.size(), 0u);
+  EXPECT_LT(d.color_indices.size(), static_cast<size_t>(ng) / 2);
+  EXPECT_TRUE(d.position_indices.empty() && !d.dense_positions);
+  for (uint32_t g : d.color_indices) {
+    const double x = view.positions[2 * g] - 48, y = view.positions[2 * g + 1] - 48;
+    EXPECT_LT(std::hypot(x, y), 29.0);  // inside the tear (control radius 28)
+  }
+}
+
+TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
+  Editor editor(disk());
+  const std::string s = editor.new_session();
+  const ViewMesh whole = editor.view(s, {0, 3});
+  ViewRequest zoomed{0, 3, 0, 0, 20, 20};
+  const ViewMesh part = editor.view(s, zoomed);
+  EXPECT_FALSE(whole.partial);
+  EXPECT_TRUE(part.partial);
+  EXPECT_LT(part.triangles.size(), whole.triangles.size() / 2);
+  EXPECT_EQ(status_of([&] { editor.view(s, {0, 9}); }), kBadRequest);
+  EXPECT_EQ(status_of([&] { editor.view(s, {5, 2}); }), kBadRequest);
+}
+
+// ---- HTTP ----------------------------------------------------------------------------------
+
+class ServeHttp : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("subvec-serve-test-" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    ServeOptions options;
+    options.input = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "01-disk.svec.json";
+    options.output = dir_ / "out.svec";
+    options.port = 0;
+    server_ = std::make_unique<EditorServer>(options);
+    server_->start();
+    thread_ = std::thread([this] { server_->run(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->port());
+    for (int i = 0; i < 200 && !client_->Get("/api/status"); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  void TearDown() override {
+    server_->stop();
+    thread_.join();
+    fs::remove_all(dir_);
+  }
+  static json body(const httplib::Result& r) { return json::parse(r->body, nullptr, false); }
+
+  fs::path dir_;
+  std::unique_ptr<EditorServer> server_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(ServeHttp, ServesThePageAndTheDocument) {
+  auto page = client_->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<canvas"), std::string::npos);
+  auto doc = client_->Get("/api/document");
+  ASSERT_TRUE(doc);
+  const json j = body(doc);
+  EXPECT_EQ(j["width"], 96);
+  EXPECT_EQ(j["levels"].size(), 1u);
+  EXPECT_EQ(j["filter"]["available"], false);
+}
+
+TEST_F(ServeHttp, ErrorsAreJsonWithStatus) {
+  auto expect_error = [&](const httplib::Result& r, int status) {
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, status) << r->body;
+    const json j = body(r);
+    ASSERT_TRUE(j.is_object()) << r->body;
+    EXPECT_TRUE(j["error"].is_string());
+    EXPECT_EQ(j["status"], status);
+  };
+  expect_error(client_->Get("/no/such/page"), 404);
+  expect_error(client_->Get("/api/control?level=7"), 400);
+  expect_error(client_->Get("/api/control?level=x"), 400);
+  expect_error(client_->Post("/api/select", "{\"at\": [1]}", "application/json"), 400);
+  expect_error(client_->Post("/api/select", "not json", "application/json"), 400);
+  expect_error(client_->Post("/api/select", "{\"at\": [1, 2]}", "text/plain"), 415);
+  expect_error(client_->Post("/api/view", "{\"session\": \"s99\"}", "application/json"), 404);
+  expect_error(client_->Post("/api/filter", "{}", "application/json"), 501);
+  expect_error(client_->Get("/api/download?format=exe"), 400);
+  const std::string big(100 * 1024, ' ');
+  expect_error(client_->Post("/api/select", big, "application/json"), 413);
+  httplib::Headers foreign = {{"Host", "evil.example:80"}};
+  expect_error(client_->Get("/api/status", foreign), 403);
+}
+
+TEST_F(ServeHttp, SaveWritesOnlyTheNamedFile) {
+  const fs::path out = dir_ / "out.svec";
+  EXPECT_FALSE(fs::exists(out));
+  auto session = client_->Post("/api/session", "{}", "application/json");
+  ASSERT_TRUE(session);
+  const std::string id = body(session)["session"];
+  const json edit = {{"session", id}, {"version", 1},   {"at", {48, 48}},
+                     {"color", {0, 255, 0}}, {"amount", 1}, {"radius", 40}};
+  auto r = client_->Post("/api/color", edit.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->body.substr(0, 4), "SVB1");
+  EXPECT_FALSE(fs::exists(out));  // nothing written before Save
+  auto save = client_->Post("/api/save", json{{"version", 2}}.dump(), "application/json");
+  ASSERT_TRUE(save);
+  ASSERT_EQ(save->status, 200) << save->body;
+  const VectorImage saved = subvec::read_svec(out);
+  const VectorImage original = disk();
+  EXPECT_NE(saved.levels[0].colors, original.levels[0].colors);
+  // Only out.svec in the folder (no temporary left over), the input untouched.
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 1);
+  auto stale = client_->Post("/api/save", json{{"version", 1}}.dump(), "application/json");
+  ASSERT_TRUE(stale);
+  EXPECT_EQ(stale->status, 409);
+}
+
+TEST_F(ServeHttp, APortInUseIsRefused) {
+  ServeOptions options;
+  options.input = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "01-disk.svec.json";
+  options.port = server_->port();
+  EditorServer second(options);
+  EXPECT_THROW(second.start(), subvec::Error);
+}
+
+TEST_F(ServeHttp, DownloadsAreBuiltInMemory) {
+  auto png = client_->Get("/api/download?format=png");
+  ASSERT_TRUE(png);
+  ASSERT_EQ(png->status, 200);
+  EXPECT_EQ(png->body.substr(1, 3), "PNG");
+  EXPECT_NE(png->get_header_value("Content-Disposition").find("01-disk-v1.png"), std::string::npos);
+  auto svec = client_->Get("/api/download?format=svec");
+  ASSERT_TRUE(svec);
+  EXPECT_EQ(svec->body.substr(0, 6), "SUBVEC");
+  auto pdf = client_->Get("/api/download?format=pdf");
+  ASSERT_TRUE(pdf);
+  EXPECT_EQ(pdf->body.substr(0, 5), "%PDF-");
+  EXPECT_FALSE(fs::exists(dir_ / "out.svec"));
+}
+
+}  // namespace
+}  // namespace subvec_serve

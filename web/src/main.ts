@@ -1,0 +1,703 @@
+// The subvec editor page: tools, view, and the conversation with `subvec serve` (docs/serve.md).
+//
+// State. The server owns the document and its version; this page owns a session (its refined
+// view of one level at the depth its zoom needs) and the last version it drew. Every edit sends
+// that version; a 409 answer means another tab changed the document, and the page reloads.
+// A poll of /api/status notices changes made elsewhere the same way.
+
+import { ApiError, Frame, getJson, postFrame, postJson } from './api';
+import { Renderer, Transform, softwareWebGL } from './gl';
+
+type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color';
+
+const TOOL_HELP: Record<Tool, string> = {
+  pan: 'Pan: drag to move the view. The wheel zooms at the cursor with every tool; the image is re-refined for the new zoom when you stop.',
+  select: 'Select: click to see what the other tools would pick there — the nearest feature (pink, its control chain) or control vertex, and the color region the radius grows from it (white points). Changes nothing.',
+  drag: 'Drag (as-rigid-as-possible): press on a feature (or a vertex, with "vertex" picked) and drag. The part near where you grabbed follows the mouse (σ sets how far along the feature), and the whole mesh deforms as rigidly as possible around it; the image border stays in place.',
+  move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
+  color: 'Color: click a region to recolor it with the picked color. The region is the clicked side of the nearest feature (or vertex) grown by the radius, stopped by tears. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
+};
+
+const $ = <T extends HTMLElement = HTMLElement>(id: string) => document.getElementById(id) as T;
+const canvas = $<HTMLCanvasElement>('canvas');
+const statusBox = $('status');
+
+interface LevelInfo { vertices: number; triangles: number; colors: number; features: number; mean_edge: number }
+interface DocInfo {
+  name: string; stem: string; version: number; width: number; height: number; levels: LevelInfo[];
+  undo: number; redo: number; strokes: number; save_to: string | null;
+  filter: { available: boolean; reason: string };
+}
+
+const state = {
+  doc: null as DocInfo | null,
+  session: '',
+  version: 0,
+  level: 0,
+  tool: 'drag' as Tool,
+  view: { id: 0, depth: -1, partial: false, window: null as number[] | null },
+  transform: { zoom: 1, panX: 0, panY: 0 } as Transform,
+  overlays: { mesh: false, features: false },
+  busy: 0,           // requests that change the document, in flight
+  drag: null as null | {
+    pointer: number; start: [number, number]; target: [number, number]; rotate: number;
+    shiftX: number; sentAt: number; pending: boolean; inFlight: Promise<void> | null; ok: boolean;
+    eventTime: number;
+  },
+  pan: null as null | { x: number; y: number; panX: number; panY: number },
+  space: false,
+  viewTimer: 0,
+  measure: false,
+  latencies: [] as number[],
+};
+
+let renderer: Renderer;
+
+// Refinement target: refined edges at most this many canvas pixels long, and MSAA. A GPU draws
+// the fine setting for nothing; a software WebGL pays per triangle, so it gets the coarse one
+// (about a quarter of the triangles: a drag then redraws within 50 ms). ?quality=fine|coarse
+// overrides the choice.
+const quality = (() => {
+  const asked = new URLSearchParams(location.search).get('quality');
+  const software = softwareWebGL();
+  const coarse = asked ? asked === 'coarse' : software;
+  return { edge: coarse ? 8 : 3, antialias: !coarse, software };
+})();
+
+function status(message: string, error = false) {
+  statusBox.textContent = message;
+  statusBox.classList.toggle('error', error);
+}
+
+function pick(): 'vertex' | 'feature' {
+  return (document.querySelector('input[name=pick]:checked') as HTMLInputElement).value as 'vertex' | 'feature';
+}
+function mode(): 'blend' | 'transform' {
+  return (document.querySelector('input[name=mode]:checked') as HTMLInputElement).value as 'blend' | 'transform';
+}
+const num = (id: string) => Number($<HTMLInputElement>(id).value);
+
+// ---- drawing -------------------------------------------------------------------------------
+
+let frameRequested = false;
+function redraw() {
+  if (frameRequested || !renderer) return;
+  frameRequested = true;
+  requestAnimationFrame(() => {
+    frameRequested = false;
+    renderer.draw(state.transform, state.overlays);
+  });
+}
+
+function resize() {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+  const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+    scheduleView();
+  }
+  redraw();
+}
+
+function fit() {
+  if (!state.doc) return;
+  const { width, height } = state.doc;
+  const zoom = Math.min(canvas.width / width, canvas.height / height) * 0.96;
+  state.transform = { zoom, panX: (canvas.width - width * zoom) / 2, panY: (canvas.height - height * zoom) / 2 };
+  updateZoomLabel();
+  scheduleView();
+  redraw();
+}
+
+function updateZoomLabel() {
+  $('zoom-out').textContent = `zoom ${(state.transform.zoom / (window.devicePixelRatio || 1)).toFixed(2)}×, ` +
+    `depth ${state.view.depth < 0 ? '…' : state.view.depth}` +
+    (quality.antialias ? '' : ' (software WebGL: coarser, no MSAA)');
+}
+
+// Canvas coordinates of a pointer event, and image coordinates of a canvas point.
+function canvasPoint(e: MouseEvent): [number, number] {
+  const r = canvas.getBoundingClientRect();
+  const dpr = window.devicePixelRatio || 1;
+  return [(e.clientX - r.left) * dpr, (e.clientY - r.top) * dpr];
+}
+function toImage([x, y]: [number, number]): [number, number] {
+  const t = state.transform;
+  return [(x - t.panX) / t.zoom, (y - t.panY) / t.zoom];
+}
+
+// ---- the refined view ----------------------------------------------------------------------
+
+// Depth: refine until refined edges are at most quality.edge canvas pixels long on average (the
+// CPU renderer's rule, docs/performance.md, uses 2.5); the whole level while that stays under ~1.5 M triangles, else the visible
+// window with a margin.
+function wantedView(): { depth: number; window: number[] | null } {
+  const doc = state.doc!;
+  const level = doc.levels[state.level];
+  const edge = level.mean_edge * state.transform.zoom;
+  let depth = 0;
+  while (depth < 6 && edge / 2 ** depth > quality.edge) ++depth;
+  if (level.triangles * 4 ** depth <= 1.5e6) return { depth, window: null };
+  const t = state.transform;
+  const x0 = -t.panX / t.zoom, y0 = -t.panY / t.zoom;
+  const x1 = (canvas.width - t.panX) / t.zoom, y1 = (canvas.height - t.panY) / t.zoom;
+  const mx = (x1 - x0) * 0.25, my = (y1 - y0) * 0.25;
+  return { depth, window: [x0 - mx, y0 - my, x1 + mx, y1 + my] };
+}
+
+function viewCovers(want: { depth: number; window: number[] | null }): boolean {
+  if (want.depth !== state.view.depth) return false;
+  if (!state.view.partial) return true;
+  const have = state.view.window;
+  if (!have || !want.window) return false;
+  const t = state.transform;
+  const x0 = -t.panX / t.zoom, y0 = -t.panY / t.zoom;
+  const x1 = (canvas.width - t.panX) / t.zoom, y1 = (canvas.height - t.panY) / t.zoom;
+  return x0 >= have[0] && y0 >= have[1] && x1 <= have[2] && y1 <= have[3];
+}
+
+function scheduleView() {
+  if (!state.doc || !state.session) return;
+  clearTimeout(state.viewTimer);
+  state.viewTimer = window.setTimeout(() => {
+    if (state.drag || viewLoads > 0) return scheduleView();
+    if (!viewCovers(wantedView())) void loadView();
+  }, 120);
+}
+
+// View loads run one at a time, in order, and edits wait for them: the server keeps one view per
+// session and answers edits with deltas against it, so the page must always hold the view the
+// server holds. A delta for another view (a race lost anyway) makes the page load the view again.
+let viewChain: Promise<void> = Promise.resolve();
+let viewLoads = 0;
+function loadView(): Promise<void> {
+  viewLoads++;
+  state.busy++;
+  const run = async () => {
+    try {
+      const want = wantedView();
+      const frame = await postFrame('/api/view', {
+        session: state.session, level: state.level, depth: want.depth, window: want.window,
+      });
+      renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
+      state.view = { id: frame.header.view, depth: want.depth, partial: frame.header.partial, window: want.window };
+      updateZoomLabel();
+      redraw();
+    } finally {
+      viewLoads--;
+      state.busy--;
+    }
+  };
+  viewChain = viewChain.then(run, run);
+  return viewChain;
+}
+
+async function loadControl() {
+  const c = await getJson(`/api/control?level=${state.level}`);
+  renderer.setControl(new Float32Array(c.positions), new Uint32Array(c.edges));
+}
+
+async function loadStrokes() {
+  renderer.setStrokes(await getJson(`/api/strokes?level=${state.level}`));
+}
+
+function applyDelta(frame: Frame) {
+  const h = frame.header;
+  if (typeof h.version === 'number') state.version = h.version;
+  if (h.view === state.view.id) {
+    renderer.updatePositions(h.dense_positions ? null : frame.u32.position_indices, frame.f32.positions);
+    renderer.updateColors(h.dense_colors ? null : frame.u32.color_indices, frame.u8.colors);
+  } else if (h.view) {
+    void loadView();
+  }
+  if (frame.f32.control.length > 0) renderer.setControl(frame.f32.control);
+  if (h.strokes_changed) void loadStrokes().then(redraw);
+}
+
+// ---- document ------------------------------------------------------------------------------
+
+async function loadDocument() {
+  const doc: DocInfo = await getJson('/api/document');
+  state.doc = doc;
+  state.version = doc.version;
+  if (state.level >= doc.levels.length) state.level = 0;
+  $('docname').textContent = `${doc.name} — ${doc.width}×${doc.height}`;
+  const level = $<HTMLInputElement>('level');
+  level.max = String(doc.levels.length - 1);
+  level.value = String(state.level);
+  level.disabled = doc.levels.length < 2;
+  $('level-help').textContent = doc.levels.length < 2
+    ? 'This file has one level. Levels of abstraction (a coarser image per level, issue 4) appear here when the file has them.'
+    : `${doc.levels.length} levels: 0 is the finest, higher levels are coarser abstractions.`;
+  describeLevel();
+  $('filter-note').textContent =
+    'Scales the detail of each band of the level pyramid (η < 1 smooths, > 1 sharpens). ' +
+    (doc.filter.available ? '' : `Disabled: ${doc.filter.reason}.`);
+  $('save-help').textContent = doc.save_to
+    ? `Save writes ${doc.save_to}. Downloads are made from the current state.`
+    : 'Save downloads the .svec (start the server with -o OUT.svec to save in place).';
+  updateHistoryButtons();
+}
+
+function describeLevel() {
+  const doc = state.doc;
+  if (!doc) return;
+  const l = doc.levels[state.level];
+  $('level-out').textContent = String(state.level);
+  $('level').title = `level ${state.level}: ${l.vertices} control vertices, ${l.triangles} triangles, ${l.features} features`;
+}
+
+function updateHistoryButtons() {
+  const doc = state.doc;
+  $<HTMLButtonElement>('undo').disabled = !doc || doc.undo === 0;
+  $<HTMLButtonElement>('redo').disabled = !doc || doc.redo === 0;
+}
+
+async function reloadAll(message?: string) {
+  await loadDocument();
+  await Promise.all([loadView(), loadControl(), loadStrokes()]);
+  renderer.setHighlight([], []);
+  redraw();
+  if (message) status(message);
+}
+
+async function refreshCounts() {
+  const doc: DocInfo = await getJson('/api/document');
+  if (state.doc) {
+    state.doc.undo = doc.undo;
+    state.doc.redo = doc.redo;
+    state.doc.version = doc.version;
+  }
+  updateHistoryButtons();
+}
+
+// Runs an edit; on a version conflict reloads from the server, on other errors reports them.
+async function edit(run: () => Promise<void>) {
+  state.busy++;
+  try {
+    await viewChain.catch(() => undefined);
+    await run();
+    await refreshCounts();
+  } catch (e) {
+    if (e instanceof ApiError && e.status === 409 && /another tab/.test(e.message)) {
+      await reloadAll();
+      status(e.message, true);
+    } else if (e instanceof ApiError && e.status === 404 && /session/.test(e.message)) {
+      await startSession();
+      status('the session had expired: reloaded', true);
+    } else {
+      status(e instanceof Error ? e.message : String(e), true);
+    }
+  } finally {
+    state.busy--;
+    redraw();
+  }
+}
+
+// ---- tools ---------------------------------------------------------------------------------
+
+function setTool(tool: Tool) {
+  state.tool = tool;
+  document.querySelectorAll<HTMLButtonElement>('#tools button').forEach((b) =>
+    b.classList.toggle('active', b.dataset.tool === tool));
+  $('tool-help').textContent = TOOL_HELP[tool];
+  canvas.classList.toggle('pan', tool === 'pan');
+}
+
+async function doSelect(at: [number, number]) {
+  try {
+    const r = await postJson('/api/select', { level: state.level, select: pick(), at, radius: num('radius') });
+    renderer.setHighlight(r.chain, r.region);
+    status(r.feature >= 0
+      ? `feature ${r.feature} (${r.chain.length} control vertices, ${r.distance.toFixed(1)} px away); region of ${r.colors} color values`
+      : `vertex ${r.vertex} (${r.distance.toFixed(1)} px away); region of ${r.colors} color values`);
+  } catch (e) {
+    status(e instanceof Error ? e.message : String(e), true);
+  }
+  redraw();
+}
+
+function hexColor(): number[] {
+  const v = $<HTMLInputElement>('color').value;
+  return [1, 3, 5].map((i) => parseInt(v.slice(i, i + 2), 16));
+}
+
+async function doColor(at: [number, number]) {
+  await edit(async () => {
+    const f = await postFrame('/api/color', {
+      session: state.session, version: state.version, level: state.level, at, select: pick(),
+      radius: num('radius'), mode: mode(), color: hexColor(), amount: num('amount'),
+    });
+    applyDelta(f);
+    status(`${mode()}: ${f.header.log}`);
+  });
+}
+
+async function doStylize() {
+  await edit(async () => {
+    const threshold = $<HTMLInputElement>('threshold').value;
+    const f = await postFrame('/api/stylize', {
+      session: state.session, version: state.version, level: state.level,
+      threshold: threshold === '' ? null : Number(threshold), seed: num('seed'), probability: num('probability'),
+    });
+    applyDelta(f);
+    status(`stylize: ${f.header.log}`);
+  });
+}
+
+async function doHistory(kind: 'undo' | 'redo') {
+  await edit(async () => {
+    const f = await postFrame(`/api/${kind}`, { session: state.session, version: state.version });
+    applyDelta(f);
+    renderer.setHighlight([], []);
+    status(`${kind} (version ${state.version})`);
+  });
+}
+
+function download(format: string) {
+  const a = document.createElement('a');
+  a.href = `/api/download?format=${format}&level=${state.level}`;
+  a.download = '';
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+}
+
+async function doSave() {
+  if (!state.doc?.save_to) {
+    download('svec');
+    status('downloading the .svec');
+    return;
+  }
+  await edit(async () => {
+    const r = await postJson('/api/save', { version: state.version });
+    status(`saved ${r.saved} (version ${r.version})`);
+  });
+}
+
+async function setLevel(level: number) {
+  if (!state.doc || level < 0 || level >= state.doc.levels.length || level === state.level) return;
+  state.level = level;
+  $<HTMLInputElement>('level').value = String(level);
+  describeLevel();
+  renderer.setHighlight([], []);
+  await Promise.all([loadView(), loadControl(), loadStrokes()]);
+  status(`level ${level}`);
+}
+
+// Drag and move: start picks the handle on the server (and factors the ARAP system), moves are
+// previews (one request in flight; the latest mouse position wins), the release commits.
+async function dragStart(e: PointerEvent) {
+  const at = toImage(canvasPoint(e));
+  const drag = {
+    pointer: e.pointerId, start: at, target: at, rotate: 0, shiftX: canvasPoint(e)[0], sentAt: 0,
+    pending: false, inFlight: null as Promise<void> | null, ok: false, eventTime: 0,
+  };
+  state.drag = drag;
+  canvas.setPointerCapture(e.pointerId);
+  state.busy++;
+  try {
+    await viewChain.catch(() => undefined);
+    const r = await postJson('/api/drag/start', {
+      session: state.session, version: state.version, level: state.level, tool: state.tool,
+      select: state.tool === 'move' ? 'feature' : pick(), at, sigma: num('sigma'), region: num('region'),
+    });
+    renderer.setHighlight(r.chain, r.vertex >= 0 ? [r.vertex] : []);
+    drag.ok = true;
+    status(r.feature >= 0 ? `dragging feature ${r.feature}` : `dragging vertex ${r.vertex}`);
+    pump();
+  } catch (e) {
+    state.drag = null;
+    state.busy--;
+    if (e instanceof ApiError && e.status === 409) await reloadAll();
+    status(e instanceof Error ? e.message : String(e), true);
+  }
+}
+
+function pump() {
+  const drag = state.drag;
+  if (!drag || !drag.ok || drag.inFlight || !drag.pending) return;
+  drag.pending = false;
+  const eventTime = drag.eventTime;
+  drag.inFlight = (async () => {
+    try {
+      const f = await postFrame('/api/drag/move', { session: state.session, to: drag.target, rotate: drag.rotate });
+      applyDelta(f);
+      renderer.draw(state.transform, state.overlays);
+      if (state.measure) {
+        renderer.readPixel(0, 0);  // waits until the frame is drawn
+        state.latencies.push(performance.now() - eventTime);
+      }
+    } catch (e) {
+      // A preview the mesh cannot take (a flip): keep the last good one, say why.
+      status(e instanceof Error ? e.message : String(e), true);
+    } finally {
+      drag.inFlight = null;
+      pump();
+    }
+  })();
+}
+
+function dragMove(e: PointerEvent) {
+  const drag = state.drag;
+  if (!drag || e.pointerId !== drag.pointer) return;
+  const p = canvasPoint(e);
+  if (state.tool === 'move' && e.shiftKey) {
+    drag.rotate = (p[0] - drag.shiftX) * 0.5;
+  } else {
+    drag.target = toImage(p);
+    drag.shiftX = p[0] - drag.rotate * 2;
+  }
+  drag.pending = true;
+  drag.eventTime = e.timeStamp || performance.now();
+  pump();
+}
+
+async function dragEnd(e: PointerEvent | null, cancel = false) {
+  const drag = state.drag;
+  if (!drag || (e && e.pointerId !== drag.pointer)) return;
+  if (e) dragMove(e);
+  while (!drag.ok && state.drag === drag) await new Promise((r) => setTimeout(r, 10));
+  if (state.drag !== drag) return;
+  drag.pending = false;
+  while (drag.inFlight) await drag.inFlight;
+  state.drag = null;
+  try {
+    if (cancel) {
+      await postJson('/api/drag/cancel', { session: state.session });
+      await loadView();
+      await loadControl();
+      status('drag cancelled');
+      return;
+    }
+    await edit(async () => {
+      let f: Frame;
+      try {
+        f = await postFrame('/api/drag/end', {
+          session: state.session, version: state.version, to: drag.target, rotate: drag.rotate,
+        });
+      } catch (e) {
+        // Refused (a flip, say): the document did not change, so drop the preview.
+        await Promise.all([loadView(), loadControl()]);
+        throw e;
+      }
+      applyDelta(f);
+      status(f.header.log);
+      if (state.view.partial) await loadView();
+    });
+  } finally {
+    state.busy--;
+    redraw();
+  }
+}
+
+// ---- input ---------------------------------------------------------------------------------
+
+canvas.addEventListener('pointerdown', (e) => {
+  if (!state.doc || !state.session) return;
+  const panning = state.tool === 'pan' || e.button === 1 || e.button === 2 || state.space;
+  if (panning) {
+    const [x, y] = canvasPoint(e);
+    state.pan = { x, y, panX: state.transform.panX, panY: state.transform.panY };
+    canvas.setPointerCapture(e.pointerId);
+    return;
+  }
+  if (e.button !== 0 || state.drag) return;
+  const at = toImage(canvasPoint(e));
+  if (state.tool === 'select') void doSelect(at);
+  else if (state.tool === 'color') void doColor(at);
+  else void dragStart(e);
+});
+canvas.addEventListener('pointermove', (e) => {
+  if (state.pan) {
+    const [x, y] = canvasPoint(e);
+    state.transform.panX = state.pan.panX + x - state.pan.x;
+    state.transform.panY = state.pan.panY + y - state.pan.y;
+    redraw();
+    scheduleView();
+    return;
+  }
+  dragMove(e);
+});
+const release = (e: PointerEvent) => {
+  if (state.pan) {
+    state.pan = null;
+    return;
+  }
+  void dragEnd(e);
+};
+canvas.addEventListener('pointerup', release);
+canvas.addEventListener('pointercancel', (e) => { state.pan = null; void dragEnd(e, true); });
+canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  const [x, y] = canvasPoint(e);
+  const t = state.transform;
+  const factor = Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015));
+  const zoom = Math.min(256, Math.max(0.02, t.zoom * factor));
+  t.panX = x - ((x - t.panX) * zoom) / t.zoom;
+  t.panY = y - ((y - t.panY) * zoom) / t.zoom;
+  t.zoom = zoom;
+  updateZoomLabel();
+  redraw();
+  scheduleView();
+}, { passive: false });
+
+window.addEventListener('keydown', (e) => {
+  const target = e.target as HTMLElement;
+  if (target && (target.tagName === 'INPUT' && (target as HTMLInputElement).type === 'number')) return;
+  const ctrl = e.ctrlKey || e.metaKey;
+  const key = e.key.toLowerCase();
+  if (ctrl && key === 'z') { e.preventDefault(); void doHistory(e.shiftKey ? 'redo' : 'undo'); return; }
+  if (ctrl && key === 'y') { e.preventDefault(); void doHistory('redo'); return; }
+  if (ctrl && key === 's') { e.preventDefault(); void doSave(); return; }
+  if (ctrl || e.altKey) return;
+  if (e.key === ' ') { state.space = true; canvas.classList.add('pan'); e.preventDefault(); return; }
+  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color' };
+  if (tools[key]) { setTool(tools[key]); return; }
+  if (key === 'f') { toggleRadio('pick'); return; }
+  if (key === 'b') { toggleRadio('mode'); return; }
+  if (key === 'y') { void doStylize(); return; }
+  if (key === '0') { fit(); return; }
+  if (key === '1') { toggleCheck('show-mesh'); return; }
+  if (key === '2') { toggleCheck('show-features'); return; }
+  if (key === '[') { void setLevel(state.level - 1); return; }
+  if (key === ']') { void setLevel(state.level + 1); return; }
+  if (key === 'escape' && state.drag) { void dragEnd(null, true); }
+});
+window.addEventListener('keyup', (e) => {
+  if (e.key === ' ') { state.space = false; canvas.classList.toggle('pan', state.tool === 'pan'); }
+});
+
+function toggleRadio(name: string) {
+  const inputs = Array.from(document.querySelectorAll<HTMLInputElement>(`input[name=${name}]`));
+  const i = inputs.findIndex((x) => x.checked);
+  inputs[(i + 1) % inputs.length].checked = true;
+}
+function toggleCheck(id: string) {
+  const box = $<HTMLInputElement>(id);
+  box.checked = !box.checked;
+  box.dispatchEvent(new Event('change'));
+}
+
+function bindOutput(id: string, format: (v: number) => string) {
+  const input = $<HTMLInputElement>(id);
+  const show = () => { $(`${id}-out`).textContent = format(Number(input.value)); };
+  input.addEventListener('input', show);
+  show();
+}
+
+function wireControls() {
+  document.querySelectorAll<HTMLButtonElement>('#tools button').forEach((b) =>
+    b.addEventListener('click', () => setTool(b.dataset.tool as Tool)));
+  bindOutput('radius', (v) => `${v} px`);
+  bindOutput('sigma', (v) => `${v} px`);
+  bindOutput('region', (v) => (v === 0 ? 'whole' : `${v} px`));
+  bindOutput('amount', (v) => v.toFixed(2));
+  $('level').addEventListener('input', () => void setLevel(num('level')));
+  $('show-mesh').addEventListener('change', () => { state.overlays.mesh = $<HTMLInputElement>('show-mesh').checked; redraw(); });
+  $('show-features').addEventListener('change', () => { state.overlays.features = $<HTMLInputElement>('show-features').checked; redraw(); });
+  $('fit').addEventListener('click', fit);
+  $('undo').addEventListener('click', () => void doHistory('undo'));
+  $('redo').addEventListener('click', () => void doHistory('redo'));
+  $('save').addEventListener('click', () => void doSave());
+  $('stylize').addEventListener('click', () => void doStylize());
+  document.querySelectorAll<HTMLAnchorElement>('.downloads a').forEach((a) =>
+    a.addEventListener('click', (e) => { e.preventDefault(); download(a.dataset.format!); }));
+  setTool('drag');
+}
+
+// ---- start-up and polling ------------------------------------------------------------------
+
+async function startSession() {
+  state.session = (await postJson('/api/session', {})).session;
+  await reloadAll();
+}
+
+async function waitForDocument() {
+  const progress = $('progress');
+  for (;;) {
+    const s = await getJson('/api/status');
+    if (s.state === 'ready') break;
+    if (s.state === 'failed') {
+      progress.hidden = false;
+      $('progress-text').textContent = `Vectorization failed: ${s.error}`;
+      throw new Error(s.error);
+    }
+    progress.hidden = false;
+    $('docname').textContent = s.name;
+    $('progress-text').textContent =
+      `Vectorizing ${s.name}: ${s.stage} ${Math.round(s.fraction * 100)}% (${Math.round(s.seconds)} s)`;
+    $('progress-bar').style.width = `${Math.round(s.fraction * 100)}%`;
+    await new Promise((r) => setTimeout(r, 300));
+  }
+  progress.hidden = true;
+}
+
+async function poll() {
+  try {
+    const s = await getJson('/api/status');
+    if (s.state === 'ready' && s.version > state.version && state.busy === 0 && !state.drag) {
+      await reloadAll(`the document changed in another tab: now version ${s.version}`);
+    }
+  } catch {
+    // the server may be gone; keep trying quietly
+  }
+  setTimeout(poll, 1000);
+}
+
+// Hooks for the end-to-end tests and the benchmark (web/tests/).
+declare global {
+  interface Window { subvec: any }
+}
+window.subvec = {
+  state,
+  renderer: () => renderer,
+  ready: false,
+  // RGBA of the canvas at image coordinates (x, y), after a synchronous redraw.
+  pixelAt(x: number, y: number) {
+    renderer.draw(state.transform, state.overlays);
+    const t = state.transform;
+    return renderer.readPixel(x * t.zoom + t.panX, y * t.zoom + t.panY);
+  },
+  // Canvas CSS coordinates (relative to the page) of image point (x, y).
+  clientPoint(x: number, y: number) {
+    const r = canvas.getBoundingClientRect();
+    const dpr = window.devicePixelRatio || 1;
+    const t = state.transform;
+    return [r.left + (x * t.zoom + t.panX) / dpr, r.top + (y * t.zoom + t.panY) / dpr];
+  },
+  idle() { return state.busy === 0 && !state.drag; },
+  measure(on: boolean) { state.measure = on; state.latencies = []; },
+  latencies() { return state.latencies.slice(); },
+};
+
+async function main() {
+  wireControls();
+  try {
+    renderer = new Renderer(canvas, quality.antialias);
+  } catch (e) {
+    status(`cannot draw: ${e instanceof Error ? e.message : e}`, true);
+    return;
+  }
+  new ResizeObserver(resize).observe(canvas);
+  resize();
+  try {
+    await waitForDocument();
+    state.session = (await postJson('/api/session', {})).session;
+    await loadDocument();
+    fit();
+    await Promise.all([loadView(), loadControl(), loadStrokes()]);
+    const doc = state.doc!;
+    const l = doc.levels[state.level];
+    status(`${doc.name}: ${l.vertices} control vertices, ${l.features} features. Pick a tool on the left; its description appears below the buttons.`);
+    window.subvec.ready = true;
+    setTimeout(poll, 1000);
+  } catch (e) {
+    status(e instanceof Error ? e.message : String(e), true);
+  }
+}
+
+void main();

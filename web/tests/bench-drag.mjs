@@ -1,0 +1,69 @@
+// Drag latency of the browser editor, end to end: from the pointer event in headless Chromium
+// (software WebGL) through the server's ARAP solve and limit evaluation to the redrawn pixels
+// (the page reads one pixel back after drawing, which waits for the frame).
+//
+//   node web/tests/bench-drag.mjs BUILD/bin/subvec IMAGE.svec [--moves N] [--width W --height H]
+//                                 [--quality fine|coarse]   (default: what the page picks)
+//
+// Grabs the longest feature at its middle vertex and drags it in N one-pixel steps, one at a
+// time (each move waits for its frame, so latencies do not queue). Prints the latencies' median,
+// 90th percentile and maximum, and the size of what was drawn.
+import { findChromium, launch, serve, stop, openEditor, client } from './harness.mjs';
+
+const [binary, input, ...rest] = process.argv.slice(2);
+const opt = (name, fallback) => {
+  const i = rest.indexOf(name);
+  return i >= 0 ? Number(rest[i + 1]) : fallback;
+};
+const moves = opt('--moves', 40);
+const qi = rest.indexOf('--quality');
+const quality = qi >= 0 ? rest[qi + 1] : '';
+const viewport = { width: opt('--width', 1280), height: opt('--height', 800) };
+const chromium = findChromium();
+if (!binary || !input || !chromium) {
+  console.error('usage: node web/tests/bench-drag.mjs SUBVEC IMAGE.svec (needs Debian\'s chromium)');
+  process.exit(2);
+}
+
+const server = await serve(binary, [input]);
+const browser = await launch(chromium);
+try {
+  const { page } = await openEditor(browser, server.url + (quality ? `?quality=${quality}` : ''), viewport);
+  const info = await page.evaluate(async () => {
+    const doc = await (await fetch('/api/document')).json();
+    const control = await (await fetch('/api/control?level=0')).json();
+    let best = control.features[0];
+    for (const f of control.features) if (f.length > best.length) best = f;
+    const v = best[Math.floor(best.length / 2)];
+    return {
+      vertices: doc.levels[0].vertices, triangles: doc.levels[0].triangles,
+      at: [control.positions[2 * v], control.positions[2 * v + 1]], size: [doc.width, doc.height],
+    };
+  });
+  await page.keyboard.press('d');
+  await page.evaluate(() => window.subvec.measure(true));
+  const [x0, y0] = await client(page, ...info.at);
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  await page.waitForFunction(() => window.subvec.state.drag && window.subvec.state.drag.ok);
+  const zoom = await page.evaluate(() => window.subvec.state.transform.zoom);
+  for (let i = 1; i <= moves; ++i) {
+    // One image pixel per move, alternating right and down.
+    await page.mouse.move(x0 + Math.ceil(i / 2) * zoom, y0 + Math.floor(i / 2) * zoom);
+    await page.waitForFunction((n) => window.subvec.latencies().length >= n, i, { timeout: 30000 });
+  }
+  await page.mouse.up();
+  const latencies = await page.evaluate(() => window.subvec.latencies());
+  const view = await page.evaluate(() => ({
+    depth: window.subvec.state.view.depth, zoom: document.getElementById('zoom-out').textContent, canvas: [document.getElementById('canvas').width, document.getElementById('canvas').height],
+  }));
+  const sorted = latencies.slice().sort((a, b) => a - b);
+  const q = (p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
+  console.log(`image ${info.size[0]}x${info.size[1]}, ${info.vertices} control vertices, ${info.triangles} triangles; ` +
+    `canvas ${view.canvas[0]}x${view.canvas[1]}, refinement depth ${view.depth} (${info.triangles * 4 ** view.depth} triangles drawn; ${view.zoom})`);
+  console.log(`drag redraw, ${latencies.length} moves: median ${q(0.5).toFixed(1)} ms, p90 ${q(0.9).toFixed(1)} ms, ` +
+    `max ${sorted[sorted.length - 1].toFixed(1)} ms`);
+} finally {
+  await browser.close();
+  await stop(server);
+}
