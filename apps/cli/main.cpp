@@ -446,6 +446,7 @@ struct VectorizeArgs {
   int64_t max_pixels = int64_t{1} << 23;
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
+  int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
 };
 
@@ -465,6 +466,7 @@ void run_vectorize(const VectorizeArgs& a) {
   options.vertices = a.vertices;
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
+  options.threads = a.threads;
   if (!a.segment.empty()) {
     subvec::PixelRect rect;
     parse_rect(a.segment, rect);  // already validated by CLI11
@@ -477,8 +479,9 @@ void run_vectorize(const VectorizeArgs& a) {
   const subvec::VectorImage v = subvec::vectorize(image, options, &report);
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
-  const subvec::ImageDifference d =
-      subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
+  subvec::RenderOptions render_options;
+  render_options.threads = a.threads;
+  const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
   progress.update("writing", 1.0);
@@ -741,6 +744,8 @@ int run(int argc, char** argv) {
             return parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
+  vectorize->add_option("--threads", va.threads, "Worker threads; 0 (default) uses all cores")
+      ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   vectorize->footer(
       "Examples:\n"
