@@ -109,6 +109,10 @@ struct RenderArgs {
   int threads = 0;
   int depth = -1;
   double tolerance = 0.25;  // .pdf and .svg only
+  // Output pixels refused by default: a file of a few hundred bytes may declare a 65536 x 4096
+  // image, whose render at 1x would take half a minute and gigabytes. 2^26 (8192 x 8192) renders
+  // in seconds with about 400 MB.
+  int64_t max_pixels = int64_t{1} << 26;
 };
 
 // Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
@@ -188,6 +192,12 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
         << subvec::Limits::kMaxDimension << " pixels a side and " << kMaxOutputPixels
         << " pixels in all)";
     throw Error(ErrorCode::kLimit, msg.str());
+  }
+  if (out_w * out_h > double(a.max_pixels)) {
+    throw Error(ErrorCode::kLimit, "output size " + std::to_string(int64_t(out_w)) + "x" +
+                                       std::to_string(int64_t(out_h)) + " is over the limit of " +
+                                       std::to_string(a.max_pixels) +
+                                       " pixels (--max-pixels raises the limit)");
   }
   options.width = static_cast<int>(out_w);
   options.height = static_cast<int>(out_h);
@@ -631,6 +641,10 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"none", "mesh", "features"}, CLI::ignore_case))
       ->default_str("none");
   render->add_flag("--no-aa", ra.no_aa, "Disable anti-aliasing of tears and the image border");
+  render
+      ->add_option("--max-pixels", ra.max_pixels,
+                   ".png: refuse larger outputs (default 67108864 = 8192 x 8192; at most 2^28)")
+      ->check(CLI::Range(int64_t{1}, kMaxOutputPixels));
   render->add_option("--threads", ra.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   render
