@@ -1,6 +1,7 @@
 // libFuzzer target: the binary `.svec` reader. Any input either parses into a valid image, which
-// must then survive a write/read round trip unchanged (or be refused by the compact writer), or is rejected with subvec::Error. Anything
-// else (a crash, a sanitizer report, another exception type, a hang) is a bug.
+// must then survive a write/read round trip unchanged (or be refused by the compact writer), or
+// is rejected with subvec::Error. Anything else (a crash, a sanitizer report, another exception
+// type, a hang) is a bug.
 #include <cstdint>
 #include <cstdlib>
 #include <span>
