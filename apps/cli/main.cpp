@@ -113,6 +113,10 @@ struct RenderArgs {
   int depth = -1;
   double tolerance = 0.25;  // .pdf and .svg only
   bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
+  // Output pixels refused by default: a file of a few hundred bytes may declare a 65536 x 4096
+  // image, whose render at 1x would take half a minute and gigabytes. 2^26 (8192 x 8192) renders
+  // in seconds with about 400 MB.
+  int64_t max_pixels = int64_t{1} << 26;
 };
 
 // Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
@@ -192,6 +196,12 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
         << subvec::Limits::kMaxDimension << " pixels a side and " << kMaxOutputPixels
         << " pixels in all)";
     throw Error(ErrorCode::kLimit, msg.str());
+  }
+  if (out_w * out_h > double(a.max_pixels)) {
+    throw Error(ErrorCode::kLimit, "output size " + std::to_string(int64_t(out_w)) + "x" +
+                                       std::to_string(int64_t(out_h)) + " is over the limit of " +
+                                       std::to_string(a.max_pixels) +
+                                       " pixels (--max-pixels raises the limit)");
   }
   options.width = static_cast<int>(out_w);
   options.height = static_cast<int>(out_h);
@@ -469,6 +479,7 @@ struct VectorizeArgs {
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
   int grid_step = 0;     // 0: automatic
+  int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
   subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
 };
@@ -490,6 +501,7 @@ void run_vectorize(const VectorizeArgs& a) {
   options.initial_mesh.grid_step = a.grid_step;
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
+  options.threads = a.threads;
   if (!a.segment.empty()) {
     subvec::PixelRect rect;
     parse_rect(a.segment, rect);  // already validated by CLI11
@@ -509,8 +521,9 @@ void run_vectorize(const VectorizeArgs& a) {
   // ---- end levels ----
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
-  const subvec::ImageDifference d =
-      subvec::compare(image, subvec::render(v, subvec::RenderOptions{}));
+  subvec::RenderOptions render_options;
+  render_options.threads = a.threads;
+  const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
   progress.update("writing", 1.0);
@@ -683,6 +696,10 @@ int run(int argc, char** argv) {
   render->add_flag("--gpu", ra.gpu,
                    "Render .png output with OpenGL through headless EGL (falls back to the CPU, with "
                    "a message, when no GPU context can be created)");
+  render
+      ->add_option("--max-pixels", ra.max_pixels,
+                   ".png: refuse larger outputs (default 67108864 = 8192 x 8192; at most 2^28)")
+      ->check(CLI::Range(int64_t{1}, kMaxOutputPixels));
   render->add_option("--threads", ra.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   render
@@ -801,6 +818,8 @@ int run(int argc, char** argv) {
                    "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
                    "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
       ->check(CLI::Range(0, 2));
+  vectorize->add_option("--threads", va.threads, "Worker threads; 0 (default) uses all cores")
+      ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   subvec_cli::add_level_options(vectorize, va.levels);  // levels
   vectorize->footer(

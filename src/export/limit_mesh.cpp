@@ -83,6 +83,18 @@ int export_depth(const VectorImage& image, const ExportOptions& options, ExportR
   }
   if (!(options.scale > 0) || !std::isfinite(options.scale))
     invalid("scale " + num(options.scale) + " is not a positive number");
+  // The page, in output units: PDF viewers and SVG renderers draw nothing sensible outside these
+  // bounds (the numbers of a page 1e300 units wide print with hundreds of digits).
+  const double page_width = image.width * options.scale, page_height = image.height * options.scale;
+  if (!(page_width <= Limits::kMaxDimension && page_height <= Limits::kMaxDimension)) {
+    throw Error(ErrorCode::kLimit, "output size " + num(page_width) + "x" + num(page_height) +
+                                       " is too large (at most " +
+                                       std::to_string(Limits::kMaxDimension) + " units a side)");
+  }
+  if (page_width < 1 || page_height < 1) {
+    invalid("output size " + num(page_width) + "x" + num(page_height) +
+            " is too small (at least 1 unit a side)");
+  }
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
     invalid("tolerance " + num(options.tolerance) + " is not a positive number");
   if (!(options.color_tolerance > 0) || !std::isfinite(options.color_tolerance))

@@ -1,4 +1,4 @@
-// Raster image files through OpenCV (io/image_io.h).
+// Raster image files through OpenCV, and PNG through libpng (io/image_io.h).
 //
 // Reading: the whole file is read into memory (io/file.h), its size checked against `max_pixels`
 // from the header where we can parse it cheaply (PNG IHDR, JPEG SOFn, BMP DIB header, WebP VP8 /
@@ -12,15 +12,21 @@
 //    orientation; other formats are decoded as stored (IMREAD_UNCHANGED keeps alpha and depth).
 // A PNG whose chunks are cut short or fail their CRC, a JPEG whose entropy-coded data has no
 // end-of-image marker, and a BMP shorter than its rows are reported as truncated before decoding
-// (libpng would print to stderr, libjpeg would fill the missing rows with grey). Other formats are
-// refused before decoding. OpenCV's own messages about damaged files (std::cerr) are muted during
-// the decode; the decoders' C libraries may still print warnings about unusual but readable files
-// (libpng's "iCCP: known incorrect sRGB profile").
+// (libjpeg would fill the missing rows with grey). PNG is decoded with libpng directly, so that its
+// errors become messages instead of lines on stderr (decode_png). An image whose header declares
+// no pixels, or a TIFF whose size cannot be found in its header, is refused before decoding.
+// Other formats are refused before decoding. OpenCV's own messages about damaged files (std::cerr)
+// are muted during the decode; libjpeg may still print a warning about a damaged but readable JPEG
+// ("Corrupt JPEG data: ...").
 //
 // Writing: encoded to memory, then written atomically.
 #include "subvec/io/image_io.h"
 
+#include <png.h>
+
 #include <array>
+#include <bit>
+#include <csetjmp>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -265,29 +271,47 @@ HeaderSize webp_size(const std::vector<uint8_t>& b) {
   return {};
 }
 
-// TIFF (classic, either byte order): the first image file directory's ImageWidth (256) and
-// ImageLength (257) entries, SHORT or LONG.
+// TIFF (classic or BigTIFF, either byte order): the first image file directory's ImageWidth (256)
+// and ImageLength (257) entries, SHORT, LONG or (BigTIFF) LONG8.
 HeaderSize tiff_size(const std::vector<uint8_t>& b) {
   if (b.size() < 8) return {};
-  const bool little = b[0] == 'I' && b[1] == 'I' && b[2] == 42 && b[3] == 0;
-  const bool big = b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42;
-  if (!little && !big) return {};
+  const bool little = b[0] == 'I' && b[1] == 'I';
   const auto u16 = [&](size_t at) {
     return little ? little_endian_u16(b.data() + at) : big_endian_u16(b.data() + at);
   };
   const auto u32 = [&](size_t at) {
     return little ? little_endian_u32(b.data() + at) : big_endian_u32(b.data() + at);
   };
-  const size_t ifd = u32(4);
-  if (ifd > b.size() - 2) return {};
-  const size_t entries = u16(ifd);
+  const auto u64 = [&](size_t at) {
+    const uint64_t lo = u32(at + (little ? 0 : 4)), hi = u32(at + (little ? 4 : 0));
+    return hi << 32 | lo;
+  };
+  const bool big_tiff = u16(2) == 43;
+  // Classic: 4-byte directory offset, 2-byte entry count, 12-byte entries with the value at 8.
+  // BigTIFF: 8-byte offset at 8, 8-byte entry count, 20-byte entries with the value at 12.
+  if (big_tiff && b.size() < 16) return {};
+  const uint64_t ifd = big_tiff ? u64(8) : u32(4);
+  const size_t count_size = big_tiff ? 8 : 2, entry_size = big_tiff ? 20 : 12;
+  if (ifd > b.size() || b.size() - ifd < count_size) return {};
+  const uint64_t entries = big_tiff ? u64(ifd) : u16(ifd);
   HeaderSize size;
-  for (size_t k = 0; k < entries && ifd + 2 + 12 * (k + 1) <= b.size(); ++k) {
-    const size_t e = ifd + 2 + 12 * k;
+  for (uint64_t k = 0; k < entries && k < 4096; ++k) {
+    const size_t e = ifd + count_size + entry_size * k;
+    if (e + entry_size > b.size()) break;
     const uint32_t tag = u16(e), type = u16(e + 2);
-    if ((tag != 256 && tag != 257) || (type != 3 && type != 4)) continue;
-    const int64_t value = type == 3 ? u16(e + 8) : u32(e + 8);
-    (tag == 256 ? size.width : size.height) = value;
+    if (tag != 256 && tag != 257) continue;
+    const size_t value = e + (big_tiff ? 12 : 8);
+    int64_t v;
+    if (type == 3) {
+      v = u16(value);
+    } else if (type == 4) {
+      v = u32(value);
+    } else if (type == 16 && big_tiff) {
+      v = static_cast<int64_t>(std::min<uint64_t>(u64(value), uint64_t{1} << 62));
+    } else {
+      continue;
+    }
+    (tag == 256 ? size.width : size.height) = v;
   }
   return size.width >= 0 && size.height >= 0 ? size : HeaderSize{};
 }
@@ -300,6 +324,102 @@ void check_pixels(const fs::path& path, int64_t width, int64_t height, int64_t m
                                        " pixels is over the limit of " +
                                        std::to_string(max_pixels) + " pixels");
   }
+}
+
+// The size a header declares: refused when empty or over the limit.
+void check_header(const fs::path& path, const HeaderSize& size, int64_t max_pixels) {
+  if (size.width < 0) return;
+  if (size.width == 0 || size.height == 0) {
+    fail(ErrorCode::kBadFile, path,
+         "the header declares " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+             " pixels");
+  }
+  check_pixels(path, size.width, size.height, max_pixels);
+}
+
+// ---- PNG through libpng ----------------------------------------------------------------------
+//
+// OpenCV's PNG decoder keeps libpng's default handlers, which print "libpng error: ..." and
+// "libpng warning: ..." on stderr. Decoding here, errors become the exception's message and
+// warnings are dropped. The result is what OpenCV's IMREAD_UNCHANGED gives: gray, gray + alpha,
+// BGR or BGRA, 8 or 16 bits per sample; palettes and tRNS expanded.
+
+struct PngInput {
+  const uint8_t* data;
+  size_t size, pos;
+};
+
+struct PngError {
+  std::string message;
+};
+
+void png_on_error(png_structp png, png_const_charp message) {
+  static_cast<PngError*>(png_get_error_ptr(png))->message = message ? message : "unknown error";
+  png_longjmp(png, 1);
+}
+void png_on_warning(png_structp, png_const_charp) {}
+
+void png_read_bytes(png_structp png, png_bytep out, png_size_t n) {
+  auto* in = static_cast<PngInput*>(png_get_io_ptr(png));
+  if (n > in->size - in->pos) png_error(png, "file is truncated");
+  std::memcpy(out, in->data + in->pos, n);
+  in->pos += n;
+}
+
+class PngReadStruct {
+ public:
+  explicit PngReadStruct(PngError* error)
+      : png_(png_create_read_struct(PNG_LIBPNG_VER_STRING, error, png_on_error, png_on_warning)),
+        info_(png_ ? png_create_info_struct(png_) : nullptr) {
+    if (!png_ || !info_) throw std::bad_alloc();
+  }
+  ~PngReadStruct() { png_destroy_read_struct(&png_, &info_, nullptr); }
+  PngReadStruct(const PngReadStruct&) = delete;
+  PngReadStruct& operator=(const PngReadStruct&) = delete;
+  png_structp png() const { return png_; }
+  png_infop info() const { return info_; }
+
+ private:
+  png_structp png_;
+  png_infop info_;
+};
+
+// Ancillary chunks (text, ICC profiles) may be compressed: at most this much memory for one.
+constexpr png_alloc_size_t kMaxPngChunkBytes = png_alloc_size_t{8} << 20;
+
+cv::Mat decode_png(const std::vector<uint8_t>& bytes, const fs::path& path, int64_t max_pixels) {
+  PngError error;
+  PngInput input{bytes.data(), bytes.size(), 0};
+  const PngReadStruct s(&error);
+  png_structp png = s.png();
+  png_infop info = s.info();
+  cv::Mat out;
+  std::vector<png_bytep> rows;
+  // libpng reports errors by longjmp back here; only C frames and the callbacks above (which hold
+  // no objects with destructors) lie between.
+  if (setjmp(png_jmpbuf(png))) {
+    fail(ErrorCode::kBadFile, path, "damaged PNG data (" + error.message + ")");
+  }
+  png_set_read_fn(png, &input, png_read_bytes);
+  png_set_user_limits(png, 1u << 24, 1u << 24);  // wider than any image under the pixel limit
+  png_set_chunk_malloc_max(png, kMaxPngChunkBytes);
+  png_read_info(png, info);
+  const png_uint_32 width = png_get_image_width(png, info), height = png_get_image_height(png, info);
+  check_pixels(path, width, height, max_pixels);
+  png_set_expand(png);  // palette to BGR, gray under 8 bits to 8, tRNS to alpha
+  png_set_bgr(png);
+  if (png_get_bit_depth(png, info) == 16 && std::endian::native == std::endian::little)
+    png_set_swap(png);
+  png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  const int channels = png_get_channels(png, info);
+  const int depth = png_get_bit_depth(png, info) == 16 ? CV_16U : CV_8U;
+  out.create(int(height), int(width), CV_MAKETYPE(depth, channels));
+  rows.resize(height);
+  for (png_uint_32 y = 0; y < height; ++y) rows[y] = out.ptr<png_byte>(int(y));
+  png_read_image(png, rows.data());
+  png_read_end(png, nullptr);
+  return out;
 }
 
 // Any decoded depth to 8 bits per sample.
@@ -332,37 +452,46 @@ Image8 read_image(const fs::path& path, int64_t max_pixels) {
   const std::vector<uint8_t> bytes = read_file(path);
   if (bytes.empty()) fail(ErrorCode::kBadFile, path, "file is empty");
 
-  // Only the five documented formats reach OpenCV's decoders.
+  // Only the five documented formats reach the decoders.
   constexpr const char* kTruncated = "file is truncated or not an image";
   int flags = cv::IMREAD_UNCHANGED;
   if (is_png(bytes)) {
-    const HeaderSize size = png_size(bytes);
-    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+    check_header(path, png_size(bytes), max_pixels);
     if (!png_complete(bytes)) fail(ErrorCode::kBadFile, path, kTruncated);
   } else if (is_jpeg(bytes)) {
     const JpegScan scan = scan_jpeg(bytes);
-    if (scan.size.width >= 0) check_pixels(path, scan.size.width, scan.size.height, max_pixels);
+    check_header(path, scan.size, max_pixels);
     if (!scan.complete) fail(ErrorCode::kBadFile, path, kTruncated);
     flags = cv::IMREAD_COLOR;  // CMYK conversion and EXIF orientation; JPEG has no alpha
   } else if (is_bmp(bytes)) {
-    const HeaderSize size = bmp_size(bytes);
-    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+    check_header(path, bmp_size(bytes), max_pixels);
     if (!bmp_complete(bytes)) fail(ErrorCode::kBadFile, path, kTruncated);
-  } else if (is_webp(bytes) || is_tiff(bytes)) {
-    const HeaderSize size = is_webp(bytes) ? webp_size(bytes) : tiff_size(bytes);
-    if (size.width >= 0) check_pixels(path, size.width, size.height, max_pixels);
+  } else if (is_webp(bytes)) {
+    check_header(path, webp_size(bytes), max_pixels);
+  } else if (is_tiff(bytes)) {
+    // Without the size from the header the limit could not be checked before decoding.
+    const HeaderSize size = tiff_size(bytes);
+    if (size.width < 0) {
+      fail(ErrorCode::kBadFile, path,
+           std::string(kTruncated) + " (no image size in the TIFF header)");
+    }
+    check_header(path, size, max_pixels);
   } else {
     fail(ErrorCode::kBadFile, path, "not a PNG, JPEG, WebP, TIFF or BMP file");
   }
 
   cv::Mat decoded;
-  try {
-    // cv::imdecode takes a non-const Mat header over the buffer but does not write to it.
-    const cv::Mat buffer(1, int(bytes.size()), CV_8U, const_cast<uint8_t*>(bytes.data()));
-    const MutedCerr quiet;
-    decoded = cv::imdecode(buffer, flags);
-  } catch (const cv::Exception&) {
-    decoded.release();
+  if (is_png(bytes)) {
+    decoded = decode_png(bytes, path, max_pixels);
+  } else {
+    try {
+      // cv::imdecode takes a non-const Mat header over the buffer but does not write to it.
+      const cv::Mat buffer(1, int(bytes.size()), CV_8U, const_cast<uint8_t*>(bytes.data()));
+      const MutedCerr quiet;
+      decoded = cv::imdecode(buffer, flags);
+    } catch (const cv::Exception&) {
+      decoded.release();
+    }
   }
   if (decoded.empty() || decoded.dims != 2) {
     fail(ErrorCode::kBadFile, path, kTruncated);

@@ -29,6 +29,7 @@
 #include <bit>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <span>
 #include <string>
 #include <tuple>
@@ -639,6 +640,22 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
   int num_colors = 0;
   const std::vector<Tri> fv = face_varying_indices(m, topo, num_colors);
   // Targets on the grid scale, in canonical order.
+  // The decoder takes grid values and residuals up to 2^48 in magnitude; colors up to 2^44 grid
+  // steps leave room for the residuals (at most 2^46) and the error diffusion. Larger colors (a
+  // hand-written 3e38, valid in the model) cannot be coded: llround would overflow.
+  const double max_color = std::ldexp(1.0, 44 - color_bits);
+  for (const Color& color : mesh.colors) {
+    for (const float v : {color.r, color.g, color.b}) {
+      if (!(std::abs(double(v)) <= max_color)) {
+        char text[96];
+        std::snprintf(text, sizeof text, "color value %g is too large for the compact .svec form",
+                      double(v));
+        throw Error(ErrorCode::kInvalidArgument,
+                    std::string(text) + " (at most " + str(uint64_t(max_color)) +
+                        " in magnitude; .svec.json or convert --lossless keep it)");
+      }
+    }
+  }
   std::vector<std::array<double, 3>> target(num_colors);
   std::vector<int32_t> origin(mesh.triangles.size());  // canonical triangle -> visited face
   {

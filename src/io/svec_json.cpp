@@ -223,7 +223,7 @@ double number_at(const Json& j, const Path& path) {
 float float_at(const Json& j, const Path& path) {
   const double v = number_at(j, path);
   if (std::abs(v) > std::numeric_limits<float>::max()) {
-    fail(path, "number " + std::to_string(v) + " is out of range for a 32-bit float");
+    fail(path, "number " + j.dump() + " is out of range for a 32-bit float");
   }
   return static_cast<float>(v);
 }
