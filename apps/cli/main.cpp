@@ -38,6 +38,7 @@
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 
+#include "batch.h"
 #include "edit_commands.h"
 
 #ifndef SUBVEC_VERSION
@@ -751,6 +752,7 @@ int run(int argc, char** argv) {
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 
   subvec_cli::add_edit_commands(app);  // edit, stylize
+  subvec_cli::add_batch_command(app);  // batch
 
   try {
     app.parse(argc, argv);
