@@ -32,6 +32,8 @@ IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".webp", ".tif", ".tiff", ".bmp")
 COLUMNS = ["image", "output", "width", "height", "vertices", "triangles", "mae", "seconds",
            "status", "error"]
 MAX_PIXELS = 1 << 23  # as `subvec batch --max-pixels`
+_UMASK = os.umask(0)  # read once (the call sets it), so outputs get the usual mode, as the CLI's
+os.umask(_UMASK)
 
 
 def list_images(in_dir):
@@ -51,6 +53,7 @@ def write_atomic(path, data):
     fd, temp = tempfile.mkstemp(dir=os.path.dirname(path) or ".",
                                 prefix=os.path.basename(path) + ".tmp-")
     try:
+        os.chmod(temp, 0o666 & ~_UMASK)  # mkstemp makes it 0600
         with os.fdopen(fd, "wb") as f:
             f.write(data)
             f.flush()

@@ -317,3 +317,32 @@ def test_long_calls_release_the_gil():
     inside = [t for t in stamps if start + 0.03 < t < end - 0.03]
     assert end - start > 0.1
     assert len(inside) >= 5, (end - start, len(inside))
+
+
+# ---- docs/python.md --------------------------------------------------------------------------
+
+
+def test_the_tour_in_docs_runs(tmp_path, monkeypatch):
+    text = (ROOT / "docs" / "python.md").read_text()
+    start = text.index("```python\nimport numpy as np\nimport subvec")
+    code = text[start + len("```python\n"):text.index("```\n", start + 10)]
+    code = code.replace('"examples/04-rocket.png"', repr(str(EXAMPLES / "04-rocket.png")))
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "docs/python.md", "exec"), scope)
+    assert scope["image"].info()["levels"][0]["vertices"] == 983
+    assert scope["before"].shape == (432, 260, 3)
+    assert not np.array_equal(scope["before"], scope["after"])
+    assert scope["styled"].num_strokes > 0
+    assert (tmp_path / "rocket-edited.png").exists() and (tmp_path / "rocket-edited.svec").exists()
+
+
+def test_the_stub_declares_the_whole_api():
+    import ast
+
+    tree = ast.parse((ROOT / "python" / "subvec" / "__init__.pyi").read_text())
+    top = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    assert set(subvec.__all__) <= top
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "VectorImage")
+    methods = {n.name for n in cls.body if isinstance(n, ast.FunctionDef)}
+    assert methods == {n for n in dir(subvec.VectorImage) if not n.startswith("_")}
