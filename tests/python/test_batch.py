@@ -158,3 +158,11 @@ def test_progress_bar_with_eta_on_a_terminal(cli, tmp_path):
     assert "subvec: batch [" in text and "/6 images" in text
     assert "ETA" in text
     assert text.endswith("\r")  # the bar is erased at the end: the terminal keeps the summary
+
+
+def test_help_lists_batch_and_its_options(cli):
+    assert "batch" in cli("--help").stdout
+    text = cli("batch", "--help").stdout
+    for word in ("--jobs", "--threads", "--ratio", "--vertices", "--render-png", "--max-pixels",
+                 "resumes"):
+        assert word in text, word
