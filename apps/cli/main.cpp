@@ -40,6 +40,7 @@
 
 #include "batch.h"
 #include "edit_commands.h"
+#include "pyramid_commands.h"  // levels: vectorize --levels, filter
 
 #ifndef SUBVEC_VERSION
 #define SUBVEC_VERSION "unknown"
@@ -249,7 +250,8 @@ void run_info(const std::string& input, bool json) {
     j["bytes"] = ec ? 0 : bytes;
     j["bytes_per_vertex"] = ec || total_vertices == 0 ? 0.0 : double(bytes) / double(total_vertices);
     j["levels"] = nlohmann::ordered_json::array();
-    for (const LevelInfo& l : levels) {
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const LevelInfo& l = levels[i];
       j["levels"].push_back({{"vertices", l.vertices},
                              {"triangles", l.triangles},
                              {"features", l.features},
@@ -259,6 +261,13 @@ void run_info(const std::string& input, bool json) {
                              {"border_edges", l.border_edges},
                              {"edges", l.edges},
                              {"corners", l.corners}});
+      // ---- levels: feature ids and saliencies (for vectorize --feature-level), pyramid record ----
+      nlohmann::ordered_json ids = nlohmann::ordered_json::array(), saliency = ids;
+      for (const subvec::Feature& f : image.levels[i].features) ids.push_back(f.id), saliency.push_back(f.saliency);
+      j["levels"].back()["feature_ids"] = ids;
+      j["levels"].back()["feature_saliency"] = saliency;
+      j["levels"].back()["collapses"] = image.levels[i].collapses.size();
+      // ---- end levels ----
     }
     j["strokes"] = image.strokes.size();
     j["metadata"] = nlohmann::ordered_json::object();
@@ -447,7 +456,9 @@ struct VectorizeArgs {
   int64_t max_pixels = int64_t{1} << 23;
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
+  int grid_step = 0;     // 0: automatic
   bool json = false;
+  subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
 };
 
 void run_vectorize(const VectorizeArgs& a) {
@@ -464,6 +475,7 @@ void run_vectorize(const VectorizeArgs& a) {
   subvec::VectorizeOptions options;
   options.ratio = a.ratio;
   options.vertices = a.vertices;
+  options.initial_mesh.grid_step = a.grid_step;
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
   if (!a.segment.empty()) {
@@ -475,7 +487,14 @@ void run_vectorize(const VectorizeArgs& a) {
     progress.update(stage, fraction);
   };
   subvec::VectorizeReport report;
-  const subvec::VectorImage v = subvec::vectorize(image, options, &report);
+  subvec::VectorImage v = subvec::vectorize(image, options, &report);
+  // ---- levels of abstraction (pyramid_commands.h) ----
+  progress.update("levels", 0.95);
+  const auto levels_start = std::chrono::steady_clock::now();
+  const subvec::LevelReport level_report = subvec_cli::build_levels(a.levels, v, image);
+  const double levels_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - levels_start).count();
+  // ---- end levels ----
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   const subvec::ImageDifference d =
@@ -518,12 +537,23 @@ void run_vectorize(const VectorizeArgs& a) {
     } else {
       j["segment"] = nullptr;
     }
+    // ---- levels ----
+    nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+    for (size_t l = 0; l < v.levels.size(); ++l) {
+      levels.push_back({{"vertices", v.levels[l].num_vertices()},
+                        {"triangles", v.levels[l].num_triangles()},
+                        {"features", v.levels[l].features.size()},
+                        {"seconds", l < level_report.seconds.size() ? level_report.seconds[l] : 0.0}});
+    }
+    j["levels"] = levels;
+    // ---- end levels ----
     j["mae"] = d.mae_mean;
     j["psnr"] =
         std::isinf(d.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(d.psnr);
     j["ssim"] = d.ssim;
     nlohmann::ordered_json stages;
     for (const auto& s : report.stages) stages[s.stage] = s.seconds;
+    if (v.levels.size() > 1) stages["levels"] = levels_seconds;
     stages["render_compare"] = compare_seconds;
     j["seconds"] = stages;
     j["total_seconds"] = total;
@@ -546,10 +576,19 @@ void run_vectorize(const VectorizeArgs& a) {
     std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
                 static_cast<long long>(report.segment_mask.area()), boundary.c_str());
   }
+  // ---- levels ----
+  if (v.levels.size() > 1) {
+    std::printf("levels   ");
+    for (size_t l = 0; l < v.levels.size(); ++l)
+      std::printf(" %zu: %d vertices, %zu features%s", l, v.levels[l].num_vertices(),
+                  v.levels[l].features.size(), l + 1 < v.levels.size() ? ";" : "\n");
+  }
+  // ---- end levels ----
   std::printf("error     MAE %.3f, PSNR %.2f dB, SSIM %.4f (rendered at 1x against the input)\n",
               d.mae_mean, d.psnr, d.ssim);
   std::printf("seconds  ");
   for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
+  if (v.levels.size() > 1) std::printf(" levels %.3f,", levels_seconds);  // levels
   std::printf(" render+compare %.3f, total %.3f\n", compare_seconds, total);
 }
 
@@ -742,7 +781,13 @@ int run(int argc, char** argv) {
             return parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
+  vectorize
+      ->add_option("--grid-step", va.grid_step,
+                   "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
+                   "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
+      ->check(CLI::Range(0, 2));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
+  subvec_cli::add_level_options(vectorize, va.levels);  // levels
   vectorize->footer(
       "Examples:\n"
       "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
@@ -752,6 +797,7 @@ int run(int argc, char** argv) {
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 
   subvec_cli::add_edit_commands(app);  // edit, stylize
+  subvec_cli::add_pyramid_commands(app);  // filter
   subvec_cli::add_batch_command(app);  // batch
 
   try {
@@ -769,10 +815,10 @@ int run(int argc, char** argv) {
       // No command: either none was given or the first word is not one.
       const std::vector<std::string> extra = app.remaining();
       if (extra.empty()) {
-        message = "a command is required: vectorize, render, edit, stylize, info, convert or compare";
+        message = "a command is required: vectorize, render, edit, stylize, filter, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, render, edit, stylize, info, convert or compare)";
+                  extra.front() + "' (expected a command: vectorize, render, edit, stylize, filter, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }

@@ -12,6 +12,7 @@
 #include "subvec/edit/selection.h"
 #include "subvec/mesh/curves.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/pyramid/levels.h"
 #include "subvec/render/renderer.h"
 
 namespace subvec {
@@ -96,18 +97,15 @@ std::vector<double> feature_saliency(const VectorImage& image, int level, double
   const Image8 raster = render(bare, RenderOptions{});
   for (size_t f = 0; f < mesh.features.size(); ++f) {
     if (saliency[f] != 0) continue;
-    double length = 0, contrast = 0;
-    int samples = 0;
+    // Eq. 2 as vectorization measures it (pyramid/levels.h), per piece: lengths add, and the
+    // contrast is the length-weighted mean of the pieces' contrasts.
+    double length = 0, weighted = 0;
     for (const auto& line : curves[f]) {
-      length += polyline_length(line);
-      walk(line, 1.0, [&](Vec2 p, Vec2 t) {
-        const auto a = sample_bilinear(raster, p.x - t.y, p.y + t.x);
-        const auto b = sample_bilinear(raster, p.x + t.y, p.y - t.x);
-        contrast += std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]) / 2;
-        ++samples;
-      });
+      const double piece = polyline_length(line);
+      length += piece;
+      weighted += piece * (curve_saliency(line, raster, contrast_weight) - piece);
     }
-    saliency[f] = length + contrast_weight * (samples ? contrast / samples : 0.0);
+    saliency[f] = length + (length > 0 ? weighted / length : 0.0);
   }
   return saliency;
 }

@@ -29,11 +29,13 @@ Strips make_strips(const RefinedMesh& mesh);
 
 // Tear hints. Viewers that fill a mesh of triangles without anti-aliasing (poppler's shadings,
 // SVG with crisp edges) leave the tears, the only sharp edges of the picture, jagged. Along each
-// refined tear edge a band `width` wide (image pixels) on each side, in that side's color at the
-// edge (the mean of the edge's two corners), drawn as an ordinary anti-aliased shape, restores
-// them: the two bands meet exactly on the tear, so their anti-aliased edges there mix the two
-// sides as the raster renderer does, while elsewhere a band is within a fraction of a level of
-// what it covers. All first sides' bands come first, then all second sides'.
+// refined tear edge a band `width` wide (image pixels) on each side, in that side's color half a
+// width in (linear over the refined triangle), drawn as an ordinary anti-aliased shape, restores
+// them. All first sides' bands come first and reach half a width across the tear; the second
+// sides' bands, drawn over them from the tear out, then mix the two sides by coverage in the
+// pixels on the tear, as the raster renderer does, with nothing of the unsmoothed mesh under
+// them. (Measured on the eight vectorized photographs in poppler: median MAE 1.29 with bands in
+// the edge's color meeting on the tear, 1.14 with these.)
 struct TearBand {
   std::array<Vec2, 4> corners;  // the edge's ends, then their offsets into the side
   std::array<double, 3> color{0, 0, 0};

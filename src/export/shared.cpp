@@ -1,6 +1,7 @@
 // Strips of refined triangles (export_p.h) and the other pieces the PDF and SVG writers share.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <map>
 #include <unordered_map>
@@ -137,28 +138,40 @@ std::vector<TearBand> tear_bands(const RefinedMesh& mesh, double width) {
       if (it == sides.end() || it->second[side] < 0) continue;
       const int32_t t = it->second[side];
       const Tri& v = mesh.triangles[t];
-      TearBand band;
-      int32_t third = v[0];
-      for (int k = 0; k < 3; ++k) {
-        if (v[k] != e[0] && v[k] != e[1]) {
-          third = v[k];
-          continue;
-        }
-        for (int ch = 0; ch < 3; ++ch)
-          band.color[ch] += 0.5 * mesh.colors[3 * mesh.triangle_colors[t][k] + ch];
-      }
+      int third = 0;  // corner of t off the edge
+      for (int k = 0; k < 3; ++k)
+        if (v[k] != e[0] && v[k] != e[1]) third = k;
       const double ax = mesh.positions[2 * e[0]], ay = mesh.positions[2 * e[0] + 1];
       const double bx = mesh.positions[2 * e[1]], by = mesh.positions[2 * e[1] + 1];
+      const double cx = mesh.positions[2 * v[third]], cy = mesh.positions[2 * v[third] + 1];
       double nx = ay - by, ny = bx - ax;
       const double length = std::hypot(nx, ny);
       if (!(length > 0)) continue;
-      nx *= width / length;
-      ny *= width / length;
-      if (nx * (mesh.positions[2 * third] - ax) + ny * (mesh.positions[2 * third + 1] - ay) < 0) {
+      nx /= length;
+      ny /= length;
+      double height = nx * (cx - ax) + ny * (cy - ay);  // of the third corner over the edge
+      if (height < 0) {
         nx = -nx;
         ny = -ny;
+        height = -height;
       }
-      band.corners = {Vec2{ax, ay}, Vec2{bx, by}, Vec2{bx + nx, by + ny}, Vec2{ax + nx, ay + ny}};
+      // The band's color: the triangle's (linear) color half a band width into the side, the
+      // mean of what the band covers where the color changes fast next to the tear.
+      const double toward_third = height > 0 ? std::min(1.0, 0.5 * width / height) : 0.0;
+      TearBand band;
+      for (int ch = 0; ch < 3; ++ch) {
+        double edge = 0;
+        for (int k = 0; k < 3; ++k)
+          if (k != third) edge += 0.5 * mesh.colors[3 * mesh.triangle_colors[t][k] + ch];
+        const double corner = mesh.colors[3 * mesh.triangle_colors[t][third] + ch];
+        band.color[ch] = edge + toward_third * (corner - edge);
+      }
+      // The first side's band reaches half a width across the tear, under the second side's: a
+      // pixel on the tear is then fully covered by the first band, and the second one's
+      // anti-aliased edge mixes the two by coverage, with nothing of the shading under them.
+      const double across = side == 0 ? 0.5 * width : 0.0;
+      band.corners = {Vec2{ax - across * nx, ay - across * ny}, Vec2{bx - across * nx, by - across * ny},
+                      Vec2{bx + width * nx, by + width * ny}, Vec2{ax + width * nx, ay + width * ny}};
       bands.push_back(band);
     }
   }

@@ -9,7 +9,9 @@
 #include <zstd.h>
 
 #include <array>
+#include <algorithm>
 #include <bit>
+#include <climits>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -29,9 +31,10 @@ using namespace svec_detail;
 // ---------------------------------------------------------------------------------------------
 // Payload.
 
-// Strokes and metadata end the payload in both versions.
+// Strokes and metadata end the payload in both versions, then the optional pyramid records.
 void encode_trailer(ByteWriter& w, const VectorImage& image);
 void decode_trailer(Cursor& in, VectorImage& image);
+void encode_pyramid(ByteWriter& w, const VectorImage& image);
 
 // Version 1: every value as stored in memory, in the image's own order.
 std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
@@ -64,6 +67,7 @@ std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
     }
   }
   encode_trailer(w, image);
+  encode_pyramid(w, image);
   return std::move(w.bytes);
 }
 
@@ -72,6 +76,7 @@ std::vector<uint8_t> encode_payload_v2(const VectorImage& image,
                                        const std::vector<std::array<int, 2>>& bits,
                                        std::vector<size_t>& block_ends) {
   ByteWriter w;
+  std::vector<std::vector<int32_t>> orders(image.levels.size());
   w.i32(image.width);
   w.i32(image.height);
   w.count(image.levels.size(), "levels");
@@ -84,9 +89,23 @@ std::vector<uint8_t> encode_payload_v2(const VectorImage& image,
     w.count(m.features.size(), "features");
     w.bytes.push_back(static_cast<uint8_t>(bits[l][0]));
     w.bytes.push_back(static_cast<uint8_t>(static_cast<int8_t>(bits[l][1])));
-    encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], w, block_ends);
+    encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], w, block_ends,
+                         &orders[l]);
+  }
+  // The pyramid records name vertices: renumber them as the levels were.
+  VectorImage records;
+  records.levels.resize(image.levels.size());
+  for (size_t l = 1; l < image.levels.size(); ++l) {
+    const ControlMesh& m = image.levels[l];
+    ControlMesh& r = records.levels[l];
+    const std::vector<int32_t>& fine = orders[l - 1];
+    r.parent_vertices.resize(m.parent_vertices.size());
+    for (size_t v = 0; v < m.parent_vertices.size(); ++v)
+      r.parent_vertices[orders[l][v]] = fine[m.parent_vertices[v]];
+    for (const EdgeVerts& e : m.collapses) r.collapses.push_back({fine[e[0]], fine[e[1]]});
   }
   encode_trailer(w, image);
+  encode_pyramid(w, records);
   return std::move(w.bytes);
 }
 
@@ -184,8 +203,62 @@ void decode_trailer(Cursor& in, VectorImage& image) {
     image.metadata[i].first = in.string(what + " key");
     image.metadata[i].second = in.string(what + " value");
   }
-  if (in.remaining() != 0)
+  // Optional: the pyramid records of levels 1 and up (docs/format.md, "Levels and the pyramid").
+  // Files written before them end here.
+  if (in.remaining() != 0 && in.remaining() < 4)  // too short for a record count: stray bytes
     fail(str(in.remaining()) + " unexpected bytes after the payload's metadata");
+  if (in.remaining() != 0) {
+    in.set_context("pyramid records");
+    const size_t n = in.count("pyramid records", 3, Limits::kMaxLevels);
+    for (size_t i = 0; i < n; ++i) {
+      const std::string what = "pyramid record " + str(i);
+      in.set_context(what);
+      const uint32_t l = in.u32();
+      if (l < 1 || l >= image.levels.size() || !image.levels[l].parent_vertices.empty() ||
+          !image.levels[l].collapses.empty())
+        fail(what + ": level " + str(l) + " is out of range or named twice");
+      ControlMesh& m = image.levels[l];
+      m.parent_vertices.resize(in.count(what + " parent vertices", 1));
+      int64_t prev = 0;
+      // base + delta as a vertex index; both are checked before they are added.
+      auto index = [&](int64_t base, uint64_t code) {
+        const int64_t delta = unzigzag(code);
+        if (delta < -(int64_t{1} << 32) || delta > (int64_t{1} << 32) || base + delta < 0 ||
+            base + delta > INT32_MAX)
+          fail(what + ": a vertex index is out of range");
+        return static_cast<int32_t>(base + delta);
+      };
+      for (int32_t& v : m.parent_vertices) prev = v = index(prev, in.varint());
+      m.collapses.resize(in.count(what + " collapses", 2));
+      for (EdgeVerts& e : m.collapses) {
+        e[0] = index(0, zigzag(static_cast<int64_t>(std::min<uint64_t>(in.varint(), uint64_t{1} << 40))));
+        e[1] = index(e[0], in.varint());
+      }
+    }
+  }
+  if (in.remaining() != 0)
+    fail(str(in.remaining()) + " unexpected bytes after the payload's pyramid records");
+}
+
+void encode_pyramid(ByteWriter& w, const VectorImage& image) {
+  uint32_t n = 0;
+  for (size_t l = 1; l < image.levels.size(); ++l)
+    n += !image.levels[l].parent_vertices.empty() || !image.levels[l].collapses.empty();
+  if (n == 0) return;  // the file ends with the metadata, as before the pyramid existed
+  w.count(n, "pyramid records");
+  for (size_t l = 1; l < image.levels.size(); ++l) {
+    const ControlMesh& m = image.levels[l];
+    if (m.parent_vertices.empty() && m.collapses.empty()) continue;
+    w.u32(static_cast<uint32_t>(l));
+    w.count(m.parent_vertices.size(), "parent vertices");
+    int64_t prev = 0;
+    for (int32_t v : m.parent_vertices) put_varint(w.bytes, zigzag(int64_t{v} - prev)), prev = v;
+    w.count(m.collapses.size(), "collapses");
+    for (const EdgeVerts& e : m.collapses) {
+      put_varint(w.bytes, static_cast<uint32_t>(e[0]));
+      put_varint(w.bytes, zigzag(int64_t{e[1]} - e[0]));
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -466,7 +466,8 @@ ControlMesh quantize_positions(const ControlMesh& mesh, int width, int height,
 // Encoder.
 
 void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
-                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends) {
+                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends,
+                          std::vector<int32_t>* vertex_order) {
   const int32_t nv = mesh.num_vertices(), virt = nv;
   // The closed mesh: real triangles, then one virtual triangle (b, a, virtual) per border edge
   // a -> b.
@@ -548,6 +549,7 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
   Canonical c = make_canonical(tr, nv);
   std::vector<int32_t> final_of(nv);
   for (int32_t v = 0; v < nv; ++v) final_of[v] = c.final_index[code[v]];
+  if (vertex_order) *vertex_order = final_of;
   ControlMesh& m = c.mesh;
   m.positions.resize(nv);
   for (int32_t v = 0; v < nv; ++v) m.positions[final_of[v]] = mesh.positions[v];

@@ -28,8 +28,10 @@ ControlMesh quantize_positions(const ControlMesh& mesh, int width, int height, i
 // triangles and color values renumbered (canonical order; a second encoding is identical).
 // Appends to `block_ends` the offsets in `out` after which the writer should start a new zstd
 // block (each section gets its own entropy tables).
+// `vertex_order`, when given, receives each vertex's number in the stored order.
 void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
-                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends);
+                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends,
+                          std::vector<int32_t>* vertex_order = nullptr);
 
 // Reads one compact level; throws Error(kBadFile) (or kLimit, kInvalidMesh) naming `level`.
 // The result is not yet validated.

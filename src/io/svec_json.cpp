@@ -286,7 +286,8 @@ Feature feature_at(const Json& j, const Path& path) {
 ControlMesh level_at(const Json& j, const Path& path) {
   object_at(j, path);
   check_keys(j, path,
-             {"vertices", "colors", "triangles", "triangle_colors", "creases", "features"});
+             {"vertices", "colors", "triangles", "triangle_colors", "creases", "features",
+              "parent_vertices", "collapses"});
   ControlMesh m;
   m.positions = list_at<Vec2>(require(j, path, "vertices"), path.member("vertices"), vec2_at);
   m.colors = list_at<Color>(require(j, path, "colors"), path.member("colors"), color_at);
@@ -317,6 +318,15 @@ ControlMesh level_at(const Json& j, const Path& path) {
   }
   if (const Json* f = find(j, "features")) {
     m.features = list_at<Feature>(*f, path.member("features"), feature_at);
+  }
+  // The pyramid record of a coarser level (docs/format.md, "Levels and the pyramid").
+  if (const Json* pv = find(j, "parent_vertices")) {
+    m.parent_vertices = list_at<int32_t>(*pv, path.member("parent_vertices"), int_at);
+  }
+  if (const Json* c = find(j, "collapses")) {
+    m.collapses = list_at<EdgeVerts>(*c, path.member("collapses"), [](const Json& e, const Path& p) {
+      return tuple_at<2, int32_t>(e, p, "[removed, kept] (two vertex indices)", int_at);
+    });
   }
   return m;
 }
@@ -475,6 +485,8 @@ void write_level(JsonWriter& w, const ControlMesh& m, bool last) {
   if (!implicit_colors) keys.push_back("triangle_colors");
   if (!m.creases.empty()) keys.push_back("creases");
   if (!m.features.empty()) keys.push_back("features");
+  if (!m.parent_vertices.empty()) keys.push_back("parent_vertices");
+  if (!m.collapses.empty()) keys.push_back("collapses");
   for (size_t k = 0; k < keys.size(); ++k) {
     const std::string key = keys[k];
     const bool comma = k + 1 < keys.size();
@@ -483,6 +495,9 @@ void write_level(JsonWriter& w, const ControlMesh& m, bool last) {
     if (key == "triangles") w.list(3, key, texts(m.triangles, ints_text<3>), comma);
     if (key == "triangle_colors") w.list(3, key, texts(m.triangle_colors, ints_text<3>), comma);
     if (key == "creases") w.list(3, key, texts(m.creases, ints_text<2>), comma);
+    if (key == "parent_vertices")
+      w.list(3, key, texts(m.parent_vertices, [](int32_t v) { return std::to_string(v); }), comma);
+    if (key == "collapses") w.list(3, key, texts(m.collapses, ints_text<2>), comma);
     if (key == "features") {
       w.line(3, "\"features\": [");
       for (size_t i = 0; i < m.features.size(); ++i) {

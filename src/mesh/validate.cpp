@@ -384,6 +384,41 @@ void validate_stroke(const Stroke& stroke, size_t index, int num_levels) {
   }
 }
 
+// The pyramid link of level l (ControlMesh::parent_vertices, collapses): indices in range, parents
+// distinct, none of them removed. Whether the collapses really make this level is checked where
+// the pyramid replays them (pyramid/pyramid.h).
+void validate_level_link(const VectorImage& image, int l) {
+  const ControlMesh& m = image.levels[l];
+  const std::string where = "level " + str(l) + ": ";
+  auto fail = [&](const std::string& message) { throw Error(ErrorCode::kInvalidMesh, where + message); };
+  if (m.parent_vertices.empty() && m.collapses.empty()) return;
+  if (l == 0) fail("level 0 has no level before it, but names parent vertices or collapses");
+  const int64_t fine = image.levels[l - 1].num_vertices();
+  if (static_cast<int64_t>(m.parent_vertices.size()) != m.num_vertices()) {
+    fail(str(int64_t(m.parent_vertices.size())) + " parent vertices for " + str(m.num_vertices()) +
+         " vertices");
+  }
+  if (static_cast<int64_t>(m.collapses.size()) + m.num_vertices() != fine) {
+    fail(str(int64_t(m.collapses.size())) + " collapses do not take level " + str(l - 1) + "'s " +
+         str(fine) + " vertices to " + str(m.num_vertices()));
+  }
+  std::vector<uint8_t> state(static_cast<size_t>(fine), 0);  // 1 parent, 2 removed
+  for (size_t i = 0; i < m.parent_vertices.size(); ++i) {
+    const int32_t p = m.parent_vertices[i];
+    if (p < 0 || p >= fine) fail("parent vertex " + str(int64_t(i)) + " is " + str(p) + ", out of range");
+    if (state[p]) fail("parent vertex " + str(p) + " appears twice");
+    state[p] = 1;
+  }
+  for (size_t i = 0; i < m.collapses.size(); ++i) {
+    const auto [u, v] = m.collapses[i];
+    if (u < 0 || u >= fine || v < 0 || v >= fine || u == v) {
+      fail("collapse " + str(int64_t(i)) + " (" + str(u) + ", " + str(v) + ") is out of range");
+    }
+    if (state[u]) fail("collapse " + str(int64_t(i)) + " removes vertex " + str(u) + ", which is kept or already removed");
+    state[u] = 2;
+  }
+}
+
 }  // namespace
 
 MeshTopology validate_level(const ControlMesh& mesh, int width, int height, int level_index) {
@@ -413,6 +448,8 @@ void validate(const VectorImage& image) {
   }
   for (size_t l = 0; l < image.levels.size(); ++l)
     validate_level(image.levels[l], image.width, image.height, static_cast<int>(l));
+  for (size_t l = 0; l < image.levels.size(); ++l)
+    validate_level_link(image, static_cast<int>(l));
   if (static_cast<int64_t>(image.strokes.size()) > Limits::kMaxElements) {
     throw Error(ErrorCode::kLimit, str(int64_t(image.strokes.size())) +
                                        " strokes is over the limit of " +

@@ -57,11 +57,51 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     }
   }
 
+  if (options.grid_step < 0 || options.grid_step > 2) {
+    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1 or 2");
+  }
+  const int step = std::max(1, options.grid_step);
+  // Pixels near a feature keep the fine grid when the grid is coarse elsewhere.
+  std::vector<uint8_t> fine;
+  if (step == 2) {
+    fine.assign(size_t(w) * h, 0);
+    const double band = std::max(options.fine_band, r);
+    for (const DetectedFeature& f : features) {
+      for (size_t i = 0; i + 1 < f.points.size(); ++i) {
+        const Vec2 a = f.points[i], b = f.points[i + 1];
+        const int x0 = std::max(0, int(std::floor(std::min(a.x, b.x) - band - 0.5)));
+        const int x1 = std::min(w - 1, int(std::ceil(std::max(a.x, b.x) + band - 0.5)));
+        const int y0 = std::max(0, int(std::floor(std::min(a.y, b.y) - band - 0.5)));
+        const int y1 = std::min(h - 1, int(std::ceil(std::max(a.y, b.y) + band - 0.5)));
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x)
+            if (segment_distance({x + 0.5, y + 0.5}, a, b) < band) fine[size_t(y) * w + x] = 1;
+      }
+    }
+  }
+
   std::vector<Point> points;
   points.reserve(size_t(w) * h + 2 * size_t(w + h) + 4);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
+  if (step == 1) {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
+  } else {
+    for (int by = 0; by < h; by += 2) {
+      for (int bx = 0; bx < w; bx += 2) {
+        const bool whole = bx + 1 < w && by + 1 < h;
+        const bool coarse = whole && !fine[size_t(by) * w + bx] && !fine[size_t(by) * w + bx + 1] &&
+                            !fine[size_t(by + 1) * w + bx] && !fine[size_t(by + 1) * w + bx + 1];
+        if (coarse) {
+          points.emplace_back(bx + 1.0, by + 1.0);
+          continue;
+        }
+        for (int y = by; y < std::min(h, by + 2); ++y)
+          for (int x = bx; x < std::min(w, bx + 2); ++x)
+            if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
+      }
+    }
+  }
   // The border: corners and one vertex per pixel along each side.
   points.emplace_back(0, 0), points.emplace_back(w, 0), points.emplace_back(w, h), points.emplace_back(0, h);
   for (int x = 0; x < w; ++x) points.emplace_back(x + 0.5, 0), points.emplace_back(x + 0.5, h);

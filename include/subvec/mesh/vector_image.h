@@ -63,6 +63,13 @@ struct ControlMesh {
   std::vector<EdgeVerts> creases;     // interior crease edges; the image border is always a crease
   std::vector<Feature> features;      // tear chains
 
+  // Levels 1 and up of a multiresolution image (paper §5, §6.4): how this level was made from the
+  // level before it, which is what the vector image pyramid replays (include/subvec/pyramid/).
+  // That level lost the features this one lacks (their seams closed), then these half-edge
+  // collapses in order, then its colors were refitted. Both are empty on level 0 and when unknown.
+  std::vector<int32_t> parent_vertices;  // #V or empty: each vertex's index in the level before
+  std::vector<EdgeVerts> collapses;      // (removed, kept) vertex pairs in the level before's numbering
+
   int num_vertices() const { return static_cast<int>(positions.size()); }
   int num_colors() const { return static_cast<int>(colors.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }

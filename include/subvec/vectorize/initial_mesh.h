@@ -16,6 +16,12 @@ namespace subvec {
 struct InitialMeshOptions {
   double min_grid_distance = 0.5;  // grid vertices closer than this to a feature are dropped, px
   double side_offset = 0.75;       // tear-side colors are sampled this far into each side, px
+  // 1: a vertex at every pixel centre. 2: away from the features, one vertex per 2 x 2 block at
+  // its centre (a pixel corner, whose bilinear color is the block's mean); blocks with a pixel
+  // within `fine_band` of a feature keep their pixel centres. 0: automatic in vectorize() (2 for
+  // images over 2^20 pixels when the target is at most 1/16 of the pixels, else 1); here, 1.
+  int grid_step = 0;
+  double fine_band = 3.0;
 };
 
 // Returns a valid single-level mesh (validate_level holds) over the image domain.

@@ -76,6 +76,56 @@ TEST(InitialMesh, IsValidAndFollowsTheFeatures) {
   EXPECT_EQ(mesh.num_colors(), mesh.num_vertices() + split);
 }
 
+TEST(InitialMesh, CoarseGridKeepsPixelCentresNearFeaturesOnly) {
+  const Image8 img = disk_image(96, 96, 47.7, 48.2, 25.3);
+  const auto features = detect_features(img);
+  InitialMeshOptions fine, coarse;
+  fine.grid_step = 1;
+  coarse.grid_step = 2;
+  const ControlMesh a = build_initial_mesh(img, features, fine);
+  const ControlMesh b = build_initial_mesh(img, features, coarse);
+  validate_level(b, 96, 96);
+  ASSERT_EQ(b.features.size(), 1u);
+  EXPECT_EQ(b.features[0].vertices.size(), a.features[0].vertices.size());
+  // Interior vertices: pixel centres (x.5, y.5) within the band of the circle, block centres
+  // (whole coordinates) at least 2.5 px away from it, and far fewer of them than with step 1.
+  int centres = 0, corners = 0;
+  for (const Vec2& p : b.positions) {
+    if (p.x <= 0 || p.y <= 0 || p.x >= 96 || p.y >= 96) continue;
+    const double d = std::abs(std::hypot(p.x - 47.7, p.y - 48.2) - 25.3);
+    if (p.x == std::floor(p.x) && p.y == std::floor(p.y)) {
+      ++corners;
+      EXPECT_GT(d, 2.2) << p.x << ", " << p.y;
+    } else if (p.x - std::floor(p.x) == 0.5 && p.y - std::floor(p.y) == 0.5) {
+      ++centres;
+      EXPECT_LT(d, 4.6) << p.x << ", " << p.y;
+    }
+  }
+  EXPECT_GT(corners, 1000);
+  EXPECT_GT(centres, 500);
+  EXPECT_LT(b.num_vertices(), a.num_vertices() * 6 / 10);
+  // A block centre's color is its 2 x 2 block's mean.
+  int checked = 0;
+  for (int f = 0; f < b.num_triangles(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 p = b.positions[b.triangles[f][k]];
+      if (p.x != 21 || p.y != 21) continue;  // the block of pixels 20..21 x 20..21
+      const Color c = b.colors[b.triangle_colors[f][k]];
+      for (int ch = 0; ch < 3; ++ch) {
+        double mean = 0;
+        for (int y = 20; y <= 21; ++y)
+          for (int x = 20; x <= 21; ++x) mean += img.row(y)[3 * x + ch] / 4.0;
+        EXPECT_NEAR((&c.r)[ch], mean, 1e-3);
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 0);
+  InitialMeshOptions bad;
+  bad.grid_step = 3;
+  EXPECT_THROW(build_initial_mesh(img, features, bad), Error);
+}
+
 // Distance from p to the polyline.
 double polyline_distance(const Vec2& p, const std::vector<Vec2>& line) {
   double best = 1e30;
@@ -203,6 +253,40 @@ TEST(Vectorize, RejectsBadOptions) {
   options.ratio = -0.1;
   EXPECT_THROW(vectorize(img, options), Error);
   EXPECT_THROW(vectorize(Image8(1, 1, 3), {}), Error);
+}
+
+// The coarse grid that large images start from gives the same error as the pixel grid: checked on
+// the 2x upscale of a shared photograph's 256 x 256 crop, with the invariants of every
+// vectorization. (Automatic only over 2^20 pixels; forced here to keep the test short.)
+TEST(Vectorize, CoarseGridMatchesThePixelGridOnAnUpscaledPhotograph) {
+  const std::filesystem::path path =
+      std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "astronaut.png";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  const Image8 photo = read_image(path);
+  constexpr int kSize = 512, kScale = 2;
+  Image8 img(kSize, kSize, 3);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      // Bilinear upscale of the crop at (128, 64).
+      const double sx = std::clamp((x + 0.5) / kScale - 0.5, 0.0, 255.0);
+      const double sy = std::clamp((y + 0.5) / kScale - 0.5, 0.0, 255.0);
+      const int x0 = std::min(int(sx), 254), y0 = std::min(int(sy), 254);
+      const double fx = sx - x0, fy = sy - y0;
+      for (int k = 0; k < 3; ++k) {
+        auto at = [&](int px, int py) { return double(photo.row(64 + py)[3 * (128 + px) + k]); };
+        img.row(y)[3 * x + k] = static_cast<uint8_t>(std::lround(
+            (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+            fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1))));
+      }
+    }
+  }
+  VectorizeOptions options;
+  options.ratio = 0.01;
+  options.initial_mesh.grid_step = 1;
+  const double fine = check_vectorization(img, options, "upscale, step 1");
+  options.initial_mesh.grid_step = 2;
+  const double coarse = check_vectorization(img, options, "upscale, step 2");
+  EXPECT_LT(coarse, fine * 1.03) << "step 1: " << fine << ", step 2: " << coarse;
 }
 
 // The shared photographs: valid meshes, no flips, feature curves within 1 px of the detected

@@ -1,0 +1,172 @@
+// `subvec vectorize --levels ...` and `subvec filter` (docs/cli.md, docs/levels.md).
+#include "pyramid_commands.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "subvec/core/error.h"
+#include "subvec/io/svec.h"
+#include "subvec/pyramid/pyramid.h"
+
+namespace subvec_cli {
+namespace {
+
+using subvec::Error;
+using subvec::ErrorCode;
+
+// "ID=L" with integers; returns an error message or "" and fills id and level.
+std::string parse_feature_level(const std::string& text, int& id, int& level) {
+  const auto eq = text.find('=');
+  const std::string expected = "expected ID=LEVEL (two integers), got '" + text + "'";
+  if (eq == std::string::npos) return expected;
+  auto integer = [](const std::string& s, int& out) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    const long v = std::strtol(s.c_str(), &end, 10);
+    if (*end != '\0' || v < -(1L << 30) || v > (1L << 30)) return false;
+    out = static_cast<int>(v);
+    return true;
+  };
+  if (!integer(text.substr(0, eq), id) || !integer(text.substr(eq + 1), level)) return expected;
+  if (level < 0) return "the level must be at least 0, got '" + text + "'";
+  return "";
+}
+
+// "a,b,c" finite numbers; returns an error message or "" and fills `out`.
+std::string parse_numbers(const std::string& text, std::vector<double>& out) {
+  out.clear();
+  std::stringstream in(text);
+  std::string item;
+  const std::string expected = "expected numbers separated by commas, got '" + text + "'";
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v)) return expected;
+    out.push_back(v);
+  }
+  if (out.empty() || text.back() == ',') return expected;
+  return "";
+}
+
+struct FilterArgs {
+  std::string input, output, eta_levels;
+  double eta = 1;
+  bool geometry = false, color = false;
+};
+
+void run_filter(const FilterArgs& a, bool eta_given) {
+  subvec::svec_format_for(a.output);
+  const subvec::VectorImage image = subvec::read_svec(a.input);
+  std::vector<double> etas = {a.eta};
+  if (!eta_given && !a.eta_levels.empty()) parse_numbers(a.eta_levels, etas);  // validated by CLI11
+  const int bands = static_cast<int>(image.levels.size()) - 1;
+  if (bands >= 1 && static_cast<int>(etas.size()) > bands) {
+    throw Error(ErrorCode::kInvalidArgument, "--eta-levels has " + std::to_string(etas.size()) +
+                                                 " values but '" + a.input + "' has " +
+                                                 std::to_string(bands) + (bands == 1 ? " band" : " bands"));
+  }
+  subvec::FilterOptions options;
+  // Colors by default (the image's frequencies live there); --geometry-eta adds or, alone, selects
+  // the positions.
+  const bool color = a.color || !a.geometry;
+  if (a.geometry) options.geometry_eta = etas;
+  if (color) options.color_eta = etas;
+  subvec::FilterReport report;
+  const subvec::VectorImage out = subvec::filter(image, options, &report);
+  subvec::write_svec(a.output, out);
+  std::string list;
+  for (size_t i = 0; i < etas.size(); ++i) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%g", i ? "," : "", etas[i]);
+    list += buf;
+  }
+  std::printf("%s -> %s: %d bands, eta %s on %s%s\n", a.input.c_str(), a.output.c_str(), report.bands,
+              list.c_str(), a.geometry && color ? "geometry and color" : a.geometry ? "geometry" : "color",
+              report.restored_vertices > 0
+                  ? (", " + std::to_string(report.restored_vertices) + " vertices held back from folding").c_str()
+                  : "");
+}
+
+}  // namespace
+
+void add_level_options(CLI::App* vectorize, LevelArgs& args) {
+  vectorize->add_option("--levels", args.levels,
+                        "Levels of abstraction, level 0 the finest with every feature (default 3; 1: "
+                        "a single level)")
+      ->check(CLI::Range(1, 16));
+  vectorize
+      ->add_option("--saliency-weight", args.saliency_weight,
+                   "w in the saliency S = length + w * contrast that orders features (default 2)")
+      ->check(CLI::Range(0.0, 1e6));
+  vectorize
+      ->add_option("--level-reduction", args.reduction,
+                   "Share of the vertices each coarser level removes (default 0.5)")
+      ->check(CLI::Range(0.01, 0.95));
+  vectorize
+      ->add_option("--feature-level", args.feature_levels,
+                   "ID=L: feature ID stays up to level L (repeatable; ids as `subvec info --json` lists)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            int id = 0, level = 0;
+            return parse_feature_level(text, id, level);
+          },
+          "ID=L", "feature-level"));
+}
+
+subvec::LevelReport build_levels(const LevelArgs& args, subvec::VectorImage& image, const subvec::Image8& photo) {
+  // With one level this only stores each feature's saliency.
+  subvec::LevelReport report;
+  subvec::LevelOptions options;
+  options.levels = args.levels;
+  options.saliency_weight = args.saliency_weight;
+  options.reduction = args.reduction;
+  for (const std::string& text : args.feature_levels) {
+    int id = 0, level = 0;
+    parse_feature_level(text, id, level);
+    options.feature_levels.push_back({id, level});
+  }
+  subvec::build_levels(image, photo, options, &report);
+  return report;
+}
+
+void add_pyramid_commands(CLI::App& app) {
+  static FilterArgs fa;
+  CLI::App* filter = app.add_subcommand(
+      "filter", "Smooth or enhance a multilevel vector image through its pyramid (paper 6.4)");
+  filter->add_option("input", fa.input, "Vector image with levels (vectorize --levels)")->required();
+  filter->add_option("-o,--output", fa.output, "Output vector image (.svec or .svec.json)")->required();
+  auto finite = CLI::Validator(
+      [](std::string& text) {
+        double v = 0;
+        const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v);
+        return ok ? std::string() : "expected a number, got '" + text + "'";
+      },
+      "NUMBER", "finite");
+  CLI::Option* eta = filter->add_option("--eta", fa.eta,
+                                        "Detail scale for every band: < 1 smooths, > 1 enhances (default 1)")
+                         ->check(finite);
+  CLI::Option* eta_levels =
+      filter
+          ->add_option("--eta-levels", fa.eta_levels,
+                       "Detail scale per band, finest first (a,b,...); a short list repeats its last value")
+          ->check(CLI::Validator(
+              [](std::string& text) {
+                std::vector<double> v;
+                return parse_numbers(text, v);
+              },
+              "A,B,...", "etas"));
+  eta->excludes(eta_levels);
+  filter->add_flag("--geometry-eta", fa.geometry,
+                   "Scale the position details (alone: positions only; with --color-eta: both)");
+  filter->add_flag("--color-eta", fa.color, "Scale the color details (the default when neither flag is given)");
+  filter->footer(
+      "Examples:\n"
+      "  subvec filter photo.svec -o smooth.svec --eta 0.3            # low-pass\n"
+      "  subvec filter photo.svec -o sharp.svec --eta 1.8             # enhance color detail\n"
+      "  subvec filter photo.svec -o calm.svec --eta 0.5 --geometry-eta --color-eta  # both\n"
+      "  subvec filter photo.svec -o band.svec --eta-levels 0.2,1      # damp the finest band only");
+  filter->callback([eta] { run_filter(fa, eta->count() > 0); });
+}
+
+}  // namespace subvec_cli

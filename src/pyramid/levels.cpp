@@ -1,0 +1,280 @@
+// Levels of abstraction (pyramid/levels.h, paper §5).
+#include "subvec/pyramid/levels.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <queue>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "pyramid/coarsen_p.h"
+#include "subvec/core/error.h"
+#include "subvec/mesh/curves.h"
+
+namespace subvec {
+namespace {
+
+using pyramid_detail::Coarsener;
+using pyramid_detail::Kind;
+
+[[noreturn]] void invalid(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, "levels: " + message);
+}
+
+// Garland-Heckbert quadric in (x, y, r, g, b): Q(x) = x'Ax + 2b'x + c.
+struct Quadric {
+  Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
+  double c = 0;
+  Quadric& operator+=(const Quadric& o) {
+    a += o.a, b += o.b, c += o.c;
+    return *this;
+  }
+  // min over the colors of Q at position p.
+  double min_over_colors(Vec2 p) const {
+    const Eigen::Vector2d x(p.x, p.y);
+    Eigen::Matrix3d acc = a.block<3, 3>(2, 2);
+    acc.diagonal().array() += 1e-9;
+    const Eigen::Vector3d rhs = a.block<3, 2>(2, 0) * x + b.tail<3>();
+    const Eigen::Vector3d col = -acc.ldlt().solve(rhs);
+    Eigen::Matrix<double, 5, 1> full;
+    full << x, col;
+    return std::max(0.0, full.dot(a * full) + 2 * b.dot(full) + c);
+  }
+};
+
+Quadric triangle_quadric(const Eigen::Matrix<double, 5, 1>& p, const Eigen::Matrix<double, 5, 1>& q,
+                         const Eigen::Matrix<double, 5, 1>& r) {
+  Quadric out;
+  Eigen::Matrix<double, 5, 1> e1 = q - p;
+  if (e1.norm() <= 0) return out;
+  e1.normalize();
+  Eigen::Matrix<double, 5, 1> e2 = r - p;
+  e2 -= e1.dot(e2) * e1;
+  if (e2.norm() <= 0) return out;
+  e2.normalize();
+  const double area = 0.5 * std::abs((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
+  const double pe1 = p.dot(e1), pe2 = p.dot(e2);
+  out.a = area * (Eigen::Matrix<double, 5, 5>::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
+  out.b = area * (pe1 * e1 + pe2 * e2 - p);
+  out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
+  return out;
+}
+
+// Calls visit(point, unit tangent) at points `step` pixels apart along the polyline.
+template <class Visit>
+void walk(std::span<const Vec2> line, double step, Visit&& visit) {
+  double next = step / 2;
+  double at = 0;
+  for (size_t i = 0; i + 1 < line.size(); ++i) {
+    const double dx = line[i + 1].x - line[i].x, dy = line[i + 1].y - line[i].y;
+    const double len = std::hypot(dx, dy);
+    if (len <= 0) continue;
+    while (next <= at + len) {
+      const double u = (next - at) / len;
+      visit(Vec2{line[i].x + u * dx, line[i].y + u * dy}, Vec2{dx / len, dy / len});
+      next += step;
+    }
+    at += len;
+  }
+}
+
+// Greedy half-edge collapses by quadric cost until `target` vertices remain. Kept chains stay within
+// `tolerance` of where they started; when nothing more can go, the tolerance doubles (up to
+// kMaxLoosening times) and the queue is planned afresh. Returns the collapses made, in order.
+constexpr double kMaxLoosening = 8;
+std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const LevelOptions& options) {
+  const int nv = c.num_vertices();
+  // Quadrics per merged color value, from the triangles' 5D points.
+  std::vector<Quadric> quadric(c.num_merged());
+  const double cs = options.color_scale;
+  const auto& tri = c.triangles();
+  const auto& tcol = c.triangle_colors();
+  for (size_t f = 0; f < tri.size(); ++f) {
+    Eigen::Matrix<double, 5, 1> p[3];
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 x = c.positions()[tri[f][k]];
+      const auto& m = c.merged_colors()[tcol[f][k]];
+      p[k] << x.x, x.y, cs * m[0], cs * m[1], cs * m[2];
+    }
+    const Quadric q = triangle_quadric(p[0], p[1], p[2]);
+    for (int k = 0; k < 3; ++k) quadric[tcol[f][k]] += q;
+  }
+  struct Entry {
+    double cost;
+    int32_t u, v;
+    uint32_t version_u, version_v;
+    bool operator>(const Entry& o) const {
+      if (cost != o.cost) return cost > o.cost;
+      if (u != o.u) return u > o.u;
+      return v > o.v;
+    }
+  };
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  std::vector<uint32_t> version(nv, 0);
+  auto plan = [&](int32_t u, int32_t v) {
+    if (c.kind(u) == Kind::kCorner) return;
+    std::array<std::array<int32_t, 2>, 2> pairs;
+    const int n = c.edge_color_pairs(u, v, pairs);
+    if (n == 0) return;
+    const Vec2 pu = c.positions()[u], pv = c.positions()[v];
+    double cost = 1e-8 * ((pu.x - pv.x) * (pu.x - pv.x) + (pu.y - pv.y) * (pu.y - pv.y));
+    for (int i = 0; i < n; ++i) {
+      Quadric q = quadric[pairs[i][0]];
+      q += quadric[pairs[i][1]];
+      cost += q.min_over_colors(pv);
+    }
+    queue.push({cost, u, v, version[u], version[v]});
+  };
+  std::vector<int32_t> ring, ring2;
+  auto plan_around = [&](int32_t v) {
+    c.neighbours(v, ring2);
+    for (int32_t w : ring2) {
+      plan(v, w);
+      plan(w, v);
+    }
+  };
+  auto plan_all = [&] {
+    for (int32_t v = 0; v < nv; ++v) {
+      if (!c.alive(v)) continue;
+      c.neighbours(v, ring);
+      for (int32_t w : ring) plan(v, w);
+    }
+  };
+  plan_all();
+  std::vector<EdgeVerts> collapses;
+  const double max_tolerance = tolerance * kMaxLoosening;
+  while (c.alive_vertices() > target) {
+    if (queue.empty()) {
+      if (tolerance >= max_tolerance) break;
+      tolerance *= 2;
+      plan_all();
+      continue;
+    }
+    const Entry e = queue.top();
+    queue.pop();
+    if (!c.alive(e.u) || !c.alive(e.v) || version[e.u] != e.version_u || version[e.v] != e.version_v) continue;
+    if (!c.can_collapse(e.u, e.v, tolerance)) continue;
+    std::array<std::array<int32_t, 2>, 2> pairs;
+    const int n = c.edge_color_pairs(e.u, e.v, pairs);
+    for (int i = 0; i < n; ++i) quadric[pairs[i][1]] += quadric[pairs[i][0]];
+    c.neighbours(e.u, ring);
+    c.collapse(e.u, e.v);
+    collapses.push_back({e.u, e.v});
+    for (int32_t w : ring) ++version[w];
+    for (int32_t w : ring) plan_around(w);
+  }
+  return collapses;
+}
+
+}  // namespace
+
+double curve_saliency(std::span<const Vec2> curve, const Image8& raster, double weight) {
+  double length = 0, contrast = 0;
+  int samples = 0;
+  for (size_t i = 0; i + 1 < curve.size(); ++i)
+    length += std::hypot(curve[i + 1].x - curve[i].x, curve[i + 1].y - curve[i].y);
+  walk(curve, 1.0, [&](Vec2 p, Vec2 t) {
+    const auto a = sample_bilinear(raster, p.x - t.y, p.y + t.x);
+    const auto b = sample_bilinear(raster, p.x + t.y, p.y - t.x);
+    contrast += std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]) / 2;
+    ++samples;
+  });
+  return length + weight * (samples ? contrast / samples : 0.0);
+}
+
+std::vector<double> measure_saliency(const ControlMesh& mesh, const Image8& raster, double weight) {
+  std::vector<double> out;
+  for (const Feature& f : mesh.features) {
+    std::vector<Vec2> points;
+    const size_t n = f.vertices.size() - (f.closed() ? 1 : 0);
+    for (size_t i = 0; i < n; ++i) points.push_back(mesh.positions[f.vertices[i]]);
+    const std::vector<Vec2> curve = sample_bspline(points, f.closed(), 8);
+    out.push_back(curve_saliency(curve, raster, weight));
+  }
+  return out;
+}
+
+std::vector<int> assign_feature_levels(const ControlMesh& mesh, const std::vector<double>& saliency, int levels,
+                                       const std::vector<std::pair<int32_t, int>>& overrides) {
+  const int n = static_cast<int>(mesh.features.size());
+  if (static_cast<int>(saliency.size()) != n) invalid("one saliency per feature is needed");
+  if (levels < 1) invalid("levels must be at least 1, got " + std::to_string(levels));
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    if (saliency[a] != saliency[b]) return saliency[a] > saliency[b];
+    return mesh.features[a].id < mesh.features[b].id;
+  });
+  std::vector<int> level(n, 0);
+  // Rank r (0 = most salient) falls in group floor(r L / n); group 0 reaches the coarsest level.
+  for (int r = 0; r < n; ++r) level[order[r]] = levels - 1 - static_cast<int>(int64_t{r} * levels / n);
+  for (const auto& [id, l] : overrides) {
+    if (l < 0 || l >= levels) {
+      invalid("feature " + std::to_string(id) + ": level " + std::to_string(l) + " is outside 0.." +
+              std::to_string(levels - 1));
+    }
+    bool found = false;
+    for (int i = 0; i < n; ++i) {
+      if (mesh.features[i].id == id) level[i] = l, found = true;
+    }
+    if (!found) invalid("no feature has id " + std::to_string(id));
+  }
+  return level;
+}
+
+void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& options, LevelReport* report) {
+  if (options.levels < 1 || options.levels > 16) invalid("levels must be in 1..16, got " + std::to_string(options.levels));
+  if (!(options.reduction > 0 && options.reduction < 1)) invalid("reduction must be in (0, 1)");
+  if (!std::isfinite(options.saliency_weight) || options.saliency_weight < 0) invalid("saliency weight must be >= 0");
+  if (!(options.max_feature_error > 0) || !(options.color_scale > 0)) invalid("max_feature_error and color_scale must be positive");
+  if (image.levels.empty()) invalid("the image has no level 0");
+  if (photo.width != image.width || photo.height != image.height) {
+    invalid("the photograph is " + std::to_string(photo.width) + "x" + std::to_string(photo.height) +
+            ", the vector image " + std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+  LevelReport local;
+  LevelReport& r = report ? *report : local;
+  r = {};
+  image.levels.resize(1);
+  ControlMesh& base = image.levels[0];
+  base.parent_vertices.clear();
+  base.collapses.clear();
+  std::vector<double> saliency = measure_saliency(base, photo, options.saliency_weight);
+  for (size_t f = 0; f < base.features.size(); ++f) {
+    if (base.features[f].saliency != 0) saliency[f] = base.features[f].saliency;
+    else base.features[f].saliency = saliency[f];
+  }
+  const std::vector<int> feature_level = assign_feature_levels(base, saliency, options.levels, options.feature_levels);
+  r.feature_level = feature_level;
+  r.vertices.push_back(base.num_vertices());
+  r.features.push_back(static_cast<int>(base.features.size()));
+  r.seconds.push_back(0);
+  for (int l = 1; l < options.levels; ++l) {
+    const auto start = std::chrono::steady_clock::now();
+    const ControlMesh& fine = image.levels[l - 1];
+    std::vector<int32_t> kept;
+    for (size_t f = 0; f < base.features.size(); ++f)
+      if (feature_level[f] >= l) kept.push_back(base.features[f].id);
+    Coarsener c(fine, image.width, image.height, kept);
+    const int target = std::max(4, static_cast<int>(std::ceil(fine.num_vertices() * (1 - options.reduction))));
+    // Kept chains may wander 1 px (max_feature_error) from the finer level's at level 1, 2 px at
+    // level 2, ...: coarser levels are coarser abstractions of the same curves.
+    const double tolerance = options.max_feature_error * std::ldexp(1.0, l - 1);
+    std::vector<EdgeVerts> collapses = coarsen(c, target, tolerance, options);
+    std::vector<int32_t> parents, color_merged;
+    ControlMesh coarse = c.result(parents, color_merged);
+    ColorFitOptions fit = options.fit;
+    fit_colors(coarse, image.width, image.height, photo, fit);
+    coarse.parent_vertices = std::move(parents);
+    coarse.collapses = std::move(collapses);
+    r.vertices.push_back(coarse.num_vertices());
+    r.features.push_back(static_cast<int>(coarse.features.size()));
+    image.levels.push_back(std::move(coarse));
+    r.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+}
+
+}  // namespace subvec

@@ -1,0 +1,329 @@
+// The vector image pyramid (pyramid/pyramid.h, paper §6.4): exact reconstruction at eta = 1,
+// high frequencies that fall with eta, contrast kept across retained features, files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "pyramid_test_util.h"
+#include "subvec/core/error.h"
+#include "subvec/io/svec.h"
+#include "subvec/mesh/curves.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/pyramid/pyramid.h"
+#include "subvec/render/renderer.h"
+
+namespace subvec {
+namespace {
+
+const VectorImage& shapes() {
+  static const VectorImage image = test::shapes_levels(test::shapes_image());
+  return image;
+}
+
+Image8 render_level0(const VectorImage& image) {
+  RenderOptions o;
+  o.level = 0;
+  return render(image, o);
+}
+
+// Pixels farther than `margin` from every feature polygon of level 0 (the limit curves stay within
+// about a pixel of them).
+std::vector<uint8_t> away_from_features(const VectorImage& image, double margin) {
+  std::vector<uint8_t> away(size_t(image.width) * image.height, 1);
+  for (const Feature& f : image.levels[0].features) {
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) {
+      const Vec2 a = image.levels[0].positions[f.vertices[i]], b = image.levels[0].positions[f.vertices[i + 1]];
+      const int steps = static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) * 2)) + 1;
+      for (int s = 0; s <= steps; ++s) {
+        const double x = a.x + (b.x - a.x) * s / steps, y = a.y + (b.y - a.y) * s / steps;
+        for (int py = std::max(0, int(y - margin - 1)); py <= std::min(image.height - 1, int(y + margin + 1)); ++py)
+          for (int px = std::max(0, int(x - margin - 1)); px <= std::min(image.width - 1, int(x + margin + 1)); ++px)
+            if (std::hypot(px + 0.5 - x, py + 0.5 - y) <= margin) away[size_t(py) * image.width + px] = 0;
+      }
+    }
+  }
+  return away;
+}
+
+// Mean squared 5-point Laplacian over the masked pixels, summed over channels.
+double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 1; y + 1 < img.height; ++y) {
+    for (int x = 1; x + 1 < img.width; ++x) {
+      if (!mask[size_t(y) * img.width + x]) continue;
+      for (int k = 0; k < 3; ++k) {
+        auto at = [&](int xx, int yy) { return double(img.row(yy)[3 * xx + k]); };
+        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
+        sum += l * l;
+      }
+      ++n;
+    }
+  }
+  return sum / std::max(n, 1);
+}
+
+// Mean color difference across feature `f` of `mesh`: points 1 px apart along its limit curve,
+// sampled `offset` pixels to each side.
+double contrast_across(const Image8& img, const ControlMesh& mesh, const Feature& f, double offset) {
+  std::vector<Vec2> points;
+  for (size_t i = 0; i + (f.closed() ? 1 : 0) < f.vertices.size(); ++i) points.push_back(mesh.positions[f.vertices[i]]);
+  const std::vector<Vec2> curve = sample_bspline(points, f.closed(), 8);
+  double sum = 0;
+  int n = 0;
+  double along = 0, next = 0.5;
+  for (size_t i = 0; i + 1 < curve.size(); ++i) {
+    const double dx = curve[i + 1].x - curve[i].x, dy = curve[i + 1].y - curve[i].y, len = std::hypot(dx, dy);
+    if (len <= 0) continue;
+    while (next <= along + len) {
+      const double u = (next - along) / len;
+      const Vec2 p{curve[i].x + u * dx, curve[i].y + u * dy};
+      const auto a = sample_bilinear(img, p.x - dy / len * offset, p.y + dx / len * offset);
+      const auto b = sample_bilinear(img, p.x + dy / len * offset, p.y - dx / len * offset);
+      sum += std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+      ++n;
+      next += 1;
+    }
+    along += len;
+  }
+  return n ? sum / n : 0;
+}
+
+Image8 gaussian_blur(const Image8& img, double sigma) {
+  const int r = static_cast<int>(std::ceil(3 * sigma));
+  std::vector<double> k(2 * r + 1);
+  double total = 0;
+  for (int i = -r; i <= r; ++i) total += k[i + r] = std::exp(-0.5 * i * i / (sigma * sigma));
+  for (double& x : k) x /= total;
+  std::vector<double> tmp(img.pixels.size());
+  Image8 out(img.width, img.height, 3);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double s = 0;
+        for (int i = -r; i <= r; ++i) s += k[i + r] * img.row(y)[3 * std::clamp(x + i, 0, img.width - 1) + c];
+        tmp[(size_t(y) * img.width + x) * 3 + c] = s;
+      }
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double s = 0;
+        for (int i = -r; i <= r; ++i) s += k[i + r] * tmp[(size_t(std::clamp(y + i, 0, img.height - 1)) * img.width + x) * 3 + c];
+        out.row(y)[3 * x + c] = static_cast<uint8_t>(std::clamp(std::lround(s), 0L, 255L));
+      }
+  return out;
+}
+
+// The jump of the limit colors across a feature: at each chain vertex with a chain neighbour on
+// both sides, the B-spline limit (1/6, 4/6, 1/6) of each side's control colors along the chain,
+// and the RGB distance between the two sides; the mean over the chain.
+double limit_jump(const ControlMesh& m, const Feature& f) {
+  // Color of vertex `at` in the face that holds the directed edge a -> b.
+  auto side = [&](int32_t a, int32_t b, int32_t at) -> Color {
+    for (int t = 0; t < m.num_triangles(); ++t)
+      for (int k = 0; k < 3; ++k)
+        if (m.triangles[t][k] == a && m.triangles[t][(k + 1) % 3] == b)
+          for (int j = 0; j < 3; ++j)
+            if (m.triangles[t][j] == at) return m.colors[m.triangle_colors[t][j]];
+    ADD_FAILURE() << "no face on edge " << a << " -> " << b;
+    return {};
+  };
+  double sum = 0;
+  int n = 0;
+  for (size_t i = 1; i + 1 < f.vertices.size(); ++i) {
+    const int32_t p = f.vertices[i - 1], v = f.vertices[i], q = f.vertices[i + 1];
+    double jump2 = 0;
+    const Color a[3] = {side(p, v, p), side(v, q, v), side(v, q, q)};
+    const Color b[3] = {side(v, p, p), side(q, v, v), side(q, v, q)};
+    const double la[3] = {(a[0].r + 4 * a[1].r + a[2].r) / 6, (a[0].g + 4 * a[1].g + a[2].g) / 6, (a[0].b + 4 * a[1].b + a[2].b) / 6};
+    const double lb[3] = {(b[0].r + 4 * b[1].r + b[2].r) / 6, (b[0].g + 4 * b[1].g + b[2].g) / 6, (b[0].b + 4 * b[1].b + b[2].b) / 6};
+    for (int c = 0; c < 3; ++c) jump2 += (la[c] - lb[c]) * (la[c] - lb[c]);
+    sum += std::sqrt(jump2);
+    ++n;
+  }
+  return n ? sum / n : 0;
+}
+
+FilterOptions colors(double eta) {
+  FilterOptions o;
+  o.color_eta = {eta};
+  return o;
+}
+
+FilterOptions uniform(double eta) {
+  FilterOptions o;
+  o.geometry_eta = {eta};
+  o.color_eta = {eta};
+  return o;
+}
+
+TEST(Pyramid, EtaOneReproducesEveryLevel) {
+  const VectorImage& image = shapes();
+  ASSERT_TRUE(has_pyramid(image));
+  FilterReport report;
+  const VectorImage out = filter(image, uniform(1.0), &report);
+  EXPECT_EQ(report.bands, 2);
+  EXPECT_EQ(report.restored_vertices, 0);
+  for (size_t l = 0; l < image.levels.size(); ++l) {
+    const ControlMesh &a = image.levels[l], &b = out.levels[l];
+    ASSERT_EQ(a.num_vertices(), b.num_vertices());
+    double worst = 0;
+    for (int v = 0; v < a.num_vertices(); ++v)
+      worst = std::max({worst, std::abs(a.positions[v].x - b.positions[v].x), std::abs(a.positions[v].y - b.positions[v].y)});
+    for (int c = 0; c < a.num_colors(); ++c)
+      worst = std::max({worst, double(std::abs(a.colors[c].r - b.colors[c].r)), double(std::abs(a.colors[c].g - b.colors[c].g)),
+                        double(std::abs(a.colors[c].b - b.colors[c].b))});
+    EXPECT_LE(worst, 1e-9) << "level " << l;
+  }
+  // Empty options mean eta = 1 as well.
+  EXPECT_EQ(filter(image, {}).levels[0].colors, image.levels[0].colors);
+}
+
+// Color filtering (the command's default). Near eta = 0 the energy levels off: the inverse-distance
+// prediction does not reproduce linear ramps, so the fully smoothed image keeps faint bumps
+// (docs/levels.md).
+TEST(Pyramid, HighFrequenciesFollowEta) {
+  const VectorImage& image = shapes();
+  const auto mask = away_from_features(image, 3.0);
+  double last = -1;
+  for (double eta : {0.3, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0}) {
+    const VectorImage out = filter(image, colors(eta));
+    validate(out);
+    const double e = laplacian_energy(render_level0(out), mask);
+    EXPECT_GT(e, last) << "eta " << eta;
+    last = e;
+  }
+}
+
+// Smoothing with eta = 0.3 keeps the jump across every feature of the coarsest level within 5 %
+// (in fact exactly), and the contrast of the rendered image across them within 5 % on average; a
+// Gaussian blur that removes as much high frequency loses more.
+TEST(Pyramid, ContrastAcrossRetainedFeaturesSurvivesSmoothing) {
+  const VectorImage& image = shapes();
+  const VectorImage out = filter(image, colors(0.3));
+  const Image8 before = render_level0(image), after = render_level0(out);
+  const auto mask = away_from_features(image, 3.0);
+  const double target = laplacian_energy(after, mask);
+  double sigma = 0.3;
+  while (sigma < 8 && laplacian_energy(gaussian_blur(before, sigma), mask) > target) sigma *= 1.1;
+  const Image8 blurred = gaussian_blur(before, sigma);
+  const ControlMesh& coarsest = image.levels.back();
+  ASSERT_FALSE(coarsest.features.empty());
+  double mean_change = 0, mean_blur = 0;
+  for (const Feature& c : coarsest.features) {
+    const auto it = std::find_if(image.levels[0].features.begin(), image.levels[0].features.end(),
+                                 [&](const Feature& f) { return f.id == c.id; });
+    ASSERT_NE(it, image.levels[0].features.end());
+    const Feature& f = *it;
+    const double c0 = contrast_across(before, image.levels[0], f, 1.5);
+    const double c1 = contrast_across(after, out.levels[0], f, 1.5);
+    const double cb = contrast_across(blurred, image.levels[0], f, 1.5);
+    const double j0 = limit_jump(image.levels[0], f), j1 = limit_jump(out.levels[0], f);
+    EXPECT_GT(j0, 10) << "feature " << f.id;
+    EXPECT_NEAR(j1 / j0, 1.0, 0.05) << "feature " << f.id << ": jump " << j0 << " -> " << j1;
+    const double n = static_cast<double>(coarsest.features.size());
+    mean_change += (c1 / c0 - 1) / n;
+    mean_blur += (cb / c0 - 1) / n;
+  }
+  EXPECT_LT(std::abs(mean_change), 0.05) << "rendered contrast across the kept features";
+  EXPECT_LT(mean_blur, -0.05) << "a Gaussian blur of sigma " << sigma << " kept the contrast";
+}
+
+TEST(Pyramid, BandsAndChannelsAreSeparate) {
+  const VectorImage& image = shapes();
+  FilterOptions colors_only;
+  colors_only.color_eta = {0.2};
+  const VectorImage c = filter(image, colors_only);
+  for (int v = 0; v < image.levels[0].num_vertices(); ++v) {
+    EXPECT_NEAR(c.levels[0].positions[v].x, image.levels[0].positions[v].x, 1e-9);
+    EXPECT_NEAR(c.levels[0].positions[v].y, image.levels[0].positions[v].y, 1e-9);
+  }
+  EXPECT_NE(c.levels[0].colors, image.levels[0].colors);
+  FilterOptions geometry_only;
+  geometry_only.geometry_eta = {0.2};
+  const VectorImage g = filter(image, geometry_only);
+  EXPECT_NE(g.levels[0].positions, image.levels[0].positions);
+  validate(g);
+  // Only the coarse band: level 1 changes, and level 0 follows it.
+  FilterOptions coarse_band;
+  coarse_band.color_eta = {1.0, 0.2};
+  const VectorImage b = filter(image, coarse_band);
+  EXPECT_EQ(b.levels[2].colors, image.levels[2].colors);
+  EXPECT_NE(b.levels[1].colors, image.levels[1].colors);
+  EXPECT_NE(b.levels[0].colors, image.levels[0].colors);
+  // The coarsest level never changes.
+  EXPECT_EQ(filter(image, uniform(0.1)).levels[2].colors, image.levels[2].colors);
+}
+
+TEST(Pyramid, BadRequests) {
+  const VectorImage& image = shapes();
+  FilterOptions too_many;
+  too_many.color_eta = {1, 1, 1};
+  EXPECT_THROW(filter(image, too_many), Error);
+  FilterOptions nan;
+  nan.color_eta = {std::nan("")};
+  EXPECT_THROW(filter(image, nan), Error);
+  VectorImage one = image;
+  one.levels.resize(1);
+  EXPECT_FALSE(has_pyramid(one));
+  EXPECT_THROW(filter(one, {}), Error);
+  // A record that does not make its level.
+  VectorImage broken = image;
+  std::swap(broken.levels[1].collapses[0], broken.levels[1].collapses[1]);
+  std::reverse(broken.levels[1].collapses.begin(), broken.levels[1].collapses.end());
+  EXPECT_THROW(filter(broken, {}), Error);
+}
+
+// The records survive every file form, including the compact one that renumbers vertices, and the
+// pyramid of the file read back reproduces its levels.
+TEST(Pyramid, FilesKeepThePyramid) {
+  const VectorImage& image = shapes();
+  for (const bool lossless : {true, false}) {
+    SvecWriteOptions w;
+    w.lossless = lossless;
+    const VectorImage read = parse_svec_binary(to_svec_binary(image, w));
+    ASSERT_TRUE(has_pyramid(read)) << lossless;
+    if (lossless) {
+      for (size_t l = 0; l < image.levels.size(); ++l) {
+        EXPECT_EQ(read.levels[l].parent_vertices, image.levels[l].parent_vertices);
+        EXPECT_EQ(read.levels[l].collapses, image.levels[l].collapses);
+      }
+    }
+    const VectorImage same = filter(read, uniform(1.0));
+    for (size_t l = 0; l < read.levels.size(); ++l) {
+      for (int v = 0; v < read.levels[l].num_vertices(); ++v) {
+        EXPECT_NEAR(same.levels[l].positions[v].x, read.levels[l].positions[v].x, 1e-9);
+        EXPECT_NEAR(same.levels[l].positions[v].y, read.levels[l].positions[v].y, 1e-9);
+      }
+      EXPECT_EQ(same.levels[l].colors, read.levels[l].colors);
+    }
+    // Smoothing the compact file looks like smoothing the original.
+    const Image8 a = render_level0(filter(read, uniform(0.3))), b = render_level0(filter(image, uniform(0.3)));
+    double diff = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) diff += std::abs(int(a.pixels[i]) - int(b.pixels[i]));
+    EXPECT_LT(diff / static_cast<double>(a.pixels.size()), 1.0) << lossless;
+  }
+  const VectorImage json = parse_svec_json(to_svec_json(image));
+  for (size_t l = 0; l < image.levels.size(); ++l) {
+    EXPECT_EQ(json.levels[l].parent_vertices, image.levels[l].parent_vertices);
+    EXPECT_EQ(json.levels[l].collapses, image.levels[l].collapses);
+  }
+  // Out-of-range records are refused at the boundary.
+  VectorImage bad = image;
+  bad.levels[1].parent_vertices[0] = image.levels[0].num_vertices();
+  EXPECT_THROW(parse_svec_json(to_svec_json(bad)), Error);
+  SvecWriteOptions lossless;
+  lossless.lossless = true;
+  EXPECT_THROW(parse_svec_binary(to_svec_binary(bad, lossless)), Error);
+  bad = image;
+  bad.levels[1].collapses.pop_back();
+  EXPECT_THROW(validate(bad), Error);
+  bad = image;
+  bad.levels[0].parent_vertices = {0};
+  EXPECT_THROW(validate(bad), Error);
+}
+
+}  // namespace
+}  // namespace subvec
