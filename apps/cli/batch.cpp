@@ -39,6 +39,7 @@
 #include "subvec/io/file.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
+#include "subvec/pyramid/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 
@@ -56,6 +57,7 @@ struct BatchArgs {
   int threads = 1;  // per image
   double ratio = 0.01;
   int vertices = 0;
+  int levels = 3;  // as `subvec vectorize --levels`
   int64_t max_pixels = int64_t{1} << 23;
   bool render_png = false;
 };
@@ -160,7 +162,12 @@ void process(Item& item, const BatchArgs& a) {
     options.ratio = a.ratio;
     options.vertices = a.vertices;
     options.threads = a.threads;
-    bytes = subvec::to_svec_binary(subvec::vectorize(photo, options));
+    subvec::VectorImage vectorized = subvec::vectorize(photo, options);
+    // Levels of abstraction as `subvec vectorize --levels` makes them (pyramid/levels.h).
+    subvec::LevelOptions level_options;
+    level_options.levels = a.levels;
+    subvec::build_levels(vectorized, photo, level_options);
+    bytes = subvec::to_svec_binary(vectorized);
     // What the file holds (positions and colors on the .svec grids), measured and drawn below.
     saved = std::make_unique<subvec::VectorImage>(subvec::parse_svec_binary(bytes));
   }
@@ -389,6 +396,8 @@ void add_batch_command(CLI::App& app) {
       batch->add_option("--vertices", ba.vertices, "Control vertex count instead of --ratio")
           ->check(CLI::Range(4, 1 << 26));
   ratio->excludes(vertices);
+  batch->add_option("--levels", ba.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
+      ->check(CLI::Range(1, 16));
   batch
       ->add_option("--max-pixels", ba.max_pixels,
                    "Refuse (fail) larger images (default 8388608, about 12 GB of memory each)")

@@ -79,7 +79,8 @@ def previous_output(svec_path, png_path, render_png, subvec):
         return None
 
 
-def vectorize_one(in_path, out_dir, conflict, ratio, vertices, render_png, fail_once_dir=None):
+def vectorize_one(in_path, out_dir, conflict, ratio, vertices, levels, render_png,
+                  fail_once_dir=None):
     """The task: one image, as `subvec batch` does it (apps/cli/batch.cpp). Returns its row."""
     import subvec  # on the worker
 
@@ -104,7 +105,8 @@ def vectorize_one(in_path, out_dir, conflict, ratio, vertices, render_png, fail_
         saved = None
     data = None
     if saved is None:
-        data = subvec.vectorize(photo, ratio=ratio, vertices=vertices, threads=1).to_bytes()
+        data = subvec.vectorize(photo, ratio=ratio, vertices=vertices, levels=levels,
+                                threads=1).to_bytes()
         saved = subvec.from_bytes(data)  # what the file holds, measured and drawn below
     rendered = saved.render(threads=1)
     mae = subvec.compare(photo, rendered)["mae_mean"]
@@ -134,7 +136,8 @@ def summary_csv(rows):
     return out.getvalue()
 
 
-def run(client, in_dir, out_dir, ratio=0.01, vertices=0, render_png=False, fail_once_dir=None,
+def run(client, in_dir, out_dir, ratio=0.01, vertices=0, levels=3, render_png=False,
+        fail_once_dir=None,
         log=sys.stderr):
     """Vectorizes in_dir into out_dir on `client`'s cluster; returns the summary rows."""
     from dask.distributed import as_completed
@@ -149,7 +152,7 @@ def run(client, in_dir, out_dir, ratio=0.01, vertices=0, render_png=False, fail_
         conflict = "" if owner == name else \
             f"its output {stem}.svec would be the output of {owner}"
         future = client.submit(vectorize_one, os.path.join(in_dir, name), out_dir, conflict,
-                               ratio, vertices, render_png, fail_once_dir,
+                               ratio, vertices, levels, render_png, fail_once_dir,
                                key=f"vectorize-{name}", retries=1, pure=False)
         futures[future] = name
     rows = []
@@ -178,6 +181,8 @@ def main(argv=None):
     size.add_argument("--ratio", type=float, default=0.01,
                       help="control vertices as a fraction of the pixel count (default 0.01)")
     size.add_argument("--vertices", type=int, default=0, help="control vertex count instead")
+    parser.add_argument("--levels", type=int, default=3,
+                        help="levels of abstraction, 1 to 16 (default 3), as subvec vectorize")
     parser.add_argument("--render-png", action="store_true", help="also write NAME.png")
     parser.add_argument("--fail-once", metavar="DIR", help=argparse.SUPPRESS)  # tests: retries
     args = parser.parse_args(argv)
@@ -197,6 +202,7 @@ def main(argv=None):
         client = Client(cluster)
     try:
         rows = run(client, args.input, args.output, ratio=args.ratio, vertices=args.vertices,
+                   levels=args.levels,
                    render_png=args.render_png, fail_once_dir=args.fail_once)
     finally:
         client.close()

@@ -34,6 +34,8 @@
 #include "subvec/io/svec.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/pyramid/levels.h"
+#include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
 #include "subvec/vectorize/vectorize.h"
@@ -655,6 +657,19 @@ PYBIND11_MODULE(_subvec, m) {
                 "color_stencils"_a = csr(sub->color_stencils()));
           },
           py::kw_only(), "level"_a = 0, "depth"_a = 3, "limit"_a = true)
+      // Levels of abstraction (pyramid/pyramid.h): a new image with every level filtered.
+      .def_property_readonly("has_pyramid", [](const VectorImage& v) { return subvec::has_pyramid(v); })
+      .def(
+          "filter",
+          [](const VectorImage& v, std::vector<double> geometry_eta, std::vector<double> color_eta) {
+            subvec::FilterOptions options;
+            options.geometry_eta = std::move(geometry_eta);
+            options.color_eta = std::move(color_eta);
+            py::gil_scoped_release release;
+            return subvec::filter(v, options);
+          },
+          py::kw_only(), "geometry_eta"_a = std::vector<double>{},
+          "color_eta"_a = std::vector<double>{})
       .def(py::pickle(
           [](const VectorImage& v) {
             subvec::SvecWriteOptions options;
@@ -675,11 +690,9 @@ PYBIND11_MODULE(_subvec, m) {
           invalid("ratio must be in (0, 1], got " + std::to_string(ratio));
         }
         if (vertices != 0 && vertices < 4) invalid("vertices must be 0 (use ratio) or at least 4");
-        // TODO(issue 4, levels of abstraction): build `levels` levels once the library has the
-        // pyramid (include/subvec/pyramid/); until then only the one level vectorization makes.
-        if (levels != 1) {
-          invalid("levels=" + std::to_string(levels) +
-                  ": this build makes one level (levels of abstraction are not in the library yet)");
+        if (levels < 1 || levels > 16) {  // as `subvec vectorize --levels`
+          invalid("levels must be in 1 to 16" + std::string() +
+                  ", got " + std::to_string(levels));
         }
         subvec::Image8 img = image_from_array(image);
         subvec::VectorizeOptions options;
@@ -687,9 +700,15 @@ PYBIND11_MODULE(_subvec, m) {
         options.vertices = vertices;
         options.threads = threads;
         py::gil_scoped_release release;
-        return subvec::vectorize(img, options);
+        VectorImage v = subvec::vectorize(img, options);
+        // As `subvec vectorize --levels` does: levels of abstraction by saliency (with one level,
+        // only each feature's saliency is stored), so both give the same file.
+        subvec::LevelOptions level_options;
+        level_options.levels = levels;
+        subvec::build_levels(v, img, level_options);
+        return v;
       },
-      "image"_a, py::kw_only(), "ratio"_a = 0.01, "vertices"_a = 0, "levels"_a = 1,
+      "image"_a, py::kw_only(), "ratio"_a = 0.01, "vertices"_a = 0, "levels"_a = 3,
       "threads"_a = 0);
 
   m.def(

@@ -21,7 +21,7 @@ BUTTERFLY_OPS = ROOT / "docs" / "figures" / "butterfly-ops.json"
 @pytest.fixture(scope="module")
 def disk():
     photo = disk_image()
-    return photo, subvec.vectorize(photo, ratio=0.05)
+    return photo, subvec.vectorize(photo, ratio=0.05, levels=1)
 
 
 # ---- NumPy round trips ---------------------------------------------------------------------
@@ -43,12 +43,12 @@ def test_vectorize_then_render_reproduces_the_photo(disk):
 
 def test_float_input_in_0_1_equals_uint8_input(disk):
     photo, image = disk
-    as_float = subvec.vectorize(photo.astype(np.float32) / 255, ratio=0.05)
+    as_float = subvec.vectorize(photo.astype(np.float32) / 255, ratio=0.05, levels=1)
     assert as_float.to_bytes(lossless=True) == image.to_bytes(lossless=True)
     # Non-contiguous views are read correctly too.
     wide = np.zeros((72, 96 * 2, 3), np.uint8)
     wide[:, ::2] = photo
-    assert subvec.vectorize(wide[:, ::2], ratio=0.05).to_bytes() == image.to_bytes()
+    assert subvec.vectorize(wide[:, ::2], ratio=0.05, levels=1).to_bytes() == image.to_bytes()
 
 
 def test_read_image_and_write_png_round_trip(tmp_path, disk):
@@ -136,8 +136,11 @@ def test_info_matches_the_cli(cli):
     path = EXAMPLES / "03-junction.svec.json"
     expected = json.loads(cli("info", path, "--json").stdout)
     info = subvec.load(path).info()
-    for key in ("width", "height", "levels", "strokes", "metadata"):
+    for key in ("width", "height", "strokes", "metadata"):
         assert info[key] == expected[key], key
+    assert len(info["levels"]) == len(expected["levels"])
+    for mine, cli_level in zip(info["levels"], expected["levels"]):
+        assert mine == {k: cli_level[k] for k in mine}
 
 
 # ---- edits -----------------------------------------------------------------------------------
@@ -239,7 +242,7 @@ def test_bad_arrays_raise_invalid_argument():
     with pytest.raises(subvec.InvalidArgumentError, match="ratio"):
         subvec.vectorize(disk_image(), ratio=0)
     with pytest.raises(subvec.InvalidArgumentError, match="levels"):
-        subvec.vectorize(disk_image(), levels=3)
+        subvec.vectorize(disk_image(), levels=0)
     with pytest.raises(ValueError):  # the built-in base class works for callers that know no subvec
         subvec.vectorize(np.zeros((0, 4, 3), np.uint8))
 
@@ -307,7 +310,7 @@ def test_long_calls_release_the_gil():
     thread.start()
     try:
         start = time.monotonic()
-        subvec.vectorize(photo, ratio=0.02)
+        subvec.vectorize(photo, ratio=0.02, levels=1)
         end = time.monotonic()
     finally:
         stop.set()
@@ -346,3 +349,26 @@ def test_the_stub_declares_the_whole_api():
     cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "VectorImage")
     methods = {n.name for n in cls.body if isinstance(n, ast.FunctionDef)}
     assert methods == {n for n in dir(subvec.VectorImage) if not n.startswith("_")}
+
+
+# ---- levels of abstraction -----------------------------------------------------------------
+
+
+def test_levels_and_filter_equal_the_cli(tmp_path, cli, disk):
+    photo, _ = disk
+    image = subvec.vectorize(photo, ratio=0.05, levels=3)
+    assert image.num_levels == 3 and image.has_pyramid
+    counts = [lv["vertices"] for lv in image.info()["levels"]]
+    assert counts[0] > counts[1] > counts[2]
+    subvec.write_png(tmp_path / "photo.png", photo)
+    cli("vectorize", tmp_path / "photo.png", "-o", tmp_path / "cli.svec", "--ratio", "0.05",
+        "--levels", "3")
+    image.save(tmp_path / "py.svec")
+    assert (tmp_path / "py.svec").read_bytes() == (tmp_path / "cli.svec").read_bytes()
+    assert np.array_equal(subvec.load(tmp_path / "py.svec").render(level=2),
+                          subvec.load(tmp_path / "cli.svec").render(level=2))
+    flat = image.filter(geometry_eta=[1], color_eta=[0])
+    assert flat.num_levels == 3
+    assert not np.array_equal(flat.render(), image.render())
+    with pytest.raises(subvec.InvalidArgumentError):
+        subvec.vectorize(photo, ratio=0.05, levels=1).filter(color_eta=[0])
