@@ -82,6 +82,9 @@ def test_outputs_do_not_depend_on_jobs(cli, folder, tmp_path):
     cli("batch", folder, "-o", out, "--jobs", "1", "--threads", "2", "--ratio", "0.03",
         check=False)
     assert (out / "img1.svec").read_bytes() == results["1"]["img1.svec"]
+    # And they are what `subvec vectorize` writes with the same options.
+    cli("vectorize", folder / "img2.png", "-o", tmp_path / "single.svec", "--ratio", "0.03")
+    assert (tmp_path / "single.svec").read_bytes() == results["1"]["img2.svec"]
 
 
 def test_batch_resumes_and_redoes_damaged_outputs(cli, folder, tmp_path):
