@@ -38,6 +38,7 @@
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 
+#include "batch.h"
 #include "edit_commands.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
 // serve (issue 7): the browser editor, apps/serve/
@@ -833,6 +834,7 @@ int run(int argc, char** argv) {
   subvec_cli::add_edit_commands(app);  // edit, stylize
   subvec_cli::add_pyramid_commands(app);  // filter
   subvec_serve::add_serve_command(app);  // serve (issue 7, apps/serve/)
+  subvec_cli::add_batch_command(app);  // batch
 
   try {
     app.parse(argc, argv);
@@ -849,10 +851,10 @@ int run(int argc, char** argv) {
       // No command: either none was given or the first word is not one.
       const std::vector<std::string> extra = app.remaining();
       if (extra.empty()) {
-        message = "a command is required: vectorize, render, edit, stylize, filter, serve, info, convert or compare";
+        message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
       } else {
         message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, render, edit, stylize, filter, serve, info, convert or compare)";
+                  extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
         status = int(CLI::ExitCodes::ExtrasError);
       }
     }
