@@ -12,6 +12,7 @@
 #include "subvec/mesh/curves.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/pyramid/pyramid.h"
 
 namespace subvec_serve {
 
@@ -116,6 +117,8 @@ DocumentInfo Editor::info() const {
   info.undo = static_cast<int>(undo_.size());
   info.redo = static_cast<int>(redo_.size());
   info.strokes = static_cast<int>(image_.strokes.size());
+  info.bands = subvec::has_pyramid(image_) ? static_cast<int>(image_.levels.size()) - 1 : 0;
+  if (filter_version_ == version_) info.filter = filter_;
   return info;
 }
 
@@ -619,6 +622,62 @@ Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
         " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")";
   commit_locked(std::move(edited));
   return delta_locked(session, nullptr, true);
+}
+
+Delta Editor::filter(const std::string& session_id, int64_t version, const FilterRequest& request,
+                     std::string& log) {
+  std::lock_guard lock(mutex_);
+  Session& session = session_locked(session_id);
+  check_version_locked(version);
+  const bool continues = filter_version_ == version_;
+  const VectorImage& base = continues ? filter_base_ : image_;
+  if (!subvec::has_pyramid(base)) {
+    throw RequestError(kUnprocessable, "this image has no level pyramid to filter (make one with "
+                                       "subvec vectorize --levels 2 or more)");
+  }
+  const int bands = static_cast<int>(base.levels.size()) - 1;
+  if (request.eta.empty() || static_cast<int>(request.eta.size()) > bands) {
+    throw RequestError(kBadRequest, "\"eta\" must have 1 to " + std::to_string(bands) +
+                                        " values (one per band)");
+  }
+  for (double eta : request.eta) {
+    if (!std::isfinite(eta) || eta < 0 || eta > 4) {
+      throw RequestError(kBadRequest, "\"eta\" values must be 0 to 4");
+    }
+  }
+  const bool identity = (!request.geometry && !request.color) ||
+                        std::all_of(request.eta.begin(), request.eta.end(),
+                                    [](double eta) { return eta == 1; });
+  VectorImage filtered;
+  subvec::FilterReport report;
+  if (identity) {
+    filtered = base;
+  } else {
+    subvec::FilterOptions options;
+    if (request.geometry) options.geometry_eta = request.eta;
+    if (request.color) options.color_eta = request.eta;
+    try {
+      filtered = subvec::filter(base, options, &report);
+    } catch (const Error& e) {
+      refuse_edit(e);
+    }
+  }
+  VectorImage start = continues ? std::move(filter_base_) : image_;
+  commit_locked(std::move(filtered));
+  filter_base_ = std::move(start);
+  filter_version_ = version_;
+  filter_ = request;
+  session.drag.reset();
+  log = identity ? "filter off: the image before filtering"
+                 : "filtered " + std::to_string(bands) + (bands == 1 ? " band" : " bands") + " on " +
+                       (request.geometry && request.color ? "geometry and color"
+                        : request.geometry              ? "geometry"
+                                                        : "color") +
+                       (report.restored_vertices > 0
+                            ? ", " + std::to_string(report.restored_vertices) +
+                                  " vertices held back from folding"
+                            : std::string());
+  return delta_locked(session, nullptr, false);
 }
 
 Delta Editor::undo(const std::string& session_id, int64_t version) {

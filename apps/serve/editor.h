@@ -55,7 +55,7 @@ class RequestError : public std::runtime_error {
 
 // Status codes used by the editor (RFC 9110 names).
 inline constexpr int kBadRequest = 400, kNotFound = 404, kConflict = 409, kUnprocessable = 422,
-                     kNotImplemented = 501, kUnavailable = 503;
+                     kUnavailable = 503;
 
 struct ViewRequest {
   int level = 0;
@@ -97,6 +97,14 @@ struct StrokeGeometry {
   Color color;
 };
 
+// A filter of the level pyramid's detail bands (pyramid/pyramid.h, as `subvec filter`): eta per
+// band, finest first (a short list repeats its last value), applied to the positions and/or the
+// colors.
+struct FilterRequest {
+  std::vector<double> eta;
+  bool geometry = false, color = true;
+};
+
 struct DocumentInfo {
   int64_t version = 0;
   int width = 0, height = 0;
@@ -107,6 +115,9 @@ struct DocumentInfo {
   std::vector<Level> levels;
   int undo = 0, redo = 0;
   int strokes = 0;
+  int bands = 0;  // detail bands of the level pyramid (0: no pyramid, nothing to filter)
+  // The filter the document shows, while the last change was a filter (the page's sliders).
+  std::optional<FilterRequest> filter;
 };
 
 // One drag in progress (drag tool or move-feature tool).
@@ -181,6 +192,11 @@ class Editor {
               std::string& log);
   Delta stylize(const std::string& session, int64_t version, int level, std::optional<double> threshold,
                 uint64_t seed, double probability, std::string& log);
+  // Filters the pyramid (subvec::filter). The sliders are absolute: a filter that directly follows
+  // another (no edit, undo or redo between them) replaces it, i.e. filters the image the first one
+  // started from, so eta = 1 everywhere gives that image back exactly. Each one is an undo step.
+  Delta filter(const std::string& session, int64_t version, const FilterRequest& request,
+               std::string& log);
   Delta undo(const std::string& session, int64_t version);
   Delta redo(const std::string& session, int64_t version);
 
@@ -198,6 +214,10 @@ class Editor {
   VectorImage image_;
   int64_t version_ = 1;
   std::vector<VectorImage> undo_, redo_;
+  // The image the current run of filters started from, valid while version_ == filter_version_.
+  VectorImage filter_base_;
+  int64_t filter_version_ = 0;
+  FilterRequest filter_;  // the filter that made version filter_version_
   std::vector<std::unique_ptr<Session>> sessions_;  // most recently used first
   int64_t next_session_ = 1, next_view_ = 1;
 };

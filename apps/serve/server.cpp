@@ -125,6 +125,13 @@ int small_int(const json& j, const char* key, int fallback) {
   return static_cast<int>(v);
 }
 
+bool flag(const json& j, const char* key, bool fallback) {
+  if (!j.contains(key)) return fallback;
+  const json& v = field(j, key);
+  if (!v.is_boolean()) throw RequestError(kBadRequest, std::string("\"") + key + "\" must be true or false");
+  return v.get<bool>();
+}
+
 std::string text(const json& j, const char* key) {
   const json& v = field(j, key);
   if (!v.is_string()) throw RequestError(kBadRequest, std::string("\"") + key + "\" must be a string");
@@ -434,10 +441,15 @@ void EditorServer::Impl::routes() {
                     {"strokes", info.strokes},
                     {"save_to", save},
                     {"filter",
-                     {{"available", false},
-                      {"reason",
-                       "filtering needs the pyramid layer (levels of abstraction, issue 4), "
-                       "which this build does not have yet"}}}});
+                     {{"available", info.bands > 0},
+                      {"bands", info.bands},
+                      {"current", info.filter ? json{{"eta", info.filter->eta},
+                                                     {"geometry", info.filter->geometry},
+                                                     {"color", info.filter->color}}
+                                              : json(nullptr)},
+                      {"reason", info.bands > 0 ? ""
+                                                : "this image has one level, so no pyramid to filter "
+                                                  "(vectorize it with --levels 2 or more)"}}}});
   });
 
   server.Post("/api/session", [this](const httplib::Request&, httplib::Response& res) {
@@ -606,15 +618,25 @@ void EditorServer::Impl::routes() {
   server.Post("/api/undo", history(true));
   server.Post("/api/redo", history(false));
 
-  // Filtering of the pyramid's detail bands (paper §5): the request is specified now so that the
-  // page and the API are ready, and answered once the pyramid layer is part of the library.
+  // Filtering of the pyramid's detail bands (paper §6.4), through subvec::filter as `subvec filter`.
   server.Post("/api/filter", [this](const httplib::Request& req, httplib::Response& res) {
     const json j = body_json(req);
-    (void)ready_editor();
-    (void)j;
-    send_error(res, kNotImplemented,
-               "filtering needs the pyramid layer (levels of abstraction, issue 4), which this "
-               "build does not have yet");
+    FilterRequest request;
+    const json& eta = field(j, "eta");
+    if (!eta.is_array() || eta.size() > 64) {
+      throw RequestError(kBadRequest, "\"eta\" must be an array of numbers, one per band");
+    }
+    for (const json& v : eta) {
+      if (!v.is_number()) throw RequestError(kBadRequest, "\"eta\" must hold numbers");
+      request.eta.push_back(v.get<double>());
+    }
+    request.geometry = flag(j, "geometry", false);
+    request.color = flag(j, "color", true);
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->filter(text(j, "session"), integer(j, "version"), request, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
   });
 
   server.Post("/api/save", [this](const httplib::Request& req, httplib::Response& res) {

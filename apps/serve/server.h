@@ -4,7 +4,7 @@
 // Boundaries. Requests are bounded (a 64 KiB body, the header limits of cpp-httplib), every error
 // is a JSON object {"error": "..."} with an HTTP status (400 malformed request, 403 foreign Host,
 // 404 unknown path or session, 409 stale version, 413 too large, 415 not JSON, 422 an edit the
-// image does not allow, 501 not available in this build, 503 still vectorizing). The server reads
+// image does not allow, 503 still vectorizing). The server reads
 // the input file once and writes only the output file the user named with -o; downloads are
 // built in memory. Bound to loopback (the default), it answers only requests whose Host header
 // names a loopback address, so a web page elsewhere cannot reach it through DNS rebinding, and

@@ -26,7 +26,10 @@ interface LevelInfo { vertices: number; triangles: number; colors: number; featu
 interface DocInfo {
   name: string; stem: string; version: number; width: number; height: number; levels: LevelInfo[];
   undo: number; redo: number; strokes: number; save_to: string | null;
-  filter: { available: boolean; reason: string };
+  filter: {
+    available: boolean; bands: number; reason: string;
+    current: null | { eta: number[]; geometry: boolean; color: boolean };
+  };
 }
 
 const state = {
@@ -229,12 +232,10 @@ async function loadDocument() {
   level.value = String(state.level);
   level.disabled = doc.levels.length < 2;
   $('level-help').textContent = doc.levels.length < 2
-    ? 'This file has one level. Levels of abstraction (a coarser image per level, issue 4) appear here when the file has them.'
+    ? 'This file has one level. Levels of abstraction (a coarser image per level: subvec vectorize --levels) appear here when the file has them.'
     : `${doc.levels.length} levels: 0 is the finest, higher levels are coarser abstractions.`;
   describeLevel();
-  $('filter-note').textContent =
-    'Scales the detail of each band of the level pyramid (η < 1 smooths, > 1 sharpens). ' +
-    (doc.filter.available ? '' : `Disabled: ${doc.filter.reason}.`);
+  buildFilterSliders(doc);
   $('save-help').textContent = doc.save_to
     ? `Save writes ${doc.save_to}. Downloads are made from the current state.`
     : 'Save downloads the .svec (start the server with -o OUT.svec to save in place).';
@@ -269,8 +270,10 @@ async function refreshCounts() {
     state.doc.undo = doc.undo;
     state.doc.redo = doc.redo;
     state.doc.version = doc.version;
+    state.doc.filter = doc.filter;
   }
   updateHistoryButtons();
+  showFilter(doc);
 }
 
 // Runs an edit; on a version conflict reloads from the server, on other errors reports them.
@@ -344,6 +347,75 @@ async function doStylize() {
     });
     applyDelta(f);
     status(`stylize: ${f.header.log}`);
+  });
+}
+
+// ---- filter (the level pyramid, paper §6.4) ---------------------------------------------------
+
+// One η slider per detail band, finest first. The sliders are absolute: the server filters the
+// image the current run of filter changes started from, and any other change (an edit, undo, redo,
+// another tab) starts a new run, so the sliders go back to 1 (showFilter).
+function buildFilterSliders(doc: DocInfo) {
+  const box = $('filter-bands');
+  box.textContent = '';
+  for (let b = 0; b < doc.filter.bands; b++) {
+    const row = document.createElement('div');
+    row.className = 'row';
+    const label = document.createElement('label');
+    label.htmlFor = `eta-${b}`;
+    label.textContent = `η band ${b + 1}`;
+    label.title = b === 0 ? 'the finest band: level 0 against level 1' : `level ${b} against level ${b + 1}`;
+    const input = document.createElement('input');
+    Object.assign(input, { type: 'range', id: `eta-${b}`, min: '0', max: '2', step: '0.05', value: '1' });
+    const out = document.createElement('output');
+    out.id = `eta-${b}-out`;
+    input.addEventListener('input', () => { out.textContent = Number(input.value).toFixed(2); });
+    input.addEventListener('change', () => void doFilter());
+    row.append(label, input, out);
+    box.append(row);
+  }
+  const enabled = doc.filter.available;
+  for (const id of ['filter-geometry', 'filter-color', 'filter-reset']) $<HTMLInputElement>(id).disabled = !enabled;
+  $('filter-note').textContent = enabled
+    ? `Smooths or enhances the image through its level pyramid (${doc.filter.bands} detail ` +
+      `${doc.filter.bands === 1 ? 'band' : 'bands'} between its ${doc.levels.length} levels): η < 1 ` +
+      'removes detail (1 = unchanged, 0 = the coarser level\'s shape or colors), η > 1 sharpens it. ' +
+      'Release a slider to apply it to every level; each change is one undo step.'
+    : `Smooths or enhances the image through its level pyramid. Not available here: ${doc.filter.reason}.`;
+  showFilter(doc);
+}
+
+function showFilter(doc: DocInfo) {
+  const cur = doc.filter.current;
+  for (let b = 0; b < doc.filter.bands; b++) {
+    const input = document.getElementById(`eta-${b}`) as HTMLInputElement | null;
+    if (!input) continue;
+    const eta = cur ? cur.eta[Math.min(b, cur.eta.length - 1)] : 1;
+    input.value = String(eta);
+    $(`eta-${b}-out`).textContent = eta.toFixed(2);
+  }
+  if (cur) {
+    $<HTMLInputElement>('filter-geometry').checked = cur.geometry;
+    $<HTMLInputElement>('filter-color').checked = cur.color;
+  }
+}
+
+async function doFilter(reset = false) {
+  const doc = state.doc;
+  if (!doc || !doc.filter.available) return;
+  const eta: number[] = [];
+  for (let b = 0; b < doc.filter.bands; b++) {
+    if (reset) $<HTMLInputElement>(`eta-${b}`).value = '1';
+    eta.push(num(`eta-${b}`));
+  }
+  // Nothing to do (and no undo step to make) when no filter is shown and every η is 1.
+  if (!doc.filter.current && eta.every((e) => e === 1)) return;
+  const geometry = $<HTMLInputElement>('filter-geometry').checked;
+  const color = $<HTMLInputElement>('filter-color').checked;
+  await edit(async () => {
+    const f = await postFrame('/api/filter', { session: state.session, version: state.version, eta, geometry, color });
+    applyDelta(f);
+    status(`filter: ${f.header.log}`);
   });
 }
 
@@ -604,6 +676,9 @@ function wireControls() {
   $('redo').addEventListener('click', () => void doHistory('redo'));
   $('save').addEventListener('click', () => void doSave());
   $('stylize').addEventListener('click', () => void doStylize());
+  $('filter-geometry').addEventListener('change', () => void doFilter());
+  $('filter-color').addEventListener('change', () => void doFilter());
+  $('filter-reset').addEventListener('click', () => void doFilter(true));
   document.querySelectorAll<HTMLAnchorElement>('.downloads a').forEach((a) =>
     a.addEventListener('click', (e) => { e.preventDefault(); download(a.dataset.format!); }));
   setTool('drag');
@@ -661,6 +736,12 @@ window.subvec = {
     renderer.draw(state.transform, state.overlays);
     const t = state.transform;
     return renderer.readPixel(x * t.zoom + t.panX, y * t.zoom + t.panY);
+  },
+  // RGBA at many image points, after one synchronous redraw.
+  pixelsAt(points: [number, number][]) {
+    renderer.draw(state.transform, state.overlays);
+    const t = state.transform;
+    return points.map(([x, y]) => renderer.readPixel(x * t.zoom + t.panX, y * t.zoom + t.panY));
   },
   // Canvas CSS coordinates (relative to the page) of image point (x, y).
   clientPoint(x: number, y: number) {

@@ -1,11 +1,13 @@
 // End-to-end test of `subvec serve` in headless Chromium (playwright-core, software WebGL):
 // open a served example, drag a feature, change a color, undo and redo, switch levels, save, and
-// two tabs at once. Asserts on canvas pixels and on the saved file.
+// two tabs at once; filter a two-level image through its pyramid. Asserts on canvas pixels and on
+// the saved file.
 //
 //   node web/tests/e2e.mjs BUILD/bin/subvec [SCREENSHOT.png]
 //
 // Exit status 0: all passed; 1: a check failed; 77: skipped (no Chromium or no node_modules),
 // with the reason on stdout. The last line is "N passed, M failed".
+import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
@@ -220,6 +222,78 @@ try {
   check('serve stops cleanly on SIGTERM', code === 0, `exit ${code}: ${server.stderr()}`);
   rmSync(dir, { recursive: true, force: true });
 }
+// Filter: a two-level vectorization of the rocket (a real pyramid). Releasing the finest band's η
+// slider at 0 smooths the colors (pixels away from the features change); η = 1 restores them.
+{
+  const fdir = mkdtempSync(join(tmpdir(), 'subvec-e2e-filter-'));
+  const levels = join(fdir, 'rocket.svec');
+  try {
+    execFileSync(binary, ['vectorize', join(root, 'examples', '04-rocket.png'), '-o', levels, '--vertices', '600',
+      '--levels', '2'], { stdio: 'ignore' });
+    const fserver = await serve(binary, [levels]);
+    const b = await launch(chromium);
+    try {
+      const { page, errors } = await openEditor(b, fserver.url);
+      const doc = await page.evaluate(async () => (await fetch('/api/document')).json());
+      check('filter: the panel is enabled with one slider per band',
+        doc.filter.available && doc.filter.bands === 1 && await page.evaluate(() =>
+          !document.getElementById('eta-0').disabled && !document.getElementById('filter-color').disabled),
+        JSON.stringify(doc.filter));
+      // Probe points on a grid, at least 6 px from every feature's control chain.
+      const probes = await page.evaluate(async ([w, h]) => {
+        const c = await (await fetch('/api/control?level=0')).json();
+        const segs = [];
+        for (const chain of c.features) {
+          for (let k = 0; k + 1 < chain.length; ++k) {
+            segs.push([c.positions[2 * chain[k]], c.positions[2 * chain[k] + 1],
+              c.positions[2 * chain[k + 1]], c.positions[2 * chain[k + 1] + 1]]);
+          }
+        }
+        const dist = (x, y) => Math.min(...segs.map(([ax, ay, bx, by]) => {
+          const dx = bx - ax, dy = by - ay;
+          const t = Math.max(0, Math.min(1, ((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy || 1)));
+          return Math.hypot(x - ax - t * dx, y - ay - t * dy);
+        }));
+        const out = [];
+        for (let y = 4; y < h - 4; y += 6) for (let x = 4; x < w - 4; x += 6) if (dist(x, y) >= 6) out.push([x, y]);
+        return out;
+      }, [doc.width, doc.height]);
+      const sample = () => page.evaluate((pts) => window.subvec.pixelsAt(pts), probes);
+      const before = await sample();
+      const setEta = (v) => page.evaluate((value) => {
+        const el = document.getElementById('eta-0');
+        el.value = value;
+        el.dispatchEvent(new Event('input'));
+        el.dispatchEvent(new Event('change'));  // what releasing the slider fires
+      }, v);
+      await setEta('0');
+      await idle(page);
+      const smoothed = await sample();
+      const changes = smoothed.map((p, i) => diff(p, before[i]));
+      const changed = changes.filter((d) => d >= 4).length;
+      check('filter: η = 0 changes pixels away from the features',
+        probes.length > 50 && changed >= probes.length / 10 && Math.max(...changes) >= 10,
+        `${changed} of ${probes.length} probes changed by >= 4, max ${Math.max(...changes)}`);
+      const after = await page.evaluate(async () => (await fetch('/api/document')).json());
+      check('filter: one undo step, the slider state kept', after.undo === 1 && after.filter.current &&
+        after.filter.current.eta[0] === 0, JSON.stringify(after.filter));
+      await setEta('1');
+      await idle(page);
+      const restored = await sample();
+      const back = Math.max(...restored.map((p, i) => diff(p, before[i])));
+      check('filter: η = 1 restores the image', back <= 1, `max difference ${back}`);
+      check('filter: no page errors', errors.length === 0, errors.join('; '));
+    } finally {
+      await b.close();
+      await stop(fserver);
+    }
+  } catch (e) {
+    check('filter: ran to its end', false, e && e.stack ? e.stack : String(e));
+  } finally {
+    rmSync(fdir, { recursive: true, force: true });
+  }
+}
+
 // A photograph is vectorized first: the page shows the progress, then the editor.
 try {
   const photo = await serve(binary, [join(root, 'examples', '04-rocket.png'), '--vertices', '400']);

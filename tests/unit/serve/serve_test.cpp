@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -16,6 +17,8 @@
 #include "server.h"
 #include "subvec/edit/ops.h"
 #include "subvec/io/svec.h"
+#include "subvec/pyramid/pyramid.h"
+#include "../pyramid/pyramid_test_util.h"
 
 // After the library headers: <httplib.h> brings <resolv.h>, whose _res macro breaks Eigen.
 #include <httplib.h>
@@ -192,6 +195,61 @@ TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   EXPECT_EQ(status_of([&] { editor.view(s, {5, 2}); }), kBadRequest);
 }
 
+// A small three-level pyramid of the synthetic shapes photograph (tests/unit/pyramid).
+const VectorImage& pyramid_image() {
+  static const VectorImage image =
+      subvec::test::shapes_levels(subvec::test::shapes_image(128, 96));
+  return image;
+}
+
+TEST(ServeEditor, FilterIsAbsoluteUndoableAndVersioned) {
+  const VectorImage& original = pyramid_image();
+  ASSERT_TRUE(subvec::has_pyramid(original));
+  Editor editor(original);
+  EXPECT_EQ(editor.info().bands, 2);
+  const std::string s = editor.new_session();
+  const ViewMesh view = editor.view(s, {0, 1});
+  std::string log;
+  FilterRequest smooth;
+  smooth.eta = {0.2};
+  const Delta d = editor.filter(s, 1, smooth, log);
+  EXPECT_EQ(d.view_id, view.id);
+  EXPECT_FALSE(d.colors.empty());
+  subvec::FilterOptions options;
+  options.color_eta = {0.2};
+  const VectorImage expected = subvec::filter(original, options);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, expected.levels[0].colors);
+  EXPECT_NE(expected.levels[0].colors, original.levels[0].colors);
+  // A second filter right after replaces the first: it filters the original, not the result.
+  FilterRequest both;
+  both.eta = {0.5, 1.5};
+  both.geometry = true;
+  editor.filter(s, 2, both, log);
+  options.color_eta = options.geometry_eta = {0.5, 1.5};
+  const VectorImage expected2 = subvec::filter(original, options);
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected2.levels[0].positions);
+  EXPECT_EQ(editor.snapshot().first.levels[1].colors, expected2.levels[1].colors);
+  // eta = 1 gives the original back exactly; each filter was one undo step.
+  FilterRequest off;
+  off.eta = {1};
+  editor.filter(s, 3, off, log);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, original.levels[0].colors);
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, original.levels[0].positions);
+  EXPECT_EQ(editor.info().undo, 3);
+  editor.undo(s, 4);
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected2.levels[0].positions);
+  // Stale versions, bad eta lists and images without a pyramid are refused.
+  EXPECT_EQ(status_of([&] { editor.filter(s, 4, smooth, log); }), kConflict);
+  FilterRequest bad;
+  bad.eta = {0.5, 0.5, 0.5};
+  EXPECT_EQ(status_of([&] { editor.filter(s, 5, bad, log); }), kBadRequest);
+  bad.eta = {-1};
+  EXPECT_EQ(status_of([&] { editor.filter(s, 5, bad, log); }), kBadRequest);
+  Editor flat(disk());
+  EXPECT_EQ(flat.info().bands, 0);
+  EXPECT_EQ(status_of([&] { flat.filter(flat.new_session(), 1, smooth, log); }), kUnprocessable);
+}
+
 // ---- HTTP ----------------------------------------------------------------------------------
 
 class ServeHttp : public ::testing::Test {
@@ -253,7 +311,7 @@ TEST_F(ServeHttp, ErrorsAreJsonWithStatus) {
   expect_error(client_->Post("/api/select", "not json", "application/json"), 400);
   expect_error(client_->Post("/api/select", "{\"at\": [1, 2]}", "text/plain"), 415);
   expect_error(client_->Post("/api/view", "{\"session\": \"s99\"}", "application/json"), 404);
-  expect_error(client_->Post("/api/filter", "{}", "application/json"), 501);
+  expect_error(client_->Post("/api/filter", "{\"eta\": [0.5], \"version\": 1}", "application/json"), 400);
   expect_error(client_->Get("/api/download?format=exe"), 400);
   const std::string big(100 * 1024, ' ');
   expect_error(client_->Post("/api/select", big, "application/json"), 413);
@@ -310,6 +368,61 @@ TEST_F(ServeHttp, DownloadsAreBuiltInMemory) {
   ASSERT_TRUE(pdf);
   EXPECT_EQ(pdf->body.substr(0, 5), "%PDF-");
   EXPECT_FALSE(fs::exists(dir_ / "out.svec"));
+}
+
+// The endpoint gives what `subvec filter` gives on the same file, byte for byte once saved.
+TEST(ServeHttpFilter, SavedFilterEqualsTheFilterCommand) {
+  const fs::path dir = fs::temp_directory_path() / ("subvec-serve-filter-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path input = dir / "in.svec", saved = dir / "saved.svec", cli = dir / "cli.svec";
+  subvec::write_svec(input, pyramid_image());
+  const std::string command = std::string("'") + SUBVEC_CLI + "' filter '" + input.string() + "' -o '" +
+                              cli.string() + "' --eta-levels 0.3,1.6 --geometry-eta --color-eta >/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+
+  ServeOptions options;
+  options.input = input;
+  options.output = saved;
+  options.port = 0;
+  EditorServer server(options);
+  server.start();
+  std::thread thread([&] { server.run(); });
+  httplib::Client client("127.0.0.1", server.port());
+  for (int i = 0; i < 200 && !client.Get("/api/status"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  auto doc = client.Get("/api/document");
+  ASSERT_TRUE(doc);
+  const json info = json::parse(doc->body, nullptr, false);
+  EXPECT_EQ(info["filter"]["available"], true);
+  EXPECT_EQ(info["filter"]["bands"], 2);
+  auto session = client.Post("/api/session", "{}", "application/json");
+  ASSERT_TRUE(session);
+  const std::string id = json::parse(session->body)["session"];
+  const json request = {{"session", id},      {"version", 1},    {"eta", {0.3, 1.6}},
+                        {"geometry", true}, {"color", true}};
+  auto r = client.Post("/api/filter", request.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->body.substr(0, 4), "SVB1");
+  auto wrong = client.Post("/api/filter", json{{"session", id}, {"version", 2}, {"eta", 0.5}}.dump(),
+                           "application/json");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 400);
+  auto save = client.Post("/api/save", json{{"version", 2}}.dump(), "application/json");
+  ASSERT_TRUE(save);
+  ASSERT_EQ(save->status, 200) << save->body;
+  server.stop();
+  thread.join();
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string a = bytes(saved), b = bytes(cli);
+  EXPECT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "saved " << a.size() << " bytes, subvec filter " << b.size();
+  fs::remove_all(dir);
 }
 
 }  // namespace
