@@ -480,6 +480,7 @@ struct VectorizeArgs {
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
   int grid_step = 0;     // 0: automatic
+  int l1_iterations = 1;
   int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
   subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
@@ -502,6 +503,7 @@ void run_vectorize(const VectorizeArgs& a) {
   options.initial_mesh.grid_step = a.grid_step;
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
+  options.fit.l1_iterations = a.l1_iterations;
   options.threads = a.threads;
   if (!a.segment.empty()) {
     subvec::PixelRect rect;
@@ -804,6 +806,11 @@ int run(int argc, char** argv) {
                    "Color fit: every pixel (default) or the paper's subdivided vertices")
       ->check(CLI::IsMember({"pixels", "vertices"}))
       ->default_str("pixels");
+  vectorize
+      ->add_option("--l1-iterations", va.l1_iterations,
+                   "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
+                   "least squares (default 1)")
+      ->check(CLI::Range(0, 20));
   vectorize
       ->add_option("--segment", va.segment,
                    "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
