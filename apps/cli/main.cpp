@@ -480,7 +480,7 @@ struct VectorizeArgs {
   std::string fit = "pixels";
   std::string segment;  // X,Y,W,H, or empty
   int grid_step = 0;     // 0: automatic
-  int l1_iterations = 1;
+  int l1_iterations = 0;
   int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
   subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
@@ -809,7 +809,7 @@ int run(int argc, char** argv) {
   vectorize
       ->add_option("--l1-iterations", va.l1_iterations,
                    "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
-                   "least squares (default 1)")
+                   "least squares (default)")
       ->check(CLI::Range(0, 20));
   vectorize
       ->add_option("--segment", va.segment,

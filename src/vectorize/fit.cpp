@@ -412,12 +412,12 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   }
 
   const std::vector<Color> start = mesh.colors;
+  const Rows st = transpose(s);
   auto solve = [&]() {
     // The normal equations, lower triangle: column i of the lower triangle is row i of S' (B'B S)
     // from column i on.
     const Rows gram = gram_rows(refined, m, blocks, diagonal, options.threads);
     const Rows gram_s = multiply(gram, s, c, options.threads);
-    const Rows st = transpose(s);
     Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
     Rows lower = build_rows(c, c, options.threads, [&](RowAccumulator& acc, int32_t i, Rows& out) {
       for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
@@ -461,16 +461,20 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   for (int it = 0; it < options.l1_iterations && options.target == ColorFitTarget::kPixels; ++it) {
     const Eigen::MatrixX3d values = s * x;
     std::vector<double> weights(rows.size());
-    for (size_t r = 0; r < rows.size(); ++r) {
-      const Location& loc = located[rows[r].pixel];
-      const Tri& v = refined.triangle_colors[loc.triangle];
-      double residual = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double pred = (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
-        residual += std::abs(pred - rows[r].target[k]);
+    const int parts = std::max(1, std::min(detail::resolve_threads(options.threads), 8));
+    detail::parallel_for(parts, parts, [&](int part) {
+      const size_t end = rows.size() * size_t(part + 1) / size_t(parts);
+      for (size_t r = rows.size() * size_t(part) / size_t(parts); r < end; ++r) {
+        const Location& loc = located[rows[r].pixel];
+        const Tri& v = refined.triangle_colors[loc.triangle];
+        double residual = 0;
+        for (int k = 0; k < 3; ++k) {
+          const double pred = (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
+          residual += std::abs(pred - rows[r].target[k]);
+        }
+        weights[r] = 1 / std::max(residual / 3, options.l1_floor);
       }
-      weights[r] = 1 / std::max(residual / 3, options.l1_floor);
-    }
+    });
     accumulate_pixels(weights);
     x = solve();
   }

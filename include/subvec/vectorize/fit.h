@@ -22,8 +22,9 @@ struct ColorFitOptions {
   double fill_radius = 3.0;   // how far hole filling looks for same-side pixels
   double regularization = 1e-6;  // relative Tikhonov weight toward the current colors
   // Reweighted refits toward the least-absolute-deviations fit (pixel target only; 0: plain least
-  // squares). Each weighs a pixel by 1 / max(its mean absolute residual, l1_floor).
-  int l1_iterations = 1;
+  // squares, the default: each costs about a third of the fit, docs/vectorize.md). Each weighs a
+  // pixel by 1 / max(its mean absolute residual, l1_floor).
+  int l1_iterations = 0;
   double l1_floor = 1.0;  // 0-255 scale
   int threads = 0;               // <= 0: all cores; the result does not depend on it
 };
