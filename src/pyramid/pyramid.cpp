@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <unordered_map>
 
@@ -119,16 +120,18 @@ Rgb predict_color(const CollapseRecord::Wedge& w, Vec2 at, const std::vector<Vec
 Rgb rgb(Color c) { return {c.r, c.g, c.b}; }
 
 // The edge profile of a kept feature: how much of its color detail each fine vertex keeps whatever
-// eta. 1 on the band's kept features and on their one-ring, 0 elsewhere. The rendered color within
-// about a triangle of a feature is made of these vertices' control colors (a limit point depends on
-// the control values within two rings); their details are the profile of the edge, not texture to
-// take away, so they are kept as they are, like the jump (docs/levels.md, "Edge profiles").
+// eta. All of it on the band's kept features and their one-ring, a quarter on the second ring, none
+// beyond. The rendered color within about a triangle of a feature is made of these vertices'
+// control colors (a limit point depends on the control values within two rings, the second with a
+// small weight): their details are the profile of the edge, not texture to take away.
 // Smoothing them separately on each side (their predictions do not cross the tear) changed the
-// rendered contrast 1.5 px out by up to 68 % on the shared photographs at eta = 0.3.
-constexpr int kProfileRings = 1;
+// rendered contrast 1.5 px out by up to 68 % on the shared photographs at eta = 0.3; keeping the
+// one-ring left one feature (squirrel) at 5.7 %, the taper on the second ring brings every feature
+// within 5 % (docs/levels.md, "Edge profiles").
+constexpr double kProfileKeep[] = {1.0, 1.0, 0.25};  // by ring: the feature, its one-ring, the next
 
 std::vector<double> feature_keep(const ControlMesh& fine, const std::vector<int32_t>& kept_ids) {
-  const int rings = kProfileRings;
+  constexpr int kRings = static_cast<int>(std::size(kProfileKeep)) - 1;
   const int nv = fine.num_vertices();
   std::vector<double> keep(nv, 0);
   std::vector<int> dist(nv, -1);
@@ -141,14 +144,14 @@ std::vector<double> feature_keep(const ControlMesh& fine, const std::vector<int3
   std::vector<std::vector<int32_t>> adj(nv);
   for (const Tri& t : fine.triangles)
     for (int k = 0; k < 3; ++k) adj[t[k]].push_back(t[(k + 1) % 3]), adj[t[(k + 1) % 3]].push_back(t[k]);
-  for (int r = 0; r < rings; ++r) {
+  for (int r = 0; r < kRings; ++r) {
     std::vector<int32_t> next;
     for (int32_t v : front)
       for (int32_t w : adj[v])
         if (dist[w] < 0) dist[w] = r + 1, next.push_back(w);
     front = std::move(next);
   }
-  for (int v = 0; v < nv; ++v) keep[v] = dist[v] >= 0 ? 1 : 0;
+  for (int v = 0; v < nv; ++v) keep[v] = dist[v] >= 0 ? kProfileKeep[dist[v]] : 0;
   return keep;
 }
 
