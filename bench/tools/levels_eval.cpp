@@ -1,14 +1,18 @@
 // subvec_levels_eval: levels of abstraction and the pyramid on one photograph, for scripts/eval and
 // docs/levels.md. Not a test: the seconds are only meaningful on an idle machine.
 //
-//   subvec_levels_eval PHOTO [--runs N] [--figures PREFIX]
+//   subvec_levels_eval PHOTO [--runs N] [--figures PREFIX] [--features]
 //
 // Prints one JSON line: the median seconds over N runs (default 3) of single-level vectorization,
 // of building levels 1 and 2 on top of it and of `filter` with eta = 0.3; per level its vertices,
 // features and MAE against the photo; and the contrast across every feature of the coarsest level
 // (points 1 px apart along its limit curve, colors 1.5 px to each side) after eta = 0.3 and after a
 // Gaussian blur of the vector image whose sigma removes as much high-frequency energy (the mean
-// squared Laplacian over pixels 3 px or more from every feature). With --figures it writes
+// squared Laplacian over pixels 3 px or more from every feature): the mean and worst relative
+// change, the smallest contrast, the worst change in levels, and how many features changed by more
+// than 5 % and by more than both 5 % and one color level (--features lists them on stderr). Then
+// that high-frequency energy after color filtering at eta = 0, 0.1, ..., 1, 1.25, 1.5, 2 and
+// whether it rises throughout. With --figures it writes
 // PREFIX-levels.png (as the paper's Fig. 7) and PREFIX-filter.png (as its Fig. 13).
 #include <algorithm>
 #include <chrono>
@@ -148,14 +152,16 @@ cv::Mat difference(const Image8& a, const Image8& b, double gain) {
 int run(int argc, char** argv) {
   std::string photo_path, figures;
   int runs = 3;
+  bool dump = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--features") dump = true;
     else if (a == "--figures" && i + 1 < argc) figures = argv[++i];
     else if (photo_path.empty()) photo_path = a;
     else throw Error(ErrorCode::kInvalidArgument, "unexpected argument '" + a + "'");
   }
-  if (photo_path.empty()) throw Error(ErrorCode::kInvalidArgument, "usage: subvec_levels_eval PHOTO [--runs N] [--figures PREFIX]");
+  if (photo_path.empty()) throw Error(ErrorCode::kInvalidArgument, "usage: subvec_levels_eval PHOTO [--runs N] [--figures PREFIX] [--features]");
   const Image8 photo = read_image(photo_path);
   VectorImage single;
   const double vectorize_s = median_seconds(runs, [&] { single = vectorize(photo, {}); });
@@ -189,7 +195,8 @@ int run(int argc, char** argv) {
     if (laplacian_energy(from_mat(blurred), mask) <= target || sigma > 10) break;
   }
   const Image8 blurred_image = from_mat(blurred);
-  double eta_worst = 0, eta_mean = 0, blur_worst = 0, blur_mean = 0;
+  double eta_worst = 0, eta_mean = 0, blur_worst = 0, blur_mean = 0, min_contrast = 1e9, worst_levels = 0;
+  int over = 0, over_floor = 0;  // features changed by > 5 %, and by > 5 % and > 1 level
   const auto& kept = image.levels.back().features;
   for (const Feature& k : kept) {
     const Feature& f = by_id(image.levels[0], k.id);
@@ -198,13 +205,36 @@ int run(int argc, char** argv) {
     const double cb = contrast_across(blurred_image, image.levels[0], f, 1.5);
     eta_worst = std::max(eta_worst, std::abs(c1 / c0 - 1)), eta_mean += (c1 / c0 - 1) / static_cast<double>(kept.size());
     blur_worst = std::max(blur_worst, std::abs(cb / c0 - 1)), blur_mean += (cb / c0 - 1) / static_cast<double>(kept.size());
+    min_contrast = std::min(min_contrast, c0);
+    worst_levels = std::max(worst_levels, std::abs(c1 - c0));
+    if (std::abs(c1 - c0) > 0.05 * c0) ++over;
+    if (std::abs(c1 - c0) > std::max(0.05 * c0, 1.0)) ++over_floor;
+    if (dump)
+      std::fprintf(stderr, "feature %d: contrast %.2f -> %.2f (%+.1f %%), blur %.2f\n", k.id, c0, c1, 100 * (c1 / c0 - 1), cb);
+  }
+  // The high-frequency energy over eta (colors): should fall as eta decreases below 1, rise above.
+  std::string sweep_json;
+  bool monotone = true;
+  double last = -1;
+  for (const double eta : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.25, 1.5, 2.0}) {
+    FilterOptions o;
+    o.color_eta = {eta};
+    const double e = laplacian_energy(render_level(filter(image, o), 0), mask);
+    if (e <= last) monotone = false;
+    last = e;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s%.2f", sweep_json.empty() ? "" : ", ", e);
+    sweep_json += buf;
   }
   std::printf(
       "{\"vectorize_s\": %.3f, \"levels_s\": %.3f, \"added\": %.3f, \"filter_s\": %.3f, \"levels\": [%s], "
       "\"contrast\": {\"features\": %zu, \"eta_mean\": %.4f, \"eta_worst\": %.4f, \"blur_sigma\": %.3f, "
-      "\"blur_mean\": %.4f, \"blur_worst\": %.4f, \"laplacian_before\": %.2f, \"laplacian_after\": %.2f}}\n",
+      "\"blur_mean\": %.4f, \"blur_worst\": %.4f, \"laplacian_before\": %.2f, \"laplacian_after\": %.2f, "
+      "\"min_contrast\": %.2f, \"worst_levels\": %.2f, \"over_5pct\": %d, \"over_5pct_and_1_level\": %d}, "
+      "\"sweep\": {\"monotone\": %s, \"energy\": [%s]}}\n",
       vectorize_s, levels_s, levels_s / vectorize_s, filter_s, levels_json.c_str(), kept.size(), eta_mean, eta_worst,
-      sigma, blur_mean, blur_worst, laplacian_energy(before, mask), target);
+      sigma, blur_mean, blur_worst, laplacian_energy(before, mask), target, min_contrast, worst_levels, over, over_floor,
+      monotone ? "true" : "false", sweep_json.c_str());
 
   if (!figures.empty()) {
     const int w = 256;

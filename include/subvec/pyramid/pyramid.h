@@ -8,9 +8,10 @@
 // Positions are predicted from the one-ring (from the two neighbours along the chain or the border
 // side for a tear or border vertex) with the weights taken at the ring's centroid (v' itself is
 // what is being predicted), and their detail is stored in the local frame of the prediction and
-// the kept vertex; colors are predicted per wedge, with the weights at v's reconstructed position,
-// from the same side of any kept tear (along the chain for a tear vertex), and their detail is
-// per channel. The other two steps between levels are details as well: the merge of a dropped
+// the kept vertex; colors are predicted per wedge, from the same side of any kept tear (along the
+// chain for a tear vertex), by the least-squares affine fit of the neighbours with eq. 3's weights
+// at v's reconstructed position (the paper takes their weighted mean; the fit reproduces linear
+// ramps), and their detail is per channel. The other two steps between levels are details as well: the merge of a dropped
 // feature's seam (each side's color minus the mean) and the color refit (each kept color value
 // minus the coarse level's). The details are a function of the levels, computed when needed, so
 // they follow any edit of a level.
@@ -18,7 +19,9 @@
 // Reconstruction starts at the coarsest level and replays the steps in reverse with
 // v' = R(v) + eta d(v) (eq. 4), eta per band (band b is the step from level b - 1 to level b) and
 // per channel. eta = 1 gives the levels back; eta < 1 smooths and eta > 1 enhances. Kept features
-// stay tears: their sides are predicted only from their own side.
+// stay tears: their sides are predicted only from their own side, and the color details of their
+// vertices and one-ring (a quarter of the second ring's) are kept at every eta, so the rendered
+// edge profile across them stays (docs/levels.md, "Edge profiles").
 #pragma once
 
 #include <vector>

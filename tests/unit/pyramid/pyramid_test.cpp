@@ -8,6 +8,7 @@
 
 #include "pyramid_test_util.h"
 #include "subvec/core/error.h"
+#include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/curves.h"
 #include "subvec/mesh/validate.h"
@@ -181,14 +182,14 @@ TEST(Pyramid, EtaOneReproducesEveryLevel) {
   EXPECT_EQ(filter(image, {}).levels[0].colors, image.levels[0].colors);
 }
 
-// Color filtering (the command's default). Near eta = 0 the energy levels off: the inverse-distance
-// prediction does not reproduce linear ramps, so the fully smoothed image keeps faint bumps
-// (docs/levels.md).
+// Color filtering (the command's default): the high-frequency energy rises with eta from 0.1 through
+// 1 to enhancement. (The pure prediction, eta = 0, is 2 % above eta = 0.1 on this image: 5.50
+// against 5.37, near the floor that 8-bit rendering alone gives; docs/levels.md.)
 TEST(Pyramid, HighFrequenciesFollowEta) {
   const VectorImage& image = shapes();
   const auto mask = away_from_features(image, 3.0);
   double last = -1;
-  for (double eta : {0.3, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0}) {
+  for (double eta : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.25, 1.5, 2.0}) {
     const VectorImage out = filter(image, colors(eta));
     validate(out);
     const double e = laplacian_energy(render_level0(out), mask);
@@ -197,9 +198,14 @@ TEST(Pyramid, HighFrequenciesFollowEta) {
   }
 }
 
+// Whether the rendered contrast 1.5 px across a kept feature changed by at most 5 %, or by at most
+// one color level where 5 % is less than that (contrast under 20 levels: the render is quantized
+// to whole levels, and the contrast of a faint feature is mostly texture).
+bool contrast_kept(double before, double after) { return std::abs(after - before) <= std::max(0.05 * before, 1.0); }
+
 // Smoothing with eta = 0.3 keeps the jump across every feature of the coarsest level within 5 %
-// (in fact exactly), and the contrast of the rendered image across them within 5 % on average; a
-// Gaussian blur that removes as much high frequency loses more.
+// (in fact exactly), and the contrast of the rendered image across each of them within 5 % (or one
+// level); a Gaussian blur that removes as much high frequency loses more.
 TEST(Pyramid, ContrastAcrossRetainedFeaturesSurvivesSmoothing) {
   const VectorImage& image = shapes();
   const VectorImage out = filter(image, colors(0.3));
@@ -223,12 +229,48 @@ TEST(Pyramid, ContrastAcrossRetainedFeaturesSurvivesSmoothing) {
     const double j0 = limit_jump(image.levels[0], f), j1 = limit_jump(out.levels[0], f);
     EXPECT_GT(j0, 10) << "feature " << f.id;
     EXPECT_NEAR(j1 / j0, 1.0, 0.05) << "feature " << f.id << ": jump " << j0 << " -> " << j1;
+    EXPECT_TRUE(contrast_kept(c0, c1)) << "feature " << f.id << ": rendered contrast " << c0 << " -> " << c1;
     const double n = static_cast<double>(coarsest.features.size());
     mean_change += (c1 / c0 - 1) / n;
     mean_blur += (cb / c0 - 1) / n;
   }
   EXPECT_LT(std::abs(mean_change), 0.05) << "rendered contrast across the kept features";
   EXPECT_LT(mean_blur, -0.05) << "a Gaussian blur of sigma " << sigma << " kept the contrast";
+}
+
+// The shared photographs (skipped when ../shared is absent): at eta = 0.3 the rendered contrast
+// across every kept feature within 5 % (or one level), and the high-frequency energy rising with
+// eta from 0.7 (below that it is flat within about 1 % on some of these photographs, docs/levels.md).
+TEST(Pyramid, SharedPhotographs) {
+  const auto dir = test::shared_images();
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no " << dir << ": shared photographs not present";
+  int count = 0;
+  for (const char* name : {"apple", "astronaut", "butterfly", "chelsea", "fruits", "home", "rocket", "squirrel"}) {
+    const auto path = dir / (std::string(name) + ".png");
+    if (!std::filesystem::exists(path)) continue;
+    const Image8 photo = read_image(path);
+    VectorImage image = vectorize(photo, {});
+    build_levels(image, photo, {});
+    const VectorImage out = filter(image, colors(0.3));
+    const Image8 before = render_level0(image), after = render_level0(out);
+    for (const Feature& c : image.levels.back().features) {
+      const auto it = std::find_if(image.levels[0].features.begin(), image.levels[0].features.end(),
+                                   [&](const Feature& f) { return f.id == c.id; });
+      ASSERT_NE(it, image.levels[0].features.end());
+      const double c0 = contrast_across(before, image.levels[0], *it, 1.5);
+      const double c1 = contrast_across(after, out.levels[0], *it, 1.5);
+      EXPECT_TRUE(contrast_kept(c0, c1)) << name << " feature " << c.id << ": rendered contrast " << c0 << " -> " << c1;
+    }
+    const auto mask = away_from_features(image, 3.0);
+    double last = -1;
+    for (double eta : {0.7, 0.8, 0.9, 1.0, 1.25, 1.5, 2.0}) {
+      const double e = laplacian_energy(render_level0(filter(image, colors(eta))), mask);
+      EXPECT_GT(e, last) << name << " eta " << eta;
+      last = e;
+    }
+    ++count;
+  }
+  EXPECT_GT(count, 0);
 }
 
 TEST(Pyramid, BandsAndChannelsAreSeparate) {
