@@ -305,7 +305,8 @@ std::vector<EditOp> parse_edit_ops(std::string_view text) {
                       [&check](int depth, Json::parse_event_t event, Json& parsed) {
                         return check(depth, event, parsed);
                       });
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double's range (1e400)
     std::string what = e.what();
     const size_t end = what.find("] ");
     if (!what.empty() && what[0] == '[' && end != std::string::npos) what.erase(0, end + 2);

@@ -239,6 +239,8 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
   LevelReport& r = report ? *report : local;
   r = {};
   image.levels.resize(1);
+  // Reserved so that `base` (and `fine` below) stay valid while coarser levels are appended.
+  image.levels.reserve(static_cast<size_t>(options.levels));
   ControlMesh& base = image.levels[0];
   base.parent_vertices.clear();
   base.collapses.clear();

@@ -356,6 +356,7 @@ def ops_files():
     ops("ops-color-wrong-length.json", [{"op": "color", "mode": "blend", "at": [48, 48],
                                          "radius": 3, "color": [0, 0], "amount": 0.5}])
     ops("ops-infinity.json", '[{"op": "drag", "select": "vertex", "from": [48, 48], "to": [Infinity, 1]}]\n')
+    ops("ops-number-overflow.json", '[{"op": "drag", "select": "vertex", "from": [48, 48], "to": [1e400, 1]}]\n')
     ops("ops-deep-nesting.json", "[" * 5000 + "]" * 5000 + "\n")
     ops("ops-duplicate-key.json", '[{"op": "drag", "op": "drag", "select": "vertex", "from": [1, 1], "to": [2, 2]}]\n')
 
