@@ -113,6 +113,7 @@ struct RenderArgs {
   int threads = 0;
   int depth = -1;
   double tolerance = 0.25;  // .pdf and .svg only
+  std::string pdf_target = "any";  // .pdf only: any or poppler (checked by CLI11)
   bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
   // Output pixels refused by default: a file of a few hundred bytes may declare a 65536 x 4096
   // image, whose render at 1x would take half a minute and gigabytes. 2^26 (8192 x 8192) renders
@@ -145,6 +146,8 @@ void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bo
   options.scale = width_given ? double(a.width) / image.width : scale_given ? a.scale : 1.0;
   options.tolerance = a.tolerance;
   options.depth = a.depth;
+  options.pdf_target =
+      lower(a.pdf_target) == "poppler" ? subvec::PdfTarget::kPoppler : subvec::PdfTarget::kAny;
   subvec::write_vector_export(a.output, image, options);
 }
 
@@ -720,6 +723,13 @@ int run(int argc, char** argv) {
             return ok ? std::string() : "expected a positive number, got '" + text + "'";
           },
           "POSITIVE", "positive"));
+  render
+      ->add_option("--pdf-target", ra.pdf_target,
+                   ".pdf: the viewers the shading is built for: any (default; one RGB Gouraud "
+                   "mesh) or poppler (per-channel meshes that pdftoppm interpolates smoothly, "
+                   "offset half a unit elsewhere)")
+      ->check(CLI::IsMember({"any", "poppler"}, CLI::ignore_case))
+      ->default_str("any");
   render->footer(
       "Examples:\n"
       "  subvec render in.svec.json -o out.png                  # the image's own size\n"

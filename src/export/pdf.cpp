@@ -76,31 +76,51 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
   const double w = image.width, h = image.height, s = options.scale;
 
-  // The shading stream.
+  // The shading streams.
+  // PdfTarget::kAny: one shading with RGB at the vertices. kPoppler: one parameterized shading
+  // per channel (t = that channel's value, a linear Function onto red, green or blue), which
+  // poppler's Splash interpolates per pixel where it fills an RGB mesh in flat pieces, combined
+  // over black with /BM /Lighten (the maximum of (r,0,0), (0,g,0), (0,0,b) is (r,g,b)) and moved
+  // half an output unit up and left: Splash colors pixel (X, Y) with the shading at the pixel's
+  // corner (X, Y), not at its centre.
+  const bool channels = options.pdf_target == PdfTarget::kPoppler;
   const detail::Strips strips = detail::make_strips(mesh);
-  std::vector<uint8_t> data;
-  data.reserve(strips.flags.size() * 13);
   constexpr double kCoordinateMax = double((1 << 24) - 1);
-  auto put = [&](uint64_t v, int bytes) {
-    for (int k = bytes - 1; k >= 0; --k) data.push_back(static_cast<uint8_t>(v >> (8 * k)));
-  };
-  for (size_t i = 0; i < strips.flags.size(); ++i) {
-    const auto [t, k] = strips.corners[i];
-    const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
-    put(strips.flags[i], 1);
-    put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), 3);
-    put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
-        3);
-    for (int ch = 0; ch < 3; ++ch) {
-      const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
-      put(uint64_t(std::lround(value * 65535.0)), 2);
+  auto stream = [&](int channel) {  // -1: all three components
+    std::vector<uint8_t> data;
+    data.reserve(strips.flags.size() * 13);
+    auto put = [&](uint64_t v, int bytes) {
+      for (int k = bytes - 1; k >= 0; --k) data.push_back(static_cast<uint8_t>(v >> (8 * k)));
+    };
+    for (size_t i = 0; i < strips.flags.size(); ++i) {
+      const auto [t, k] = strips.corners[i];
+      const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
+      put(strips.flags[i], 1);
+      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), 3);
+      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
+          3);
+      for (int ch = 0; ch < 3; ++ch) {
+        if (channel >= 0 && ch != channel) continue;
+        const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
+        put(uint64_t(std::lround(value * 65535.0)), 2);
+      }
     }
+    return deflate(data);
+  };
+  std::vector<std::vector<uint8_t>> shadings;
+  if (channels) {
+    for (int ch = 0; ch < 3; ++ch) shadings.push_back(stream(ch));
+  } else {
+    shadings.push_back(stream(-1));
   }
-  const std::vector<uint8_t> shading = deflate(data);
 
   // The page: image pixels to points, y up.
   std::string content = "q " + detail::fixed(s, 6) + " 0 0 " + detail::fixed(-s, 6) + " 0 " +
-                        detail::fixed(h * s, 6) + " cm\n/Sh0 sh\n";
+                        detail::fixed(h * s, 6) + " cm\n" +
+                        (channels ? "0 0 0 rg 0 0 " + detail::fixed(w, 6) + " " + detail::fixed(h, 6) +
+                                        " re f\nq /GS0 gs 1 0 0 1 " + detail::fixed(-0.5 / s, 6) + " " +
+                                        detail::fixed(-0.5 / s, 6) + " cm /Sh0 sh /Sh1 sh /Sh2 sh Q\n"
+                                  : "/Sh0 sh\n");
   if (options.tear_hints) {
     for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
       for (const double c : band.color)
@@ -141,15 +161,32 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
   object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
          detail::fixed(h * s, 6) +
-         "] /Contents 4 0 R /Resources << /Shading << /Sh0 5 0 R >> >> >>");
+         "] /Contents 4 0 R /Resources << /Shading << /Sh0 5 0 R" +
+         (channels ? " /Sh1 7 0 R /Sh2 8 0 R >> /ExtGState << /GS0 << /BM /Lighten >> >> >> >>"
+                   : " >> >> >>"));
   const std::vector<uint8_t> packed = deflate(std::vector<uint8_t>(content.begin(), content.end()));
   object("<< /Filter /FlateDecode /Length " + std::to_string(packed.size()) + " >>\nstream\n" +
          std::string(packed.begin(), packed.end()) + "\nendstream");
-  object("<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24 /BitsPerComponent 16"
-         " /BitsPerFlag 8 /Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6) +
-         " 0 1 0 1 0 1] /Filter /FlateDecode /Length " + std::to_string(shading.size()) +
-         " >>\nstream\n" + std::string(shading.begin(), shading.end()) + "\nendstream");
+  auto shading_object = [&](int channel) {
+    const std::vector<uint8_t>& data = shadings[channel < 0 ? 0 : channel];
+    std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24 /BitsPerComponent 16"
+                       " /BitsPerFlag 8 /Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
+    if (channel < 0) {
+      dict += " 0 1 0 1 0 1]";
+    } else {
+      const char* c1[3] = {"[1 0 0]", "[0 1 0]", "[0 0 1]"};
+      dict += std::string(" 0 1] /Function << /FunctionType 2 /Domain [0 1] /C0 [0 0 0] /C1 ") +
+              c1[channel] + " /N 1 >>";
+    }
+    object(dict + " /Filter /FlateDecode /Length " + std::to_string(data.size()) + " >>\nstream\n" +
+           std::string(data.begin(), data.end()) + "\nendstream");
+  };
+  shading_object(channels ? 0 : -1);
   object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
+  if (channels) {
+    shading_object(1);
+    shading_object(2);
+  }
   const size_t xref = pdf.size();
   pdf += "xref\n0 " + std::to_string(offsets.size() + 1) + "\n0000000000 65535 f \n";
   for (const size_t o : offsets) {

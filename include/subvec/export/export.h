@@ -16,6 +16,13 @@
 
 namespace subvec {
 
+// Which PDF viewers the shading is built for (docs/export.md, "PDF"). kAny: one Gouraud mesh with
+// RGB vertex colors, which every viewer interpolates. kPoppler: three parameterized meshes, one per
+// channel, blended with /BM /Lighten and offset half an output unit, which poppler's pdftoppm
+// (Splash) interpolates per pixel and samples at the pixel centre at 1x; the offset shows as a
+// half-unit shift of the mesh in viewers that sample at pixel centres (cairo, MuPDF, Ghostscript).
+enum class PdfTarget { kAny, kPoppler };
+
 struct ExportOptions {
   int level = 0;       // level of detail
   double scale = 1;    // output units (PDF points, SVG pixels) per image pixel
@@ -30,6 +37,7 @@ struct ExportOptions {
   // PDF: along both sides of every tear, a band one output unit wide in that side's color, so that
   // viewers that do not anti-alias shadings (poppler) still show anti-aliased tears.
   bool tear_hints = true;
+  PdfTarget pdf_target = PdfTarget::kAny;
 };
 
 struct ExportReport {

@@ -248,6 +248,10 @@ TEST_F(Cli, RenderExportsPdfAndSvg) {
   EXPECT_TRUE(r.out.empty());
   EXPECT_EQ(read_text(pdf).rfind("%PDF-1.4", 0), 0u);
   EXPECT_NE(read_text(pdf).find("/MediaBox [0 0 192 192]"), std::string::npos);
+  EXPECT_EQ(read_text(pdf).find("/BM /Lighten"), std::string::npos);
+  r = subvec("render " + q(example("01-disk")) + " -o " + q(pdf) + " --pdf-target Poppler");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(pdf).find("/BM /Lighten"), std::string::npos);  // docs/export.md, "PDF"
   r = subvec("render " + q(example("01-disk")) + " -o " + q(svg) + " --width 48 --tolerance 0.5");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(read_text(svg).find("width=\"48\" height=\"48\""), std::string::npos);
