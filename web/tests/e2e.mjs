@@ -271,8 +271,10 @@ try {
       const smoothed = await sample();
       const changes = smoothed.map((p, i) => diff(p, before[i]));
       const changed = changes.filter((d) => d >= 4).length;
+      // Not all of them: the edge profiles of kept features (their control one-ring, a quarter of
+      // the next) keep their color detail at every eta (docs/levels.md).
       check('filter: η = 0 changes pixels away from the features',
-        probes.length > 50 && changed >= probes.length / 10 && Math.max(...changes) >= 10,
+        probes.length > 50 && changed >= probes.length / 20 && Math.max(...changes) >= 10,
         `${changed} of ${probes.length} probes changed by >= 4, max ${Math.max(...changes)}`);
       const after = await page.evaluate(async () => (await fetch('/api/document')).json());
       check('filter: one undo step, the slider state kept', after.undo === 1 && after.filter.current &&
