@@ -63,6 +63,7 @@ MeshTopology MeshTopology::build(const ControlMesh& mesh, int width, int height)
     std::vector<int32_t> fill(start.begin(), start.end() - 1);
     for (const HalfEdge& h : half) sorted[fill[h.key >> 32]++] = h;
     for (int v = 0; v < nv; ++v) {
+      if (start[v + 1] - start[v] < 2) continue;  // (also: no pointer arithmetic on an empty array)
       HalfEdge* first = sorted.data() + start[v];
       HalfEdge* last = sorted.data() + start[v + 1];
       for (HalfEdge* i = first + 1; i < last; ++i) {  // stable insertion sort by key
