@@ -484,6 +484,7 @@ struct VectorizeArgs {
   std::string segment;  // X,Y,W,H, or empty
   int grid_step = 0;     // 0: automatic
   int l1_iterations = 0;
+  int relocate = 0;
   int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
   subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
@@ -507,6 +508,7 @@ void run_vectorize(const VectorizeArgs& a) {
   options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
                                            : subvec::ColorFitTarget::kPixels;
   options.fit.l1_iterations = a.l1_iterations;
+  options.fit.relocate_iterations = a.relocate;
   options.threads = a.threads;
   if (!a.segment.empty()) {
     subvec::PixelRect rect;
@@ -821,6 +823,11 @@ int run(int argc, char** argv) {
                    "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
                    "least squares (default)")
       ->check(CLI::Range(0, 20));
+  vectorize
+      ->add_option("--relocate", va.relocate,
+                   "Gauss-Newton steps that move the smooth control vertices to lower the pixel "
+                   "error before the final color fit; 0 keeps the simplified positions (default)")
+      ->check(CLI::Range(0, 50));
   vectorize
       ->add_option("--segment", va.segment,
                    "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "

@@ -8,11 +8,14 @@
 // refined values (a 3x3 Gram block of barycentric weights per refined triangle), so the large
 // pixel matrix is never formed, and the products run row by row through a dense accumulator.
 // Then `l1_iterations` reweighted solves (each pixel row weighted by 1 / its absolute residual,
-// floored) move the fit toward least absolute deviations, the error we report.
+// floored) move the fit toward least absolute deviations, the error we report. Before those,
+// `relocate_iterations` damped Gauss-Newton steps may move the smooth control vertices against the
+// same pixel residual (docs/vectorize.md, "Vertex relocation").
 #include "subvec/vectorize/fit.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -206,6 +209,51 @@ std::array<double, 3> pixel(const Image8& image, int x, int y) {
   return {double(p[0]), double(p[1]), double(p[2])};
 }
 
+
+// Where a pixel centre lies: a refined triangle and barycentric weights (1 - b1 - b2, b1, b2).
+struct Location {
+  int32_t triangle = -1;
+  float b1 = 0, b2 = 0;
+};
+
+// Channel k of the prediction at a located pixel: the refined triangle's values interpolated.
+double predict(const Location& loc, const Tri& v, const Eigen::MatrixX3d& values, int k) {
+  return (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
+}
+
+// The lower triangle of the normal matrix S' M S, with M given as rows over the rows of S and st
+// the transpose of S: row i of the result is column i of the lower triangle, from the diagonal
+// (always stored) down.
+Rows lower_normal(const Rows& m, const SparseMatrix& s, const Rows& st, int threads) {
+  const int c = static_cast<int>(s.cols());
+  const Rows ms = multiply(m, s, c, threads);
+  return build_rows(c, c, threads, [&](RowAccumulator& acc, int32_t i, Rows& out) {
+    for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
+      const int32_t r = st.columns[e];
+      const double w = st.values[e];
+      // (Rows come out of RowAccumulator sorted: the lower triangle is a suffix.)
+      const int32_t* first = ms.columns.data() + ms.offsets[r];
+      const int32_t* last = ms.columns.data() + ms.offsets[r + 1];
+      for (int32_t k = static_cast<int32_t>(std::lower_bound(first, last, i) - ms.columns.data());
+           k < ms.offsets[r + 1]; ++k) {
+        acc.add(ms.columns[k], w * ms.values[k]);
+      }
+    }
+    acc.flush(out, i, i);
+  });
+}
+
+// Solves (lower triangle, as lower_normal gives it) x = rhs.
+template <class Rhs>
+Rhs solve_lower(const Rows& lower, const Rhs& rhs, const char* what) {
+  const int c = lower.num_rows();
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> normal(
+      c, c, static_cast<int32_t>(lower.columns.size()), lower.offsets.data(), lower.columns.data(), lower.values.data());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>, Eigen::Lower> solver(normal);
+  if (solver.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, std::string(what) + ": normal equations are singular");
+  return Rhs(solver.solve(rhs));
+}
+
 }  // namespace
 
 int default_fit_depth(const ControlMesh& mesh) {
@@ -234,6 +282,12 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   if (options.l1_iterations < 0 || !(options.l1_floor > 0)) {
     throw Error(ErrorCode::kInvalidArgument, "fit_colors: l1_iterations must be >= 0 and l1_floor positive");
   }
+  if (options.relocate_iterations < 0 || !(options.relocate_damping > 0) || !(options.relocate_max_step > 0) ||
+      options.relocate_cg_iterations < 1 || options.relocate_refit_every < 1) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "fit_colors: relocate_iterations must be >= 0, relocate_damping and relocate_max_step positive, "
+                "relocate_cg_iterations and relocate_refit_every at least 1");
+  }
   const MeshTopology topo = MeshTopology::build(mesh, width, height);
   const int depth = options.depth >= 0 ? options.depth : default_fit_depth(mesh);
   const Subdivision sub(mesh, topo, depth);
@@ -257,10 +311,6 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   std::vector<std::array<double, 3>> btt(m, {0, 0, 0});
   ColorFitStats stats;
 
-  struct Location {
-    int32_t triangle = -1;
-    float b1 = 0, b2 = 0;
-  };
   std::vector<Location> located;
   // The fitted pixels (image index, target), and the Gram blocks and B't of their rows, each
   // weighted (all 1 without weights).
@@ -269,23 +319,11 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
     std::array<float, 3> target;
   };
   std::vector<PixelRow> rows;
-  auto accumulate_pixels = [&](const std::vector<double>& weights) {
-    blocks.assign(refined.num_triangles(), {0, 0, 0, 0, 0, 0});
-    btt.assign(m, {0, 0, 0});
-    for (size_t r = 0; r < rows.size(); ++r) {
-      const Location& loc = located[rows[r].pixel];
-      const double wr = weights.empty() ? 1.0 : weights[r];
-      const Tri& values = refined.triangle_colors[loc.triangle];
-      const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
-      std::array<double, 6>& g = blocks[loc.triangle];
-      g[0] += wr * w[0] * w[0], g[1] += wr * w[0] * w[1], g[2] += wr * w[0] * w[2];
-      g[3] += wr * w[1] * w[1], g[4] += wr * w[1] * w[2], g[5] += wr * w[2] * w[2];
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) btt[values[i]][k] += wr * w[i] * rows[r].target[k];
-    }
-  };
-  if (options.target == ColorFitTarget::kPixels) {
-    // Locate every pixel centre in a refined triangle (first one wins on shared edges).
+  // Locates every pixel centre in a refined triangle of the limit mesh (first one wins on shared
+  // edges). Returns the number of folded refined triangles, plus the number of pixels with a row
+  // that no triangle holds.
+  auto locate_pixels = [&]() {
+    int folded = 0;
     located.assign(size_t(width) * height, Location{});
     for (int t = 0; t < refined.num_triangles(); ++t) {
       const Tri& tri = refined.triangles[t];
@@ -293,7 +331,10 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
       const double x1 = limit[2 * tri[1]], y1 = limit[2 * tri[1] + 1];
       const double x2 = limit[2 * tri[2]], y2 = limit[2 * tri[2] + 1];
       const double area = cross(x1 - x0, y1 - y0, x2 - x0, y2 - y0);
-      if (area <= 0) continue;
+      if (area <= 0) {
+        ++folded;
+        continue;
+      }
       const int px0 = std::max(0, int(std::ceil(std::min({x0, x1, x2}) - 0.5)));
       const int px1 = std::min(width - 1, int(std::floor(std::max({x0, x1, x2}) - 0.5)));
       const int py0 = std::max(0, int(std::ceil(std::min({y0, y1, y2}) - 0.5)));
@@ -311,6 +352,26 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         }
       }
     }
+    for (const PixelRow& row : rows) folded += located[row.pixel].triangle < 0;
+    return folded;
+  };
+  auto accumulate_pixels = [&](const std::vector<double>& weights) {
+    blocks.assign(refined.num_triangles(), {0, 0, 0, 0, 0, 0});
+    btt.assign(m, {0, 0, 0});
+    for (size_t r = 0; r < rows.size(); ++r) {
+      const Location& loc = located[rows[r].pixel];
+      const double wr = weights.empty() ? 1.0 : weights[r];
+      const Tri& values = refined.triangle_colors[loc.triangle];
+      const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
+      std::array<double, 6>& g = blocks[loc.triangle];
+      g[0] += wr * w[0] * w[0], g[1] += wr * w[0] * w[1], g[2] += wr * w[0] * w[2];
+      g[3] += wr * w[1] * w[1], g[4] += wr * w[1] * w[2], g[5] += wr * w[2] * w[2];
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) btt[values[i]][k] += wr * w[i] * rows[r].target[k];
+    }
+  };
+  if (options.target == ColorFitTarget::kPixels) {
+    locate_pixels();
     // The band along tears: those pixels get targets filled from their own side.
     std::vector<uint8_t> band(size_t(width) * height, 0);
     for (size_t i = 0; i < grid.size(); ++i) {
@@ -414,27 +475,12 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   const std::vector<Color> start = mesh.colors;
   const Rows st = transpose(s);
   auto solve = [&]() {
-    // The normal equations, lower triangle: column i of the lower triangle is row i of S' (B'B S)
-    // from column i on.
-    const Rows gram = gram_rows(refined, m, blocks, diagonal, options.threads);
-    const Rows gram_s = multiply(gram, s, c, options.threads);
+    Rows lower = lower_normal(gram_rows(refined, m, blocks, diagonal, options.threads), s, st, options.threads);
     Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
-    Rows lower = build_rows(c, c, options.threads, [&](RowAccumulator& acc, int32_t i, Rows& out) {
-      for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e) {
-        const int32_t r = st.columns[e];
-        const double w = st.values[e];
-        // (Rows come out of RowAccumulator sorted: the lower triangle is a suffix.)
-        const int32_t* first = gram_s.columns.data() + gram_s.offsets[r];
-        const int32_t* last = gram_s.columns.data() + gram_s.offsets[r + 1];
-        for (int32_t k = static_cast<int32_t>(std::lower_bound(first, last, i) - gram_s.columns.data());
-             k < gram_s.offsets[r + 1]; ++k) {
-          acc.add(gram_s.columns[k], w * gram_s.values[k]);
-        }
-        for (int k = 0; k < 3; ++k) rhs(i, k) += w * btt[r][k];
-      }
-      acc.flush(out, i, i);
-    });
-
+    for (int i = 0; i < c; ++i) {
+      for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e)
+        for (int k = 0; k < 3; ++k) rhs(i, k) += st.values[e] * btt[st.columns[e]][k];
+    }
     // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches. Each
     // column's first entry is its diagonal.
     double trace = 0;
@@ -447,13 +493,207 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
       rhs(i, 1) += lambda * start[i].g;
       rhs(i, 2) += lambda * start[i].b;
     }
-    const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> normal(
-        c, c, static_cast<int32_t>(lower.columns.size()), lower.offsets.data(), lower.columns.data(), lower.values.data());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>, Eigen::Lower> solver(normal);
-    if (solver.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, "color fit: normal equations are singular");
-    return Eigen::MatrixX3d(solver.solve(rhs));
+    return Eigen::MatrixX3d(solve_lower(lower, rhs, "color fit"));
   };
   Eigen::MatrixX3d x = solve();
+  if (options.relocate_iterations > 0 && options.target == ColorFitTarget::kPixels) {
+    // Beyond the paper: the smooth control vertices move where the pixel residual asks, by damped
+    // Gauss-Newton steps on the squared error with the colors held, each kept only when it lowers
+    // the error; then the colors are refitted. The color field is carried by the surface: moving
+    // refined vertex j by e changes the prediction at a fixed pixel by -w_j g.e (w_j its barycentric
+    // weight, g the color gradient of the refined triangle), and refined vertex j moves by
+    // sum_v P_jv e_v (P the position stencils). Tear, crease, border and corner vertices stay, so the
+    // feature curves and the image border do not move. The normal equations P'HP are applied
+    // matrix-free in a few preconditioned conjugate-gradient iterations.
+    const SparseMatrix& p = sub.position_stencils();
+    const Rows pt = transpose(p);
+    const int n = num_refined, nv = mesh.num_vertices(), nt = refined.num_triangles();
+    std::vector<uint8_t> movable(nv, 0);
+    for (int v = 0; v < nv; ++v) movable[v] = topo.vertex_tags[v] == VertexTag::kSmooth;
+    auto folded_triangles = [&]() {
+      int folded = 0;
+      for (const Tri& tv : refined.triangles) {
+        folded += !(cross(limit[2 * tv[1]] - limit[2 * tv[0]], limit[2 * tv[1] + 1] - limit[2 * tv[0] + 1],
+                          limit[2 * tv[2]] - limit[2 * tv[0]], limit[2 * tv[2] + 1] - limit[2 * tv[0] + 1]) > 0);
+      }
+      return folded;
+    };
+    auto squared_error = [&](const Eigen::MatrixX3d& values) {
+      double sum = 0;
+      for (const PixelRow& row : rows) {
+        const Location& loc = located[row.pixel];
+        for (int k = 0; k < 3; ++k) {
+          const double e = predict(loc, refined.triangle_colors[loc.triangle], values, k) - row.target[k];
+          sum += e * e;
+        }
+      }
+      return sum;
+    };
+    static constexpr int kPacked[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+    std::vector<std::array<double, 6>> gram(nt), gradient(nt);
+    std::vector<std::array<double, 3>> tensor(nt), precondition(nv);
+    std::vector<double> rhs_refined(size_t(2) * n), u(size_t(2) * n), hu(size_t(2) * n);
+    // out = (P'HP + damping * diag) d over the movable vertices.
+    double damping = options.relocate_damping;
+    auto apply = [&](const std::vector<double>& d, std::vector<double>& out) {
+      for (int j = 0; j < n; ++j) {
+        double ux = 0, uy = 0;
+        for (SparseMatrix::InnerIterator it(p, j); it; ++it) ux += it.value() * d[2 * it.col()], uy += it.value() * d[2 * it.col() + 1];
+        u[2 * j] = ux, u[2 * j + 1] = uy;
+      }
+      std::fill(hu.begin(), hu.end(), 0.0);
+      for (int t = 0; t < nt; ++t) {
+        const Tri& tv = refined.triangles[t];
+        const std::array<double, 3>& tt = tensor[t];
+        for (int k = 0; k < 3; ++k) {
+          double sx = 0, sy = 0;
+          for (int l = 0; l < 3; ++l) {
+            const double g = gram[t][kPacked[k][l]];
+            sx += g * u[2 * tv[l]], sy += g * u[2 * tv[l] + 1];
+          }
+          hu[2 * tv[k]] += tt[0] * sx + tt[1] * sy, hu[2 * tv[k] + 1] += tt[1] * sx + tt[2] * sy;
+        }
+      }
+      for (int v = 0; v < nv; ++v) {
+        double ox = 0, oy = 0;
+        if (movable[v]) {
+          for (int32_t e = pt.offsets[v]; e < pt.offsets[v + 1]; ++e)
+            ox += pt.values[e] * hu[2 * pt.columns[e]], oy += pt.values[e] * hu[2 * pt.columns[e] + 1];
+          const std::array<double, 3>& pc = precondition[v];
+          ox += damping * (pc[0] * d[2 * v] + pc[1] * d[2 * v + 1]), oy += damping * (pc[1] * d[2 * v] + pc[2] * d[2 * v + 1]);
+        }
+        out[2 * v] = ox, out[2 * v + 1] = oy;
+      }
+    };
+    Eigen::MatrixX3d values = s * x;
+    double error = squared_error(values);
+    const int folded = folded_triangles();
+    for (int it = 0; it < options.relocate_iterations; ++it) {
+      // Color gradients and their structure tensors per refined triangle.
+      for (int t = 0; t < nt; ++t) {
+        const Tri& tv = refined.triangles[t];
+        const Tri& tc = refined.triangle_colors[t];
+        const double e1x = limit[2 * tv[1]] - limit[2 * tv[0]], e1y = limit[2 * tv[1] + 1] - limit[2 * tv[0] + 1];
+        const double e2x = limit[2 * tv[2]] - limit[2 * tv[0]], e2y = limit[2 * tv[2] + 1] - limit[2 * tv[0] + 1];
+        const double det = e1x * e2y - e1y * e2x;
+        gradient[t] = {0, 0, 0, 0, 0, 0}, tensor[t] = {0, 0, 0}, gram[t] = {0, 0, 0, 0, 0, 0};
+        if (!(det > 0)) continue;
+        for (int k = 0; k < 3; ++k) {
+          const double d1 = values(tc[1], k) - values(tc[0], k), d2 = values(tc[2], k) - values(tc[0], k);
+          const double gx = (d1 * e2y - e1y * d2) / det, gy = (e1x * d2 - d1 * e2x) / det;
+          gradient[t][2 * k] = gx, gradient[t][2 * k + 1] = gy;
+          tensor[t][0] += gx * gx, tensor[t][1] += gx * gy, tensor[t][2] += gy * gy;
+        }
+      }
+      // Barycentric Gram blocks and the gradient of half the squared error on refined coordinates.
+      std::fill(rhs_refined.begin(), rhs_refined.end(), 0.0);
+      for (const PixelRow& row : rows) {
+        const Location& loc = located[row.pixel];
+        const Tri& tv = refined.triangles[loc.triangle];
+        const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
+        std::array<double, 6>& g = gram[loc.triangle];
+        g[0] += w[0] * w[0], g[1] += w[0] * w[1], g[2] += w[0] * w[2];
+        g[3] += w[1] * w[1], g[4] += w[1] * w[2], g[5] += w[2] * w[2];
+        double rx = 0, ry = 0;
+        for (int k = 0; k < 3; ++k) {
+          const double e = predict(loc, refined.triangle_colors[loc.triangle], values, k) - row.target[k];
+          rx += e * gradient[loc.triangle][2 * k], ry += e * gradient[loc.triangle][2 * k + 1];
+        }
+        for (int i = 0; i < 3; ++i) rhs_refined[2 * tv[i]] += w[i] * rx, rhs_refined[2 * tv[i] + 1] += w[i] * ry;
+      }
+      // Right-hand side and a block-Jacobi preconditioner (the diagonal terms of P'HP) per vertex.
+      std::vector<double> r(size_t(2) * nv, 0.0);
+      std::vector<std::array<double, 3>> hjj(n, {0, 0, 0});
+      for (int t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k)
+          for (int c3 = 0; c3 < 3; ++c3) hjj[refined.triangles[t][k]][c3] += gram[t][kPacked[k][k]] * tensor[t][c3];
+      for (int v = 0; v < nv; ++v) {
+        precondition[v] = {0, 0, 0};
+        if (!movable[v]) continue;
+        for (int32_t e = pt.offsets[v]; e < pt.offsets[v + 1]; ++e) {
+          const int32_t j = pt.columns[e];
+          const double w2 = pt.values[e] * pt.values[e];
+          r[2 * v] += pt.values[e] * rhs_refined[2 * j], r[2 * v + 1] += pt.values[e] * rhs_refined[2 * j + 1];
+          for (int c3 = 0; c3 < 3; ++c3) precondition[v][c3] += w2 * hjj[j][c3];
+        }
+        precondition[v][0] += 1e-9, precondition[v][2] += 1e-9;
+      }
+      auto preconditioned = [&](const std::vector<double>& in, std::vector<double>& out) {
+        for (int v = 0; v < nv; ++v) {
+          const std::array<double, 3>& pc = precondition[v];
+          const double scale = 1 + damping, a = scale * pc[0], b2 = scale * pc[1], d = scale * pc[2];
+          const double det = a * d - b2 * b2;
+          if (!movable[v] || !(det > 0)) {
+            out[2 * v] = out[2 * v + 1] = 0;
+            continue;
+          }
+          out[2 * v] = (d * in[2 * v] - b2 * in[2 * v + 1]) / det;
+          out[2 * v + 1] = (a * in[2 * v + 1] - b2 * in[2 * v]) / det;
+        }
+      };
+      // Conjugate gradients from 0.
+      std::vector<double> step(size_t(2) * nv, 0.0), z(size_t(2) * nv), dir(size_t(2) * nv), ad(size_t(2) * nv);
+      preconditioned(r, z);
+      dir = z;
+      double rz = std::inner_product(r.begin(), r.end(), z.begin(), 0.0);
+      for (int cg = 0; cg < options.relocate_cg_iterations && rz > 0; ++cg) {
+        apply(dir, ad);
+        const double dad = std::inner_product(dir.begin(), dir.end(), ad.begin(), 0.0);
+        if (!(dad > 0)) break;
+        const double alpha = rz / dad;
+        for (size_t i = 0; i < step.size(); ++i) step[i] += alpha * dir[i], r[i] -= alpha * ad[i];
+        preconditioned(r, z);
+        const double rz_next = std::inner_product(r.begin(), r.end(), z.begin(), 0.0);
+        for (size_t i = 0; i < dir.size(); ++i) dir[i] = z[i] + rz_next / rz * dir[i];
+        rz = rz_next;
+      }
+      // Move, at most max_step px a vertex; a vertex of a triangle that would flip or thin stays.
+      const std::vector<Vec2> before = mesh.positions;
+      std::vector<uint8_t> held(nv, 0);
+      for (int round = 0; round < 8; ++round) {
+        for (int v = 0; v < nv; ++v) {
+          if (!movable[v] || held[v]) {
+            mesh.positions[v] = before[v];
+            continue;
+          }
+          double dx = step[2 * v], dy = step[2 * v + 1];
+          const double len = std::hypot(dx, dy);
+          if (len > options.relocate_max_step) dx *= options.relocate_max_step / len, dy *= options.relocate_max_step / len;
+          mesh.positions[v] = {before[v].x + dx, before[v].y + dy};
+        }
+        bool bad = false;
+        for (const Tri& t : mesh.triangles) {
+          const Vec2 a = mesh.positions[t[0]], b = mesh.positions[t[1]], q = mesh.positions[t[2]];
+          if (cross(b.x - a.x, b.y - a.y, q.x - a.x, q.y - a.y) > 2e-3) continue;
+          bad = true;
+          for (int32_t v : t) held[v] = 1;
+        }
+        if (!bad) break;
+        if (round == 7) mesh.positions = before;
+      }
+      const std::vector<float> limit_before = limit;
+      const std::vector<Location> located_before = located;
+      for (int j = 0; j < n; ++j) {
+        double lx = 0, ly = 0;
+        for (SparseMatrix::InnerIterator e(p, j); e; ++e) lx += e.value() * mesh.positions[e.col()].x, ly += e.value() * mesh.positions[e.col()].y;
+        limit[2 * j] = static_cast<float>(lx), limit[2 * j + 1] = static_cast<float>(ly);
+      }
+      const double moved_error = locate_pixels() <= folded ? squared_error(values) : std::numeric_limits<double>::infinity();
+      if (moved_error < error) {
+        error = moved_error, damping = std::max(damping / 2, 1e-3);
+        ++stats.relocations;
+      } else {
+        mesh.positions = before, limit = limit_before, located = located_before;
+        damping *= 4;
+      }
+      if ((it + 1) % options.relocate_refit_every == 0 || it + 1 == options.relocate_iterations) {
+        accumulate_pixels({});
+        x = solve();
+        values = s * x;
+        error = squared_error(values);
+      }
+    }
+  }
   // Iteratively reweighted least squares toward the least absolute deviations fit: the error we
   // report (and the one the eye forgives least on flat areas) is the mean absolute one, and the L1
   // fit lets outliers (texture, specular dots, pixels at misplaced edges) pull the colors less.
@@ -468,10 +708,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         const Location& loc = located[rows[r].pixel];
         const Tri& v = refined.triangle_colors[loc.triangle];
         double residual = 0;
-        for (int k = 0; k < 3; ++k) {
-          const double pred = (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
-          residual += std::abs(pred - rows[r].target[k]);
-        }
+        for (int k = 0; k < 3; ++k) residual += std::abs(predict(loc, v, values, k) - rows[r].target[k]);
         weights[r] = 1 / std::max(residual / 3, options.l1_floor);
       }
     });
@@ -494,7 +731,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
         const Tri& v = refined.triangle_colors[loc.triangle];
         const auto target = pixel(image, px, y);
         for (int k = 0; k < 3; ++k) {
-          const double pred = (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
+          const double pred = predict(loc, v, values, k);
           sum += (pred - target[k]) * (pred - target[k]);
           abs_sum += std::abs(std::clamp(std::round(pred), 0.0, 255.0) - target[k]);
         }

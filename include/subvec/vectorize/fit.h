@@ -26,6 +26,14 @@ struct ColorFitOptions {
   // pixel by 1 / max(its mean absolute residual, l1_floor).
   int l1_iterations = 0;
   double l1_floor = 1.0;  // 0-255 scale
+  // Damped Gauss-Newton steps that move the smooth control vertices (not those of features, creases,
+  // the border or corners) to lower the squared pixel error, each kept only when the refit colors
+  // lower it (pixel target only; 0: positions as given).
+  int relocate_iterations = 0;
+  double relocate_damping = 1.0;   // initial Levenberg-Marquardt factor on the diagonal
+  double relocate_max_step = 2.0;  // pixels a vertex moves at most per step
+  int relocate_cg_iterations = 12; // conjugate-gradient iterations per step
+  int relocate_refit_every = 3;    // steps between color refits (and after the last)
   int threads = 0;               // <= 0: all cores; the result does not depend on it
 };
 
@@ -34,6 +42,7 @@ struct ColorFitStats {
   int filled = 0;        // band pixels given hole-filled targets
   double rms = 0;        // root-mean-square residual over the located pixels, 0-255 scale
   double mae = 0;        // mean absolute error of the 8-bit prediction at pixel centres
+  int relocations = 0;   // relocation steps kept
 };
 
 // Refits mesh.colors in place against `image` (same size as the domain). Throws kInvalidArgument.
