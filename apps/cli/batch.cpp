@@ -42,6 +42,7 @@
 #include "subvec/pyramid/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "vectorize_options.h"
 
 namespace subvec_cli {
 namespace {
@@ -52,12 +53,12 @@ using subvec::ErrorCode;
 using Clock = std::chrono::steady_clock;
 
 struct BatchArgs {
+  BatchArgs() { vectorize.threads = 1; }
   std::string input, output;
-  int jobs = 0;     // 0: one per core
-  int threads = 1;  // per image
-  double ratio = 0.01;
-  int vertices = 0;
-  int levels = 3;  // as `subvec vectorize --levels`
+  int jobs = 0;  // 0: one per core
+  // As `subvec vectorize` takes them (vectorize_options.h); batch sets the vertex count, the
+  // levels and the threads per image (1 by default), and leaves the rest at their defaults.
+  VectorizeParams vectorize;
   int64_t max_pixels = int64_t{1} << 23;
   bool render_png = false;
 };
@@ -158,21 +159,15 @@ void process(Item& item, const BatchArgs& a) {
   if (saved && (saved->width != photo.width || saved->height != photo.height)) saved.reset();
   std::vector<uint8_t> bytes;
   if (!saved) {
-    subvec::VectorizeOptions options;
-    options.ratio = a.ratio;
-    options.vertices = a.vertices;
-    options.threads = a.threads;
-    subvec::VectorImage vectorized = subvec::vectorize(photo, options);
+    subvec::VectorImage vectorized = subvec::vectorize(photo, vectorize_options(a.vectorize));
     // Levels of abstraction as `subvec vectorize --levels` makes them (pyramid/levels.h).
-    subvec::LevelOptions level_options;
-    level_options.levels = a.levels;
-    subvec::build_levels(vectorized, photo, level_options);
+    build_levels(a.vectorize.levels, vectorized, photo);
     bytes = subvec::to_svec_binary(vectorized);
     // What the file holds (positions and colors on the .svec grids), measured and drawn below.
     saved = std::make_unique<subvec::VectorImage>(subvec::parse_svec_binary(bytes));
   }
   subvec::RenderOptions render_options;
-  render_options.threads = a.threads;
+  render_options.threads = a.vectorize.threads;
   const subvec::Image8 rendered = subvec::render(*saved, render_options);
   const subvec::ImageDifference d = subvec::compare(photo, rendered);
   if (!bytes.empty()) {
@@ -378,25 +373,10 @@ void add_batch_command(CLI::App& app) {
       ->required();
   batch->add_option("--jobs", ba.jobs, "Images vectorized at once; 0 (default) one per core")
       ->check(CLI::Range(0, 1024));
-  batch->add_option("--threads", ba.threads, "Threads per image (default 1; 0: all cores)")
+  batch->add_option("--threads", ba.vectorize.threads, "Threads per image (default 1; 0: all cores)")
       ->check(CLI::Range(0, 1024));
-  CLI::Option* ratio =
-      batch
-          ->add_option("--ratio", ba.ratio,
-                       "Control vertices as a fraction of the pixel count (default 0.01)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok =
-                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
-                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
-              },
-              "RATIO", "ratio"));
-  CLI::Option* vertices =
-      batch->add_option("--vertices", ba.vertices, "Control vertex count instead of --ratio")
-          ->check(CLI::Range(4, 1 << 26));
-  ratio->excludes(vertices);
-  batch->add_option("--levels", ba.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
+  add_vertex_count_options(batch, ba.vectorize);
+  batch->add_option("--levels", ba.vectorize.levels.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
       ->check(CLI::Range(1, 16));
   batch
       ->add_option("--max-pixels", ba.max_pixels,

@@ -9,7 +9,6 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -41,6 +40,7 @@
 #include "batch.h"
 #include "edit_commands.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
+#include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
 #include "serve_command.h"
 
@@ -372,29 +372,6 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
 
 // ---- vectorize -------------------------------------------------------------------------------
 
-// Parses "X,Y,W,H" (integers); returns an error message, or "" and fills `r`. Whether the
-// rectangle lies inside the image is the library's check, once the image is read.
-std::string parse_rect(const std::string& text, subvec::PixelRect& r) {
-  const std::string usage = "expected four integers X,Y,W,H, got '" + text + "'";
-  int v[4];
-  const char* p = text.data();
-  const char* const end = text.data() + text.size();
-  for (int k = 0; k < 4; ++k) {
-    const auto [next, ec] = std::from_chars(p, end, v[k]);
-    if (ec != std::errc() || next == p) return usage;
-    p = next;
-    if (k < 3) {
-      if (p == end || *p != ',') return usage;
-      ++p;
-    }
-  }
-  if (p != end) return usage;
-  if (v[2] <= 0 || v[3] <= 0)
-    return "the rectangle '" + text + "' is empty (W and H must be positive)";
-  r = {v[0], v[1], v[2], v[3]};
-  return "";
-}
-
 // One line of progress on stderr for long runs: only when stderr is a terminal, and only once the
 // run has taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that). A thread redraws it a few
 // times a second and at every new stage (stage, share of the pipeline, elapsed seconds) and erases
@@ -475,18 +452,11 @@ class ProgressLine {
 
 struct VectorizeArgs {
   std::string input, output;
-  double ratio = 0.01;
-  int vertices = 0;
   // 2^23 pixels: a 4K UHD frame (3840 x 2160) fits. Vectorizing takes about 1.5 KB of memory per
   // pixel (the dense mesh has a vertex per pixel), so the default stays near 12 GB.
   int64_t max_pixels = int64_t{1} << 23;
-  std::string fit = "pixels";
-  std::string segment;  // X,Y,W,H, or empty
-  int grid_step = 0;     // 0: automatic
-  int l1_iterations = 0;
-  int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
-  subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
+  subvec_cli::VectorizeParams params;  // shared with batch (vectorize_options.h)
 };
 
 void run_vectorize(const VectorizeArgs& a) {
@@ -500,19 +470,7 @@ void run_vectorize(const VectorizeArgs& a) {
     if (e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
-  subvec::VectorizeOptions options;
-  options.ratio = a.ratio;
-  options.vertices = a.vertices;
-  options.initial_mesh.grid_step = a.grid_step;
-  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
-                                           : subvec::ColorFitTarget::kPixels;
-  options.fit.l1_iterations = a.l1_iterations;
-  options.threads = a.threads;
-  if (!a.segment.empty()) {
-    subvec::PixelRect rect;
-    parse_rect(a.segment, rect);  // already validated by CLI11
-    options.segment = rect;
-  }
+  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
@@ -521,14 +479,14 @@ void run_vectorize(const VectorizeArgs& a) {
   // ---- levels of abstraction (pyramid_commands.h) ----
   progress.update("levels", 0.95);
   const auto levels_start = std::chrono::steady_clock::now();
-  const subvec::LevelReport level_report = subvec_cli::build_levels(a.levels, v, image);
+  const subvec::LevelReport level_report = subvec_cli::build_levels(a.params.levels, v, image);
   const double levels_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - levels_start).count();
   // ---- end levels ----
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   subvec::RenderOptions render_options;
-  render_options.threads = a.threads;
+  render_options.threads = a.params.threads;
   const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
@@ -604,7 +562,7 @@ void run_vectorize(const VectorizeArgs& a) {
                            (segment_features == 1 ? " open feature" : " open features") +
                            " ending on the image border";
     }
-    std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
+    std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.params.segment.c_str(),
                 static_cast<long long>(report.segment_mask.area()), boundary.c_str());
   }
   // ---- levels ----
@@ -791,55 +749,40 @@ int run(int argc, char** argv) {
   vectorize->add_option("input", va.input, "Raster image")->required();
   vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
       ->required();
-  CLI::Option* ratio_opt =
-      vectorize
-          ->add_option("--ratio", va.ratio,
-                       "Control vertices as a fraction of the pixel count (default 0.01)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok =
-                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
-                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
-              },
-              "RATIO", "ratio"));
-  CLI::Option* vertices_opt =
-      vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
-          ->check(CLI::Range(4, 1 << 26));
-  ratio_opt->excludes(vertices_opt);
+  subvec_cli::add_vertex_count_options(vectorize, va.params);
   vectorize
       ->add_option("--max-pixels", va.max_pixels,
                    "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
   vectorize
-      ->add_option("--fit", va.fit,
+      ->add_option("--fit", va.params.fit,
                    "Color fit: every pixel (default) or the paper's subdivided vertices")
       ->check(CLI::IsMember({"pixels", "vertices"}))
       ->default_str("pixels");
   vectorize
-      ->add_option("--l1-iterations", va.l1_iterations,
+      ->add_option("--l1-iterations", va.params.l1_iterations,
                    "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
                    "least squares (default)")
       ->check(CLI::Range(0, 20));
   vectorize
-      ->add_option("--segment", va.segment,
+      ->add_option("--segment", va.params.segment,
                    "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
                    "becomes a closed tear")
       ->check(CLI::Validator(
           [](std::string& text) {
             subvec::PixelRect r;
-            return parse_rect(text, r);
+            return subvec_cli::parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
   vectorize
-      ->add_option("--grid-step", va.grid_step,
+      ->add_option("--grid-step", va.params.grid_step,
                    "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
                    "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
       ->check(CLI::Range(0, 2));
-  vectorize->add_option("--threads", va.threads, "Worker threads; 0 (default) uses all cores")
+  vectorize->add_option("--threads", va.params.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
-  subvec_cli::add_level_options(vectorize, va.levels);  // levels
+  subvec_cli::add_level_options(vectorize, va.params.levels);  // levels
   vectorize->footer(
       "Examples:\n"
       "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
