@@ -15,20 +15,16 @@
 //   (so a skipped image reports the same value as a fresh run).
 #include "batch.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <new>
 #include <string>
 #include <thread>
@@ -42,6 +38,7 @@
 #include "subvec/pyramid/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "progress.h"
 #include "vectorize_options.h"
 
 namespace subvec_cli {
@@ -224,74 +221,6 @@ std::string summary_csv(const std::vector<Item>& items) {
   return out;
 }
 
-// The overall progress bar on stderr, only when stderr is a terminal: images done of all, a bar,
-// elapsed seconds and the estimated time left (from the mean time per finished image so far).
-class BatchProgress {
- public:
-  explicit BatchProgress(int total) : total_(total), start_(Clock::now()) {
-    if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
-  }
-  ~BatchProgress() { finish(); }
-  BatchProgress(const BatchProgress&) = delete;
-  BatchProgress& operator=(const BatchProgress&) = delete;
-
-  void done(Status s) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      ++done_;
-      failed_ += s == Status::kFailed;
-      skipped_ += s == Status::kSkipped;
-    }
-    wake_.notify_all();
-  }
-
-  void finish() {
-    if (!thread_.joinable()) return;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-    if (shown_ > 0) std::fprintf(stderr, "\r%*s\r", shown_, "");
-    std::fflush(stderr);
-  }
-
- private:
-  void run() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (!stop_) {
-      wake_.wait_for(lock, std::chrono::milliseconds(250));
-      if (stop_) return;
-      const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-      constexpr int kBar = 24;
-      const int filled = total_ ? kBar * done_ / total_ : kBar;
-      std::string eta = "ETA --";
-      if (done_ > 0 && done_ < total_) {
-        eta = "ETA " + std::to_string(std::lround(elapsed / done_ * (total_ - done_))) + " s";
-      }
-      char line[256];
-      const int n = std::snprintf(
-          line, sizeof line, "subvec: batch [%s%s] %d/%d images (%d skipped, %d failed), %ld s, %s",
-          std::string(size_t(filled), '#').c_str(), std::string(size_t(kBar - filled), '.').c_str(),
-          done_, total_, skipped_, failed_, std::lround(std::floor(elapsed)), eta.c_str());
-      const int len = std::min(n, static_cast<int>(sizeof line) - 1);
-      std::fprintf(stderr, "\r%s%*s", line, std::max(0, shown_ - len), "");
-      std::fflush(stderr);
-      shown_ = std::max(shown_, len);
-    }
-  }
-
-  const int total_;
-  const Clock::time_point start_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::thread thread_;
-  int done_ = 0, failed_ = 0, skipped_ = 0;
-  bool stop_ = false;
-  int shown_ = 0;
-};
-
 void run_batch(const BatchArgs& a) {
   std::vector<Item> items = list_items(a);
   std::error_code ec;
@@ -305,7 +234,8 @@ void run_batch(const BatchArgs& a) {
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int jobs = std::min(count, a.jobs > 0 ? a.jobs : cores);
 
-  BatchProgress progress(count);
+  // On a terminal: images done of all, a bar, elapsed seconds and the estimated time left.
+  ProgressLine progress("batch", count, "images", {"skipped", "failed"});
   std::atomic<int> next{0};
   const auto worker = [&] {
     for (int i = next++; i < count; i = next++) {
@@ -322,7 +252,9 @@ void run_batch(const BatchArgs& a) {
         item.status = Status::kFailed;
         item.seconds = std::chrono::duration<double>(Clock::now() - item_start).count();
       }
-      progress.done(item.status);
+      progress.advance(item.status == Status::kSkipped  ? 0
+                       : item.status == Status::kFailed ? 1
+                                                        : -1);
     }
   };
   std::vector<std::thread> pool;

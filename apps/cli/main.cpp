@@ -4,27 +4,23 @@
 // CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
 // status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
 // partial file and never clobbers an existing one.
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "subvec/core/error.h"
@@ -39,6 +35,7 @@
 
 #include "batch.h"
 #include "edit_commands.h"
+#include "progress.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
 #include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
@@ -372,84 +369,6 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
 
 // ---- vectorize -------------------------------------------------------------------------------
 
-// One line of progress on stderr for long runs: only when stderr is a terminal, and only once the
-// run has taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that). A thread redraws it a few
-// times a second and at every new stage (stage, share of the pipeline, elapsed seconds) and erases
-// it at the end, so the terminal keeps the summary alone and pipes and logs get nothing.
-class ProgressLine {
- public:
-  explicit ProgressLine(std::string label)
-      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
-    if (const char* env = std::getenv("SUBVEC_PROGRESS_DELAY")) {
-      char* end = nullptr;
-      const double v = std::strtod(env, &end);
-      if (end != env && *end == '\0' && v >= 0 && std::isfinite(v)) delay_ = v;
-    }
-    if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
-  }
-  ~ProgressLine() { finish(); }
-  ProgressLine(const ProgressLine&) = delete;
-  ProgressLine& operator=(const ProgressLine&) = delete;
-
-  void update(const std::string& stage, double fraction) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stage_ = stage;
-      fraction_ = fraction;
-      changed_ = true;
-    }
-    wake_.notify_all();
-  }
-
-  // Stops redrawing and erases the line.
-  void finish() {
-    if (!thread_.joinable()) return;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      done_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-    if (shown_ > 0) std::fprintf(stderr, "\r%*s\r", shown_, "");
-    std::fflush(stderr);
-  }
-
- private:
-  void run() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (true) {
-      wake_.wait_for(lock, std::chrono::milliseconds(200), [this] { return done_ || changed_; });
-      if (done_) return;
-      changed_ = false;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-      if (elapsed < delay_) continue;
-      char line[512];
-      const int n = std::snprintf(line, sizeof line, "subvec: %s: %s %3d%%, %.0f s", label_.c_str(),
-                                  stage_.c_str(), static_cast<int>(std::lround(100 * fraction_)),
-                                  std::floor(elapsed));
-      const int len = std::min(n, static_cast<int>(sizeof line) - 1);
-      if (last_ == line) continue;
-      last_ = line;
-      std::fprintf(stderr, "\r%s%*s", line, std::max(0, shown_ - len), "");
-      std::fflush(stderr);
-      shown_ = std::max(shown_, len);
-    }
-  }
-
-  const std::string label_;
-  const std::chrono::steady_clock::time_point start_;
-  double delay_ = 1.0;  // seconds before the line appears
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::thread thread_;
-  std::string stage_ = "reading";
-  double fraction_ = 0;
-  bool changed_ = false, done_ = false;
-  std::string last_;  // the line on the terminal
-  int shown_ = 0;     // widest line drawn, in characters
-};
-
 struct VectorizeArgs {
   std::string input, output;
   // 2^23 pixels: a 4K UHD frame (3840 x 2160) fits. Vectorizing takes about 1.5 KB of memory per
@@ -462,7 +381,7 @@ struct VectorizeArgs {
 void run_vectorize(const VectorizeArgs& a) {
   subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
   const auto start = std::chrono::steady_clock::now();
-  ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
+  subvec_cli::ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
   subvec::Image8 image;
   try {
     image = subvec::read_image(a.input, a.max_pixels);
