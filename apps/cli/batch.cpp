@@ -15,20 +15,16 @@
 //   (so a skipped image reports the same value as a fresh run).
 #include "batch.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <new>
 #include <string>
 #include <thread>
@@ -42,6 +38,8 @@
 #include "subvec/pyramid/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "progress.h"
+#include "vectorize_options.h"
 
 namespace subvec_cli {
 namespace {
@@ -52,12 +50,12 @@ using subvec::ErrorCode;
 using Clock = std::chrono::steady_clock;
 
 struct BatchArgs {
+  BatchArgs() { vectorize.threads = 1; }
   std::string input, output;
-  int jobs = 0;     // 0: one per core
-  int threads = 1;  // per image
-  double ratio = 0.01;
-  int vertices = 0;
-  int levels = 3;  // as `subvec vectorize --levels`
+  int jobs = 0;  // 0: one per core
+  // As `subvec vectorize` takes them (vectorize_options.h); batch sets the vertex count, the
+  // levels and the threads per image (1 by default), and leaves the rest at their defaults.
+  VectorizeParams vectorize;
   int64_t max_pixels = int64_t{1} << 23;
   bool render_png = false;
 };
@@ -158,21 +156,15 @@ void process(Item& item, const BatchArgs& a) {
   if (saved && (saved->width != photo.width || saved->height != photo.height)) saved.reset();
   std::vector<uint8_t> bytes;
   if (!saved) {
-    subvec::VectorizeOptions options;
-    options.ratio = a.ratio;
-    options.vertices = a.vertices;
-    options.threads = a.threads;
-    subvec::VectorImage vectorized = subvec::vectorize(photo, options);
+    subvec::VectorImage vectorized = subvec::vectorize(photo, vectorize_options(a.vectorize));
     // Levels of abstraction as `subvec vectorize --levels` makes them (pyramid/levels.h).
-    subvec::LevelOptions level_options;
-    level_options.levels = a.levels;
-    subvec::build_levels(vectorized, photo, level_options);
+    build_levels(a.vectorize.levels, vectorized, photo);
     bytes = subvec::to_svec_binary(vectorized);
     // What the file holds (positions and colors on the .svec grids), measured and drawn below.
     saved = std::make_unique<subvec::VectorImage>(subvec::parse_svec_binary(bytes));
   }
   subvec::RenderOptions render_options;
-  render_options.threads = a.threads;
+  render_options.threads = a.vectorize.threads;
   const subvec::Image8 rendered = subvec::render(*saved, render_options);
   const subvec::ImageDifference d = subvec::compare(photo, rendered);
   if (!bytes.empty()) {
@@ -229,74 +221,6 @@ std::string summary_csv(const std::vector<Item>& items) {
   return out;
 }
 
-// The overall progress bar on stderr, only when stderr is a terminal: images done of all, a bar,
-// elapsed seconds and the estimated time left (from the mean time per finished image so far).
-class BatchProgress {
- public:
-  explicit BatchProgress(int total) : total_(total), start_(Clock::now()) {
-    if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
-  }
-  ~BatchProgress() { finish(); }
-  BatchProgress(const BatchProgress&) = delete;
-  BatchProgress& operator=(const BatchProgress&) = delete;
-
-  void done(Status s) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      ++done_;
-      failed_ += s == Status::kFailed;
-      skipped_ += s == Status::kSkipped;
-    }
-    wake_.notify_all();
-  }
-
-  void finish() {
-    if (!thread_.joinable()) return;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-    if (shown_ > 0) std::fprintf(stderr, "\r%*s\r", shown_, "");
-    std::fflush(stderr);
-  }
-
- private:
-  void run() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (!stop_) {
-      wake_.wait_for(lock, std::chrono::milliseconds(250));
-      if (stop_) return;
-      const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-      constexpr int kBar = 24;
-      const int filled = total_ ? kBar * done_ / total_ : kBar;
-      std::string eta = "ETA --";
-      if (done_ > 0 && done_ < total_) {
-        eta = "ETA " + std::to_string(std::lround(elapsed / done_ * (total_ - done_))) + " s";
-      }
-      char line[256];
-      const int n = std::snprintf(
-          line, sizeof line, "subvec: batch [%s%s] %d/%d images (%d skipped, %d failed), %ld s, %s",
-          std::string(size_t(filled), '#').c_str(), std::string(size_t(kBar - filled), '.').c_str(),
-          done_, total_, skipped_, failed_, std::lround(std::floor(elapsed)), eta.c_str());
-      const int len = std::min(n, static_cast<int>(sizeof line) - 1);
-      std::fprintf(stderr, "\r%s%*s", line, std::max(0, shown_ - len), "");
-      std::fflush(stderr);
-      shown_ = std::max(shown_, len);
-    }
-  }
-
-  const int total_;
-  const Clock::time_point start_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::thread thread_;
-  int done_ = 0, failed_ = 0, skipped_ = 0;
-  bool stop_ = false;
-  int shown_ = 0;
-};
-
 void run_batch(const BatchArgs& a) {
   std::vector<Item> items = list_items(a);
   std::error_code ec;
@@ -310,7 +234,8 @@ void run_batch(const BatchArgs& a) {
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int jobs = std::min(count, a.jobs > 0 ? a.jobs : cores);
 
-  BatchProgress progress(count);
+  // On a terminal: images done of all, a bar, elapsed seconds and the estimated time left.
+  ProgressLine progress("batch", count, "images", {"skipped", "failed"});
   std::atomic<int> next{0};
   const auto worker = [&] {
     for (int i = next++; i < count; i = next++) {
@@ -327,7 +252,9 @@ void run_batch(const BatchArgs& a) {
         item.status = Status::kFailed;
         item.seconds = std::chrono::duration<double>(Clock::now() - item_start).count();
       }
-      progress.done(item.status);
+      progress.advance(item.status == Status::kSkipped  ? 0
+                       : item.status == Status::kFailed ? 1
+                                                        : -1);
     }
   };
   std::vector<std::thread> pool;
@@ -378,25 +305,10 @@ void add_batch_command(CLI::App& app) {
       ->required();
   batch->add_option("--jobs", ba.jobs, "Images vectorized at once; 0 (default) one per core")
       ->check(CLI::Range(0, 1024));
-  batch->add_option("--threads", ba.threads, "Threads per image (default 1; 0: all cores)")
+  batch->add_option("--threads", ba.vectorize.threads, "Threads per image (default 1; 0: all cores)")
       ->check(CLI::Range(0, 1024));
-  CLI::Option* ratio =
-      batch
-          ->add_option("--ratio", ba.ratio,
-                       "Control vertices as a fraction of the pixel count (default 0.01)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok =
-                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
-                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
-              },
-              "RATIO", "ratio"));
-  CLI::Option* vertices =
-      batch->add_option("--vertices", ba.vertices, "Control vertex count instead of --ratio")
-          ->check(CLI::Range(4, 1 << 26));
-  ratio->excludes(vertices);
-  batch->add_option("--levels", ba.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
+  add_vertex_count_options(batch, ba.vectorize);
+  batch->add_option("--levels", ba.vectorize.levels.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
       ->check(CLI::Range(1, 16));
   batch
       ->add_option("--max-pixels", ba.max_pixels,

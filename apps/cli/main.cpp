@@ -4,28 +4,23 @@
 // CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
 // status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
 // partial file and never clobbers an existing one.
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "subvec/core/error.h"
@@ -40,7 +35,9 @@
 
 #include "batch.h"
 #include "edit_commands.h"
+#include "progress.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
+#include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
 #include "serve_command.h"
 
@@ -372,128 +369,19 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
 
 // ---- vectorize -------------------------------------------------------------------------------
 
-// Parses "X,Y,W,H" (integers); returns an error message, or "" and fills `r`. Whether the
-// rectangle lies inside the image is the library's check, once the image is read.
-std::string parse_rect(const std::string& text, subvec::PixelRect& r) {
-  const std::string usage = "expected four integers X,Y,W,H, got '" + text + "'";
-  int v[4];
-  const char* p = text.data();
-  const char* const end = text.data() + text.size();
-  for (int k = 0; k < 4; ++k) {
-    const auto [next, ec] = std::from_chars(p, end, v[k]);
-    if (ec != std::errc() || next == p) return usage;
-    p = next;
-    if (k < 3) {
-      if (p == end || *p != ',') return usage;
-      ++p;
-    }
-  }
-  if (p != end) return usage;
-  if (v[2] <= 0 || v[3] <= 0)
-    return "the rectangle '" + text + "' is empty (W and H must be positive)";
-  r = {v[0], v[1], v[2], v[3]};
-  return "";
-}
-
-// One line of progress on stderr for long runs: only when stderr is a terminal, and only once the
-// run has taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that). A thread redraws it a few
-// times a second and at every new stage (stage, share of the pipeline, elapsed seconds) and erases
-// it at the end, so the terminal keeps the summary alone and pipes and logs get nothing.
-class ProgressLine {
- public:
-  explicit ProgressLine(std::string label)
-      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
-    if (const char* env = std::getenv("SUBVEC_PROGRESS_DELAY")) {
-      char* end = nullptr;
-      const double v = std::strtod(env, &end);
-      if (end != env && *end == '\0' && v >= 0 && std::isfinite(v)) delay_ = v;
-    }
-    if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { run(); });
-  }
-  ~ProgressLine() { finish(); }
-  ProgressLine(const ProgressLine&) = delete;
-  ProgressLine& operator=(const ProgressLine&) = delete;
-
-  void update(const std::string& stage, double fraction) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stage_ = stage;
-      fraction_ = fraction;
-      changed_ = true;
-    }
-    wake_.notify_all();
-  }
-
-  // Stops redrawing and erases the line.
-  void finish() {
-    if (!thread_.joinable()) return;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      done_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-    if (shown_ > 0) std::fprintf(stderr, "\r%*s\r", shown_, "");
-    std::fflush(stderr);
-  }
-
- private:
-  void run() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (true) {
-      wake_.wait_for(lock, std::chrono::milliseconds(200), [this] { return done_ || changed_; });
-      if (done_) return;
-      changed_ = false;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-      if (elapsed < delay_) continue;
-      char line[512];
-      const int n = std::snprintf(line, sizeof line, "subvec: %s: %s %3d%%, %.0f s", label_.c_str(),
-                                  stage_.c_str(), static_cast<int>(std::lround(100 * fraction_)),
-                                  std::floor(elapsed));
-      const int len = std::min(n, static_cast<int>(sizeof line) - 1);
-      if (last_ == line) continue;
-      last_ = line;
-      std::fprintf(stderr, "\r%s%*s", line, std::max(0, shown_ - len), "");
-      std::fflush(stderr);
-      shown_ = std::max(shown_, len);
-    }
-  }
-
-  const std::string label_;
-  const std::chrono::steady_clock::time_point start_;
-  double delay_ = 1.0;  // seconds before the line appears
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::thread thread_;
-  std::string stage_ = "reading";
-  double fraction_ = 0;
-  bool changed_ = false, done_ = false;
-  std::string last_;  // the line on the terminal
-  int shown_ = 0;     // widest line drawn, in characters
-};
-
 struct VectorizeArgs {
   std::string input, output;
-  double ratio = 0.01;
-  int vertices = 0;
   // 2^23 pixels: a 4K UHD frame (3840 x 2160) fits. Vectorizing takes about 1.5 KB of memory per
   // pixel (the dense mesh has a vertex per pixel), so the default stays near 12 GB.
   int64_t max_pixels = int64_t{1} << 23;
-  std::string fit = "pixels";
-  std::string segment;  // X,Y,W,H, or empty
-  int grid_step = 0;     // 0: automatic
-  int l1_iterations = 0;
-  int relocate = 0;
-  int threads = 0;      // 0: all cores; the output does not depend on it
   bool json = false;
-  subvec_cli::LevelArgs levels;  // levels: --levels, --saliency-weight, ... (pyramid_commands.h)
+  subvec_cli::VectorizeParams params;  // shared with batch (vectorize_options.h)
 };
 
 void run_vectorize(const VectorizeArgs& a) {
   subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
   const auto start = std::chrono::steady_clock::now();
-  ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
+  subvec_cli::ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
   subvec::Image8 image;
   try {
     image = subvec::read_image(a.input, a.max_pixels);
@@ -501,20 +389,7 @@ void run_vectorize(const VectorizeArgs& a) {
     if (e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
-  subvec::VectorizeOptions options;
-  options.ratio = a.ratio;
-  options.vertices = a.vertices;
-  options.initial_mesh.grid_step = a.grid_step;
-  options.fit.target = a.fit == "vertices" ? subvec::ColorFitTarget::kRefinedVertices
-                                           : subvec::ColorFitTarget::kPixels;
-  options.fit.l1_iterations = a.l1_iterations;
-  options.fit.relocate_iterations = a.relocate;
-  options.threads = a.threads;
-  if (!a.segment.empty()) {
-    subvec::PixelRect rect;
-    parse_rect(a.segment, rect);  // already validated by CLI11
-    options.segment = rect;
-  }
+  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
@@ -523,14 +398,14 @@ void run_vectorize(const VectorizeArgs& a) {
   // ---- levels of abstraction (pyramid_commands.h) ----
   progress.update("levels", 0.95);
   const auto levels_start = std::chrono::steady_clock::now();
-  const subvec::LevelReport level_report = subvec_cli::build_levels(a.levels, v, image);
+  const subvec::LevelReport level_report = subvec_cli::build_levels(a.params.levels, v, image);
   const double levels_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - levels_start).count();
   // ---- end levels ----
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   subvec::RenderOptions render_options;
-  render_options.threads = a.threads;
+  render_options.threads = a.params.threads;
   const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
@@ -606,7 +481,7 @@ void run_vectorize(const VectorizeArgs& a) {
                            (segment_features == 1 ? " open feature" : " open features") +
                            " ending on the image border";
     }
-    std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.segment.c_str(),
+    std::printf("segment   %s: %lld foreground pixels, boundary %s\n", a.params.segment.c_str(),
                 static_cast<long long>(report.segment_mask.area()), boundary.c_str());
   }
   // ---- levels ----
@@ -793,60 +668,45 @@ int run(int argc, char** argv) {
   vectorize->add_option("input", va.input, "Raster image")->required();
   vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
       ->required();
-  CLI::Option* ratio_opt =
-      vectorize
-          ->add_option("--ratio", va.ratio,
-                       "Control vertices as a fraction of the pixel count (default 0.01)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok =
-                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
-                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
-              },
-              "RATIO", "ratio"));
-  CLI::Option* vertices_opt =
-      vectorize->add_option("--vertices", va.vertices, "Control vertex count instead of --ratio")
-          ->check(CLI::Range(4, 1 << 26));
-  ratio_opt->excludes(vertices_opt);
+  subvec_cli::add_vertex_count_options(vectorize, va.params);
   vectorize
       ->add_option("--max-pixels", va.max_pixels,
                    "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
   vectorize
-      ->add_option("--fit", va.fit,
+      ->add_option("--fit", va.params.fit,
                    "Color fit: every pixel (default) or the paper's subdivided vertices")
       ->check(CLI::IsMember({"pixels", "vertices"}))
       ->default_str("pixels");
   vectorize
-      ->add_option("--l1-iterations", va.l1_iterations,
+      ->add_option("--l1-iterations", va.params.l1_iterations,
                    "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
                    "least squares (default)")
       ->check(CLI::Range(0, 20));
   vectorize
-      ->add_option("--relocate", va.relocate,
+      ->add_option("--relocate", va.params.relocate,
                    "Gauss-Newton steps that move the smooth control vertices to lower the pixel "
                    "error before the final color fit; 0 keeps the simplified positions (default)")
       ->check(CLI::Range(0, 50));
   vectorize
-      ->add_option("--segment", va.segment,
+      ->add_option("--segment", va.params.segment,
                    "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
                    "becomes a closed tear")
       ->check(CLI::Validator(
           [](std::string& text) {
             subvec::PixelRect r;
-            return parse_rect(text, r);
+            return subvec_cli::parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
   vectorize
-      ->add_option("--grid-step", va.grid_step,
+      ->add_option("--grid-step", va.params.grid_step,
                    "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
                    "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
       ->check(CLI::Range(0, 2));
-  vectorize->add_option("--threads", va.threads, "Worker threads; 0 (default) uses all cores")
+  vectorize->add_option("--threads", va.params.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
-  subvec_cli::add_level_options(vectorize, va.levels);  // levels
+  subvec_cli::add_level_options(vectorize, va.params.levels);  // levels
   vectorize->footer(
       "Examples:\n"
       "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "

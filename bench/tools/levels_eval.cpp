@@ -28,14 +28,18 @@
 #include "subvec/core/error.h"
 #include "subvec/core/metrics.h"
 #include "subvec/io/image_io.h"
-#include "subvec/mesh/curves.h"
 #include "subvec/pyramid/levels.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/image_measures.h"
 
 namespace subvec {
 namespace {
+
+using test::away_from_features;
+using test::contrast_across;
+using test::laplacian_energy;
 
 double median_seconds(int runs, const std::function<void()>& f) {
   std::vector<double> t;
@@ -64,63 +68,6 @@ Image8 render_level(const VectorImage& image, int level, Overlay overlay = Overl
   o.level = level;
   o.overlay = overlay;
   return render(image, o);
-}
-
-std::vector<uint8_t> away_from_features(const VectorImage& image, double margin) {
-  std::vector<uint8_t> away(size_t(image.width) * image.height, 1);
-  for (const Feature& f : image.levels[0].features) {
-    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) {
-      const Vec2 a = image.levels[0].positions[f.vertices[i]], b = image.levels[0].positions[f.vertices[i + 1]];
-      const int steps = static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) * 2)) + 1;
-      for (int s = 0; s <= steps; ++s) {
-        const double x = a.x + (b.x - a.x) * s / steps, y = a.y + (b.y - a.y) * s / steps;
-        for (int py = std::max(0, int(y - margin - 1)); py <= std::min(image.height - 1, int(y + margin + 1)); ++py)
-          for (int px = std::max(0, int(x - margin - 1)); px <= std::min(image.width - 1, int(x + margin + 1)); ++px)
-            if (std::hypot(px + 0.5 - x, py + 0.5 - y) <= margin) away[size_t(py) * image.width + px] = 0;
-      }
-    }
-  }
-  return away;
-}
-
-double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
-  double sum = 0;
-  int n = 0;
-  for (int y = 1; y + 1 < img.height; ++y) {
-    for (int x = 1; x + 1 < img.width; ++x) {
-      if (!mask[size_t(y) * img.width + x]) continue;
-      for (int k = 0; k < 3; ++k) {
-        auto at = [&](int xx, int yy) { return double(img.row(yy)[3 * xx + k]); };
-        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
-        sum += l * l;
-      }
-      ++n;
-    }
-  }
-  return sum / std::max(n, 1);
-}
-
-double contrast_across(const Image8& img, const ControlMesh& mesh, const Feature& f, double offset) {
-  std::vector<Vec2> points;
-  for (size_t i = 0; i + (f.closed() ? 1 : 0) < f.vertices.size(); ++i) points.push_back(mesh.positions[f.vertices[i]]);
-  const std::vector<Vec2> curve = sample_bspline(points, f.closed(), 8);
-  double sum = 0, along = 0, next = 0.5;
-  int n = 0;
-  for (size_t i = 0; i + 1 < curve.size(); ++i) {
-    const double dx = curve[i + 1].x - curve[i].x, dy = curve[i + 1].y - curve[i].y, len = std::hypot(dx, dy);
-    if (len <= 0) continue;
-    while (next <= along + len) {
-      const double u = (next - along) / len;
-      const Vec2 p{curve[i].x + u * dx, curve[i].y + u * dy};
-      const auto a = sample_bilinear(img, p.x - dy / len * offset, p.y + dx / len * offset);
-      const auto b = sample_bilinear(img, p.x + dy / len * offset, p.y - dx / len * offset);
-      sum += std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-      ++n;
-      next += 1;
-    }
-    along += len;
-  }
-  return n ? sum / n : 0;
 }
 
 const Feature& by_id(const ControlMesh& m, int32_t id) {

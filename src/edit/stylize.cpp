@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "mesh/polyline_p.h"
 #include "subvec/core/error.h"
 #include "subvec/core/image.h"
 #include "subvec/edit/selection.h"
@@ -17,6 +18,9 @@
 
 namespace subvec {
 namespace {
+
+using detail::polyline_length;
+using detail::walk;
 
 constexpr int kSamplesPerSpan = 16;
 
@@ -48,31 +52,6 @@ std::vector<std::vector<std::vector<Vec2>>> feature_curves(const ControlMesh& me
     }
   }
   return curves;
-}
-
-double polyline_length(const std::vector<Vec2>& line) {
-  double length = 0;
-  for (size_t i = 0; i + 1 < line.size(); ++i)
-    length += std::hypot(line[i + 1].x - line[i].x, line[i + 1].y - line[i].y);
-  return length;
-}
-
-// Calls visit(point, unit tangent) at points `step` pixels apart along the polyline.
-template <class Visit>
-void walk(const std::vector<Vec2>& line, double step, Visit&& visit) {
-  double next = step / 2;  // first sample half a step in
-  double at = 0;
-  for (size_t i = 0; i + 1 < line.size(); ++i) {
-    const double dx = line[i + 1].x - line[i].x, dy = line[i + 1].y - line[i].y;
-    const double len = std::hypot(dx, dy);
-    if (len <= 0) continue;
-    while (next <= at + len) {
-      const double u = (next - at) / len;
-      visit(Vec2{line[i].x + u * dx, line[i].y + u * dy}, Vec2{dx / len, dy / len});
-      next += step;
-    }
-    at += len;
-  }
 }
 
 }  // namespace

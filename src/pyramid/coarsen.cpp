@@ -5,15 +5,12 @@
 #include <cmath>
 #include <string>
 
+#include "mesh/collapse_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
 namespace subvec::pyramid_detail {
 namespace {
-
-double signed_area(Vec2 a, Vec2 b, Vec2 c) {
-  return 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
-}
 
 double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
   const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
@@ -68,6 +65,7 @@ Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::
   vfaces_.assign(nv, {});
   for (size_t f = 0; f < tri_.size(); ++f)
     for (int32_t v : tri_[f]) vfaces_[v].push_back(static_cast<int32_t>(f));
+  marks_.mark.assign(nv, 0);
   sides_.assign(nv, 0);
   kind_.assign(nv, Kind::kSmooth);
   for (int v = 0; v < nv; ++v) {
@@ -124,15 +122,7 @@ void Coarsener::neighbours(int32_t v, std::vector<int32_t>& out) const {
 }
 
 int Coarsener::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
-  int n = 0;
-  for (int32_t f : vfaces_[u]) {
-    const Tri& t = tri_[f];
-    if (t[0] == v || t[1] == v || t[2] == v) {
-      if (n < 2) out[n] = f;
-      ++n;
-    }
-  }
-  return n;
+  return detail::faces_with_edge(vfaces_[u], tri_, v, out);
 }
 
 bool Coarsener::has_edge(int32_t a, int32_t b) const {
@@ -148,17 +138,7 @@ bool Coarsener::sharp_edge(int32_t a, int32_t b) const {
 int Coarsener::edge_color_pairs(int32_t u, int32_t v, std::array<std::array<int32_t, 2>, 2>& out) const {
   int32_t faces[2];
   const int nf = std::min(faces_with_edge(u, v, faces), 2);
-  int n = 0;
-  for (int i = 0; i < nf; ++i) {
-    int32_t cu = -1, cv = -1;
-    for (int k = 0; k < 3; ++k) {
-      if (tri_[faces[i]][k] == u) cu = tcol_[faces[i]][k];
-      if (tri_[faces[i]][k] == v) cv = tcol_[faces[i]][k];
-    }
-    if (n == 1 && out[0][0] == cu && out[0][1] == cv) continue;
-    out[n++] = {cu, cv};
-  }
-  return n;
+  return detail::edge_color_pairs(faces, nf, tri_, tcol_, u, v, out);
 }
 
 bool Coarsener::can_collapse(int32_t u, int32_t v, double feature_tolerance, double min_area) const {
@@ -194,32 +174,27 @@ bool Coarsener::can_collapse(int32_t u, int32_t v, double feature_tolerance, dou
     }
   }
   // Link condition: the common neighbours are exactly the faces' third vertices.
-  std::vector<int32_t> nu, nv;
-  neighbours(u, nu);
-  neighbours(v, nv);
-  std::vector<int32_t> common;
-  std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
-  if (static_cast<int>(common.size()) != nf) return false;
+  if (!detail::link_condition(vfaces_[u], vfaces_[v], tri_, u, v, nf, marks_)) return false;
   // A dying face must not fold two sharp edges into one.
-  for (int i = 0; i < nf; ++i) {
-    for (int32_t w : tri_[faces[i]])
-      if (w != u && w != v && sharp_edge(u, w) && sharp_edge(v, w)) return false;
+  if (detail::folds_sharp_edges(faces, nf, tri_, u, v,
+                                [&](int32_t a, int32_t b) { return sharp_edge(a, b); })) {
+    return false;
   }
-  // No new edge between two vertices of one image side (only border edges may join them).
+  // No new edge between two vertices of one image side (only border edges may join them): none
+  // from v to a neighbour of u but the faces' third vertices (u and v's common neighbours).
+  std::vector<int32_t> nu;
+  neighbours(u, nu);
+  const auto third_vertex = [&](int32_t w) {
+    for (int i = 0; i < nf; ++i)
+      if (tri_[faces[i]][0] == w || tri_[faces[i]][1] == w || tri_[faces[i]][2] == w) return true;
+    return false;
+  };
   for (int32_t w : nu) {
-    if (w == v || std::binary_search(common.begin(), common.end(), w)) continue;
+    if (w == v || third_vertex(w)) continue;
     if ((sides_[v] & sides_[w]) != 0) return false;
   }
-  // No flipped or thin triangle.
-  const Vec2 pv = pos_[v];
-  for (int32_t f : vfaces_[u]) {
-    const Tri& t = tri_[f];
-    if (t[0] == v || t[1] == v || t[2] == v) continue;
-    Vec2 p[3];
-    for (int k = 0; k < 3; ++k) p[k] = t[k] == u ? pv : pos_[t[k]];
-    if (signed_area(p[0], p[1], p[2]) <= min_area) return false;
-  }
-  return true;
+  // No flipped or thin triangle (u goes to v, which stays where it is).
+  return detail::faces_keep_area(vfaces_[u], tri_, u, v, [&](int32_t w) { return pos_[w]; }, min_area);
 }
 
 CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/collapse_p.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec::pyramid_detail {
@@ -108,6 +109,7 @@ class Coarsener {
   std::vector<int32_t> chain_of_;  // chain of a tear vertex, else -1
   std::unordered_set<uint64_t> tear_edges_;
   std::vector<EdgeVerts> creases_;
+  mutable detail::VertexMarks marks_;  // scratch for can_collapse
   int alive_count_ = 0;
 };
 

@@ -9,6 +9,7 @@
 
 #include <Eigen/Dense>
 
+#include "mesh/polyline_p.h"
 #include "pyramid/coarsen_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
@@ -16,6 +17,8 @@
 namespace subvec {
 namespace {
 
+using detail::polyline_length;
+using detail::walk;
 using pyramid_detail::Coarsener;
 using pyramid_detail::Kind;
 
@@ -61,24 +64,6 @@ Quadric triangle_quadric(const Eigen::Matrix<double, 5, 1>& p, const Eigen::Matr
   out.b = area * (pe1 * e1 + pe2 * e2 - p);
   out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
   return out;
-}
-
-// Calls visit(point, unit tangent) at points `step` pixels apart along the polyline.
-template <class Visit>
-void walk(std::span<const Vec2> line, double step, Visit&& visit) {
-  double next = step / 2;
-  double at = 0;
-  for (size_t i = 0; i + 1 < line.size(); ++i) {
-    const double dx = line[i + 1].x - line[i].x, dy = line[i + 1].y - line[i].y;
-    const double len = std::hypot(dx, dy);
-    if (len <= 0) continue;
-    while (next <= at + len) {
-      const double u = (next - at) / len;
-      visit(Vec2{line[i].x + u * dx, line[i].y + u * dy}, Vec2{dx / len, dy / len});
-      next += step;
-    }
-    at += len;
-  }
 }
 
 // Greedy half-edge collapses by quadric cost until `target` vertices remain. Kept chains stay within
@@ -172,10 +157,9 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
 }  // namespace
 
 double curve_saliency(std::span<const Vec2> curve, const Image8& raster, double weight) {
-  double length = 0, contrast = 0;
+  const double length = polyline_length(curve);
+  double contrast = 0;
   int samples = 0;
-  for (size_t i = 0; i + 1 < curve.size(); ++i)
-    length += std::hypot(curve[i + 1].x - curve[i].x, curve[i + 1].y - curve[i].y);
   walk(curve, 1.0, [&](Vec2 p, Vec2 t) {
     const auto a = sample_bilinear(raster, p.x - t.y, p.y + t.x);
     const auto b = sample_bilinear(raster, p.x + t.y, p.y - t.x);

@@ -36,6 +36,7 @@
 #include <Eigen/Dense>
 
 #include "core/parallel_p.h"
+#include "mesh/collapse_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
@@ -401,13 +402,8 @@ class Simplifier {
     CollapseQueue queue;
     SimplifyStats stats;
     Arena arena;
-    std::vector<uint32_t> mark;  // vertices marked with a stamp (neighbourhood queries)
-    uint32_t stamp = 0;
+    detail::VertexMarks marks;  // neighbourhood queries
     std::vector<int32_t> ring, faces;
-    uint32_t next_stamp() {
-      if (++stamp == 0) std::fill(mark.begin(), mark.end(), 0u), stamp = 1;
-      return stamp;
-    }
   };
 
   void setup();
@@ -425,10 +421,8 @@ class Simplifier {
   bool image_corner(Vec2 p) const { return (p.x == 0 || p.x == w_) && (p.y == 0 || p.y == h_); }
   bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
-  bool link_condition(Worker& w, int32_t u, int32_t v) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
   bool tear_edge(int32_t a, int32_t b) const;
-  double signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved, int num_moved) const;
   void write_back();
 
   // Feature refit for the removal of node `removed`: fills moved vertices and returns the largest
@@ -607,26 +601,18 @@ void Simplifier::setup() {
 // The distinct neighbours of v, in no particular order.
 void Simplifier::neighbours(Worker& worker, int32_t v, std::vector<int32_t>& out) const {
   out.clear();
-  const uint32_t stamp = worker.next_stamp();
+  const uint32_t stamp = worker.marks.next_stamp();
   for (int32_t f : vfaces_[v]) {
     for (int32_t w : tri_[f]) {
-      if (w == v || worker.mark[w] == stamp) continue;
-      worker.mark[w] = stamp;
+      if (w == v || worker.marks.mark[w] == stamp) continue;
+      worker.marks.mark[w] = stamp;
       out.push_back(w);
     }
   }
 }
 
 int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
-  int n = 0;
-  for (int32_t f : vfaces_[u]) {
-    const Tri& t = tri_[f];
-    if (t[0] == v || t[1] == v || t[2] == v) {
-      if (n < 2) out[n] = f;
-      ++n;
-    }
-  }
-  return n;
+  return detail::faces_with_edge(vfaces_[u], tri_, v, out);
 }
 
 // Whether (a, b) is a tear edge: consecutive in a feature chain.
@@ -657,10 +643,10 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
   // A smooth vertex into a vertex with one color: the edge (which exists: u and v are neighbours)
   // merges one pair of quadrics whatever its faces.
   int32_t faces[2];
-  int32_t pairs[2][2];
+  std::array<std::array<int32_t, 2>, 2> pairs;
   int npairs = 0;
   if (ku == Kind::kSmooth && only_color_[u] >= 0 && only_color_[v] >= 0) {
-    pairs[0][0] = only_color_[u], pairs[0][1] = only_color_[v];
+    pairs[0] = {only_color_[u], only_color_[v]};
     npairs = 1;
   } else {
     const int nfaces = faces_with_edge(u, v, faces);
@@ -681,17 +667,7 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
     if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
 
     // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
-    for (int i = 0; i < nfaces; ++i) {
-      const Tri& t = tri_[faces[i]];
-      int32_t cu = -1, cv = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (t[k] == u) cu = tcol_[faces[i]][k];
-        if (t[k] == v) cv = tcol_[faces[i]][k];
-      }
-      if (npairs == 1 && pairs[0][0] == cu && pairs[0][1] == cv) continue;
-      pairs[npairs][0] = cu, pairs[npairs][1] = cv;
-      ++npairs;
-    }
+    npairs = detail::edge_color_pairs(faces, nfaces, tri_, tcol_, u, v, pairs);
   }
   Quadric2 r;
   for (int i = 0; i < npairs; ++i) {
@@ -758,33 +734,6 @@ void Simplifier::rebuild_queue(Worker& worker) {
   }
 }
 
-bool Simplifier::link_condition(Worker& worker, int32_t u, int32_t v) const {
-  // Mark u's neighbours, then count v's marked ones, each once.
-  const uint32_t of_u = worker.next_stamp(), counted = worker.next_stamp();
-  for (int32_t f : vfaces_[u])
-    for (int32_t w : tri_[f]) worker.mark[w] = of_u;
-  int common = 0;
-  for (int32_t f : vfaces_[v]) {
-    for (int32_t w : tri_[f]) {
-      if (w == u || w == v || worker.mark[w] != of_u) continue;
-      worker.mark[w] = counted;
-      ++common;
-    }
-  }
-  int32_t faces[2];
-  return common == faces_with_edge(u, v, faces);
-}
-
-double Simplifier::signed_area(const Tri& t, const std::array<std::pair<int32_t, Vec2>, 8>& moved,
-                               int num_moved) const {
-  Vec2 p[3];
-  for (int k = 0; k < 3; ++k) {
-    p[k] = pos_[t[k]];
-    for (int i = 0; i < num_moved; ++i)
-      if (moved[i].first == t[k]) p[k] = moved[i].second;
-  }
-  return 0.5 * ((p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x));
-}
 
 double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved,
                          int& num_moved) const {
@@ -943,21 +892,18 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   // A collapse along a feature refits nodes up to five away: they must all be the worker's.
   const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
   if (removed_node >= 0 && !owns_window(worker, removed_node)) return false;
-  if (!link_condition(worker, u, v)) {
-    ++stats.rejected_topology;
-    return false;
-  }
-  // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
   {
     int32_t faces[2];
     const int nfaces = faces_with_edge(u, v, faces);
-    for (int i = 0; i < std::min(nfaces, 2); ++i) {
-      for (int32_t w : tri_[faces[i]]) {
-        if (w != u && w != v && sharp(u) && sharp(v) && sharp(w) && tear_edge(u, w) && tear_edge(v, w)) {
-          ++stats.rejected_topology;
-          return false;
-        }
-      }
+    if (!detail::link_condition(vfaces_[u], vfaces_[v], tri_, u, v, nfaces, worker.marks)) {
+      ++stats.rejected_topology;
+      return false;
+    }
+    // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
+    const auto sharp_tear_edge = [&](int32_t a, int32_t b) { return sharp(a) && sharp(b) && tear_edge(a, b); };
+    if (detail::folds_sharp_edges(faces, std::min(nfaces, 2), tri_, u, v, sharp_tear_edge)) {
+      ++stats.rejected_topology;
+      return false;
     }
   }
   std::array<std::pair<int32_t, Vec2>, 8> moved;
@@ -977,23 +923,14 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
 
   // No flipped or degenerate triangle among everything that moves.
   constexpr double kMinArea = 1e-4;
-  auto faces_ok = [&](int32_t x) {
-    for (int32_t f : vfaces_[x]) {
-      Tri t = tri_[f];
-      bool has_u = false, has_v = false;
-      for (int32_t& w : t) {
-        has_u |= w == u;
-        has_v |= w == v;
-      }
-      if (has_u && has_v) continue;  // dies
-      for (int32_t& w : t)
-        if (w == u) w = v;
-      if (signed_area(t, moved, num_moved) <= kMinArea) return false;
-    }
-    return true;
+  const auto position = [&](int32_t w) {
+    Vec2 p = pos_[w];
+    for (int i = 0; i < num_moved; ++i)
+      if (moved[i].first == w) p = moved[i].second;
+    return p;
   };
   for (int i = 0; i < num_moved; ++i) {
-    if (!faces_ok(moved[i].first)) {
+    if (!detail::faces_keep_area(vfaces_[moved[i].first], tri_, u, v, position, kMinArea)) {
       ++stats.rejected_topology;
       return false;
     }
@@ -1060,7 +997,7 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
 
 // Greedy collapses, cheapest first, of the worker's edges until it is down to w.stop vertices.
 void Simplifier::simplify_with(Worker& worker) {
-  worker.mark.assign(pos_.size(), 0);
+  worker.marks.mark.assign(pos_.size(), 0);
   rebuild_queue(worker);
   size_t rebuild_at = 4 * worker.queue.size();
   auto live = [&](const Entry& e) {
@@ -1081,7 +1018,7 @@ void Simplifier::simplify_with(Worker& worker) {
       rebuild_at = std::max<size_t>(4 * worker.queue.size(), 1024);
     }
   }
-  worker.mark = {};
+  worker.marks.mark = {};
 }
 
 SimplifyStats Simplifier::run() {

@@ -7,16 +7,20 @@
 #include <filesystem>
 
 #include "pyramid_test_util.h"
+#include "support/image_measures.h"
 #include "subvec/core/error.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
-#include "subvec/mesh/curves.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 
 namespace subvec {
 namespace {
+
+using test::away_from_features;
+using test::contrast_across;
+using test::laplacian_energy;
 
 const VectorImage& shapes() {
   static const VectorImage image = test::shapes_levels(test::shapes_image());
@@ -27,69 +31,6 @@ Image8 render_level0(const VectorImage& image) {
   RenderOptions o;
   o.level = 0;
   return render(image, o);
-}
-
-// Pixels farther than `margin` from every feature polygon of level 0 (the limit curves stay within
-// about a pixel of them).
-std::vector<uint8_t> away_from_features(const VectorImage& image, double margin) {
-  std::vector<uint8_t> away(size_t(image.width) * image.height, 1);
-  for (const Feature& f : image.levels[0].features) {
-    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) {
-      const Vec2 a = image.levels[0].positions[f.vertices[i]], b = image.levels[0].positions[f.vertices[i + 1]];
-      const int steps = static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) * 2)) + 1;
-      for (int s = 0; s <= steps; ++s) {
-        const double x = a.x + (b.x - a.x) * s / steps, y = a.y + (b.y - a.y) * s / steps;
-        for (int py = std::max(0, int(y - margin - 1)); py <= std::min(image.height - 1, int(y + margin + 1)); ++py)
-          for (int px = std::max(0, int(x - margin - 1)); px <= std::min(image.width - 1, int(x + margin + 1)); ++px)
-            if (std::hypot(px + 0.5 - x, py + 0.5 - y) <= margin) away[size_t(py) * image.width + px] = 0;
-      }
-    }
-  }
-  return away;
-}
-
-// Mean squared 5-point Laplacian over the masked pixels, summed over channels.
-double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
-  double sum = 0;
-  int n = 0;
-  for (int y = 1; y + 1 < img.height; ++y) {
-    for (int x = 1; x + 1 < img.width; ++x) {
-      if (!mask[size_t(y) * img.width + x]) continue;
-      for (int k = 0; k < 3; ++k) {
-        auto at = [&](int xx, int yy) { return double(img.row(yy)[3 * xx + k]); };
-        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
-        sum += l * l;
-      }
-      ++n;
-    }
-  }
-  return sum / std::max(n, 1);
-}
-
-// Mean color difference across feature `f` of `mesh`: points 1 px apart along its limit curve,
-// sampled `offset` pixels to each side.
-double contrast_across(const Image8& img, const ControlMesh& mesh, const Feature& f, double offset) {
-  std::vector<Vec2> points;
-  for (size_t i = 0; i + (f.closed() ? 1 : 0) < f.vertices.size(); ++i) points.push_back(mesh.positions[f.vertices[i]]);
-  const std::vector<Vec2> curve = sample_bspline(points, f.closed(), 8);
-  double sum = 0;
-  int n = 0;
-  double along = 0, next = 0.5;
-  for (size_t i = 0; i + 1 < curve.size(); ++i) {
-    const double dx = curve[i + 1].x - curve[i].x, dy = curve[i + 1].y - curve[i].y, len = std::hypot(dx, dy);
-    if (len <= 0) continue;
-    while (next <= along + len) {
-      const double u = (next - along) / len;
-      const Vec2 p{curve[i].x + u * dx, curve[i].y + u * dy};
-      const auto a = sample_bilinear(img, p.x - dy / len * offset, p.y + dx / len * offset);
-      const auto b = sample_bilinear(img, p.x + dy / len * offset, p.y - dx / len * offset);
-      sum += std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-      ++n;
-      next += 1;
-    }
-    along += len;
-  }
-  return n ? sum / n : 0;
 }
 
 Image8 gaussian_blur(const Image8& img, double sigma) {

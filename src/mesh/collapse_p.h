@@ -1,0 +1,118 @@
+// Validity checks for an edge collapse on an index mesh: triangles as vertex triples and, per
+// vertex, the ids of its incident faces (any range of int32_t). Shared by the simplification of
+// vectorization (vectorize/simplify.cpp) and the coarsening between levels (pyramid/coarsen.cpp),
+// so that the two agree about what a collapse may not do to a mesh: break the link condition, fold
+// two sharp edges into one, or flip or flatten a triangle.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec::detail {
+
+// A stamp per vertex for neighbourhood queries: taking a new stamp unmarks every vertex at once.
+struct VertexMarks {
+  std::vector<uint32_t> mark;  // sized to the vertex count by the owner
+  uint32_t stamp = 0;
+  uint32_t next_stamp() {
+    if (++stamp == 0) std::fill(mark.begin(), mark.end(), 0u), stamp = 1;
+    return stamp;
+  }
+};
+
+inline double signed_area(Vec2 a, Vec2 b, Vec2 c) {
+  return 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+}
+
+// The faces among `faces_of_u` (u's incident faces) that have the vertex v: how many, and the
+// first two in `out`.
+template <class Faces>
+int faces_with_edge(const Faces& faces_of_u, const std::vector<Tri>& tri, int32_t v, int32_t* out) {
+  int n = 0;
+  for (int32_t f : faces_of_u) {
+    const Tri& t = tri[f];
+    if (t[0] == v || t[1] == v || t[2] == v) {
+      if (n < 2) out[n] = f;
+      ++n;
+    }
+  }
+  return n;
+}
+
+// (color of u, color of v) in each of the `n` faces on the edge (u, v), colors from `tcol` (one per
+// corner); the second face's pair is dropped when it repeats the first (no tear along the edge).
+// Returns how many pairs.
+inline int edge_color_pairs(const int32_t* faces, int n, const std::vector<Tri>& tri,
+                            const std::vector<Tri>& tcol, int32_t u, int32_t v,
+                            std::array<std::array<int32_t, 2>, 2>& out) {
+  int pairs = 0;
+  for (int i = 0; i < n; ++i) {
+    int32_t cu = -1, cv = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (tri[faces[i]][k] == u) cu = tcol[faces[i]][k];
+      if (tri[faces[i]][k] == v) cv = tcol[faces[i]][k];
+    }
+    if (pairs == 1 && out[0][0] == cu && out[0][1] == cv) continue;
+    out[pairs++] = {cu, cv};
+  }
+  return pairs;
+}
+
+// The link condition for collapsing the edge (u, v), which has `edge_faces` faces: u and v have
+// exactly as many common neighbours, the third vertices of those faces.
+template <class Faces>
+bool link_condition(const Faces& faces_of_u, const Faces& faces_of_v, const std::vector<Tri>& tri,
+                    int32_t u, int32_t v, int edge_faces, VertexMarks& marks) {
+  // Mark u's neighbours, then count v's marked ones, each once.
+  const uint32_t of_u = marks.next_stamp(), counted = marks.next_stamp();
+  for (int32_t f : faces_of_u)
+    for (int32_t w : tri[f]) marks.mark[w] = of_u;
+  int common = 0;
+  for (int32_t f : faces_of_v) {
+    for (int32_t w : tri[f]) {
+      if (w == u || w == v || marks.mark[w] != of_u) continue;
+      marks.mark[w] = counted;
+      ++common;
+    }
+  }
+  return common == edge_faces;
+}
+
+// Whether one of the `n` faces on the edge (u, v) has a third vertex w with sharp(u, w) and
+// sharp(v, w): the collapse would fold those two sharp edges into one.
+template <class Sharp>
+bool folds_sharp_edges(const int32_t* faces, int n, const std::vector<Tri>& tri, int32_t u,
+                       int32_t v, Sharp&& sharp) {
+  for (int i = 0; i < n; ++i) {
+    for (int32_t w : tri[faces[i]])
+      if (w != u && w != v && sharp(u, w) && sharp(v, w)) return true;
+  }
+  return false;
+}
+
+// No flipped or thin triangle: whether every face among `faces_of_x` that survives the collapse
+// of u into v (every face but those with both) keeps a signed area over `min_area` once u is
+// renamed v, with its corners at position(vertex).
+template <class Faces, class Position>
+bool faces_keep_area(const Faces& faces_of_x, const std::vector<Tri>& tri, int32_t u, int32_t v,
+                     Position&& position, double min_area) {
+  for (int32_t f : faces_of_x) {
+    Tri t = tri[f];
+    bool has_u = false, has_v = false;
+    for (int32_t& w : t) {
+      has_u |= w == u;
+      has_v |= w == v;
+    }
+    if (has_u && has_v) continue;  // dies
+    for (int32_t& w : t)
+      if (w == u) w = v;
+    if (signed_area(position(t[0]), position(t[1]), position(t[2])) <= min_area) return false;
+  }
+  return true;
+}
+
+}  // namespace subvec::detail
