@@ -22,7 +22,7 @@ struct SvecWriteOptions {
   // level renumbered in traversal order (the same picture; a second write is identical).
   bool lossless = false;
   // The compact form's version: 3 (range-coded, the default) or 2 (varints and zstd, the same
-  // content in about 8 % more bytes; kept for older readers).
+  // content in about 11 % more bytes; for readers that predate version 3).
   int compact_version = 3;
   // Compact: positions on multiples of 2^-position_bits pixels (0 to 12; finer where needed to
   // keep every triangle positive), colors on multiples of 2^-color_bits levels (0 to 12).
