@@ -2,7 +2,8 @@
 // For each pair PHOTO VECTOR (a photograph and its vectorization, any .svec form) it writes the
 // compact form at several position and color grids and prints, per grid, the bytes per control
 // vertex and the change of the 1x render's MAE against the photograph, and the MAE between the
-// renders before and after quantization. A last row gives the medians over the images.
+// renders before and after quantization; also the bytes of version 1 and of version 2 at the
+// default grids. A last row gives the medians over the images.
 //
 //   subvec_svec_precision PHOTO VECTOR [PHOTO VECTOR ...]
 #include <algorithm>
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
     const std::vector<std::pair<int, int>> grids = {{1, -1}, {2, -1}, {3, -1}, {4, -1},
                                                     {2, 1},  {2, 0},  {2, -2}};
     std::vector<std::vector<double>> bpv(grids.size()), dmae(grids.size()), rmae(grids.size());
-    std::vector<double> lossless_bpv;
+    std::vector<double> lossless_bpv, v2_bpv;
     std::printf("%-12s %5s %5s %10s %8s %10s %10s\n", "image", "pbits", "cbits", "bytes",
                 "B/vertex", "dMAE", "MAE(render)");
     for (int i = 1; i + 1 < argc; i += 2) {
@@ -57,6 +58,12 @@ int main(int argc, char** argv) {
       lossless_bpv.push_back(double(lossless) / vertices);
       std::printf("%-12s %5s %5s %10zu %8.3f %10s %10s\n", name.c_str(), "v1", "-", lossless,
                   double(lossless) / vertices, "0", "0");
+      // Version 2 at the default grids: the same content as version 3 in varints and zstd.
+      const size_t v2 =
+          subvec::to_svec_binary(image, subvec::SvecWriteOptions{.compact_version = 2}).size();
+      v2_bpv.push_back(double(v2) / vertices);
+      std::printf("%-12s %5s %5s %10zu %8.3f %10s %10s\n", name.c_str(), "v2", "2/-1", v2,
+                  double(v2) / vertices, "", "");
       for (size_t g = 0; g < grids.size(); ++g) {
         subvec::SvecWriteOptions options;
         options.position_bits = grids[g].first;
@@ -75,6 +82,8 @@ int main(int argc, char** argv) {
     }
     std::printf("%-12s %5s %5s %10s %8.3f %10s %10s\n", "median", "v1", "-", "",
                 median(lossless_bpv), "0", "0");
+    std::printf("%-12s %5s %5s %10s %8.3f %10s %10s\n", "median", "v2", "2/-1", "",
+                median(v2_bpv), "", "");
     for (size_t g = 0; g < grids.size(); ++g) {
       std::printf("%-12s %5d %5d %10s %8.3f %+10.4f %10.4f\n", "median", grids[g].first,
                   grids[g].second, "", median(bpv[g]), median(dmae[g]), median(rmae[g]));

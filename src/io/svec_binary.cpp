@@ -71,10 +71,11 @@ std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
   return std::move(w.bytes);
 }
 
-// Version 2: levels in the compact layout (svec_compact.cpp), already quantized with `bits`.
-std::vector<uint8_t> encode_payload_v2(const VectorImage& image,
-                                       const std::vector<std::array<int, 2>>& bits,
-                                       std::vector<size_t>& block_ends) {
+// Versions 2 and 3: levels in the compact layout (svec_compact.cpp), already quantized with
+// `bits`.
+std::vector<uint8_t> encode_payload_compact(const VectorImage& image, uint32_t version,
+                                            const std::vector<std::array<int, 2>>& bits,
+                                            std::vector<size_t>& block_ends) {
   ByteWriter w;
   std::vector<std::vector<int32_t>> orders(image.levels.size());
   w.i32(image.width);
@@ -89,8 +90,8 @@ std::vector<uint8_t> encode_payload_v2(const VectorImage& image,
     w.count(m.features.size(), "features");
     w.bytes.push_back(static_cast<uint8_t>(bits[l][0]));
     w.bytes.push_back(static_cast<uint8_t>(static_cast<int8_t>(bits[l][1])));
-    encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], w, block_ends,
-                         &orders[l]);
+    encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], int(version), w,
+                         block_ends, &orders[l]);
   }
   // The pyramid records name vertices: renumber them as the levels were.
   VectorImage records;
@@ -134,14 +135,14 @@ VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version) {
   image.height = in.i32();
   const size_t num_levels = in.count("levels", 20, Limits::kMaxLevels);
   image.levels.resize(num_levels);
-  if (version == kCompactVersion) {
+  if (version == kCompactVersion || version == kCodedVersion) {
     if (image.width < 1 || image.height < 1 || image.width > Limits::kMaxDimension ||
         image.height > Limits::kMaxDimension) {
       fail("image size " + std::to_string(image.width) + " x " + std::to_string(image.height) +
            " is out of range (1 to " + str(Limits::kMaxDimension) + " a side)");
     }
     for (size_t l = 0; l < num_levels; ++l)
-      image.levels[l] = decode_compact_level(in, int(l), image.width, image.height);
+      image.levels[l] = decode_compact_level(in, int(l), image.width, image.height, int(version));
     decode_trailer(in, image);
     return image;
   }
@@ -385,9 +386,9 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
   const uint32_t flags = header.u32();
   const uint64_t payload_size = header.u64();
   const uint64_t frame_size = header.u64();
-  if (version != kLosslessVersion && version != kCompactVersion) {
+  if (version != kLosslessVersion && version != kCompactVersion && version != kCodedVersion) {
     fail("unsupported .svec version " + str(version) + " (this build reads " +
-         str(kLosslessVersion) + " and " + str(kCompactVersion) + ")");
+         str(kLosslessVersion) + ", " + str(kCompactVersion) + " and " + str(kCodedVersion) + ")");
   }
   if (flags != 0) fail("unsupported .svec flags " + str(flags) + " (this build knows none)");
   if (payload_size > kMaxPayloadBytes) {
@@ -418,18 +419,25 @@ std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOpt
              str(kMaxColorBits) + ")",
          ErrorCode::kInvalidArgument);
   }
-  // Version 2 quantizes each level, with finer positions when the coarse grid would flip or
+  if (options.compact_version != int(kCompactVersion) &&
+      options.compact_version != int(kCodedVersion)) {
+    fail("compact .svec version " + std::to_string(options.compact_version) +
+             " is not one this build writes (2 or 3)",
+         ErrorCode::kInvalidArgument);
+  }
+  const auto compact = static_cast<uint32_t>(options.compact_version);
+  // The compact form quantizes each level, with finer positions when the coarse grid would flip or
   // collapse a triangle, and falls back to version 1 when even the finest grid does.
-  uint32_t version = options.lossless ? kLosslessVersion : kCompactVersion;
+  uint32_t version = options.lossless ? kLosslessVersion : compact;
   VectorImage quantized;
   std::vector<std::array<int, 2>> bits;
-  if (version == kCompactVersion) {
+  if (version == compact) {
     validate(image);
     quantized.width = image.width;
     quantized.height = image.height;
     quantized.strokes = image.strokes;
     quantized.metadata = image.metadata;
-    for (size_t l = 0; l < image.levels.size() && version == kCompactVersion; ++l) {
+    for (size_t l = 0; l < image.levels.size() && version == compact; ++l) {
       version = kLosslessVersion;
       for (int p = options.position_bits; p <= kMaxPositionBits; ++p) {
         ControlMesh q = quantize_positions(image.levels[l], image.width, image.height, p);
@@ -440,15 +448,15 @@ std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOpt
         }
         quantized.levels.push_back(std::move(q));
         bits.push_back({p, options.color_bits});
-        version = kCompactVersion;
+        version = compact;
         break;
       }
     }
   }
   std::vector<size_t> block_ends;
-  const std::vector<uint8_t> payload = version == kCompactVersion
-                                           ? encode_payload_v2(quantized, bits, block_ends)
-                                           : encode_payload_v1(image);
+  const std::vector<uint8_t> payload =
+      version == kLosslessVersion ? encode_payload_v1(image)
+                                  : encode_payload_compact(quantized, version, bits, block_ends);
   if (payload.size() > kMaxPayloadBytes) {
     fail("image too large for a .svec file (" + str(payload.size()) + " bytes of payload, limit " +
              str(kMaxPayloadBytes) + ")",

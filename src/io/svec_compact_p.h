@@ -1,4 +1,4 @@
-// The compact level layout of `.svec` version 2 (docs/format.md, "Compact levels"): quantized
+// The compact level layouts of `.svec` versions 2 and 3 (docs/format.md, "Compact levels"): quantized
 // positions and colors, predicted along a traversal of the mesh, and connectivity coded as one
 // operation per triangle. Private to the binary reader and writer (svec_binary.cpp).
 #pragma once
@@ -29,12 +29,14 @@ ControlMesh quantize_positions(const ControlMesh& mesh, int width, int height, i
 // Appends to `block_ends` the offsets in `out` after which the writer should start a new zstd
 // block (each section gets its own entropy tables).
 // `vertex_order`, when given, receives each vertex's number in the stored order.
+// `version` 2 writes six varint sections, 3 one range-coded stream (svec_range_p.h).
 void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
-                          int color_bits, ByteWriter& out, std::vector<size_t>& block_ends,
+                          int color_bits, int version, ByteWriter& out,
+                          std::vector<size_t>& block_ends,
                           std::vector<int32_t>* vertex_order = nullptr);
 
 // Reads one compact level; throws Error(kBadFile) (or kLimit, kInvalidMesh) naming `level`.
 // The result is not yet validated.
-ControlMesh decode_compact_level(Cursor& in, int level, int width, int height);
+ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, int version);
 
 }  // namespace subvec::svec_detail

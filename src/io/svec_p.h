@@ -12,6 +12,7 @@ namespace subvec::svec_detail {
 inline constexpr std::array<uint8_t, 8> kMagic = {'S', 'U', 'B', 'V', 'E', 'C', 0x00, 0x1A};
 inline constexpr uint32_t kLosslessVersion = 1;  // exact values, the image's own order
 inline constexpr uint32_t kCompactVersion = 2;   // quantized, predicted, traversal order
+inline constexpr uint32_t kCodedVersion = 3;     // version 2's content, range-coded
 inline constexpr size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8;
 inline constexpr uint64_t kMaxPayloadBytes = uint64_t{1} << 30;  // 1 GiB uncompressed
 inline constexpr int kZstdLevel = 9;

@@ -367,7 +367,9 @@ def svec_binary_files():
     subvec = os.environ.get("SUBVEC", os.path.join(HERE, "..", "..", "build", "bin", "subvec"))
     example = os.path.join(HERE, "..", "..", "examples", "03-junction.svec.json")
     with tempfile.TemporaryDirectory() as tmp:
-        for version, extra in (("v1", ["--lossless"]), ("v2", [])):
+        # svec-v2-*.svec were written the same way by the version 2 writer (before version 3
+        # became the default); main() keeps them.
+        for version, extra in (("v1", ["--lossless"]), ("v3", [])):
             path = os.path.join(tmp, version + ".svec")
             subprocess.run([subvec, "convert", example, "-o", path] + extra, check=True)
             with open(path, "rb") as f:
@@ -380,12 +382,35 @@ def svec_binary_files():
                 b[at] ^= 0xA5
                 write(f"svec-{version}-flipped-{name}.svec", bytes(b))
             write(f"svec-{version}-doubled.svec", good + good)
+            if version == "v3":
+                v3_stream_files(good)
+
+
+def v3_stream_files(good):
+    """Version 3 files whose zstd frame is sound but whose level stream is damaged."""
+    import struct
+    payload = subprocess.run(["zstd", "-d", "-q", "-c"], input=good[32:], check=True,
+                             stdout=subprocess.PIPE).stdout
+    # The level's stream length follows 12 bytes of size and level count, 20 of counts, 2 of grids.
+    n = struct.unpack_from("<I", payload, 34)[0]
+
+    def wrap(p):
+        frame = subprocess.run(["zstd", "-q", "-c", "-9"], input=p, check=True,
+                               stdout=subprocess.PIPE).stdout
+        return good[:16] + struct.pack("<QQ", len(p), len(frame)) + frame
+
+    flipped = bytearray(payload)
+    flipped[38 + n // 2] ^= 0x5A
+    write("svec-v3-stream-flipped.svec", wrap(bytes(flipped)))
+    cut = payload[:34] + struct.pack("<I", n - 8) + payload[38:38 + n - 8] + payload[38 + n:]
+    write("svec-v3-stream-cut.svec", wrap(cut))
 
 
 def main():
     os.makedirs(OUT, exist_ok=True)
     for name in os.listdir(OUT):
-        os.remove(os.path.join(OUT, name))
+        if not name.startswith("svec-v2-"):
+            os.remove(os.path.join(OUT, name))
     png_files()
     jpeg_files()
     other_files()

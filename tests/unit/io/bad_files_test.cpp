@@ -82,7 +82,7 @@ const std::vector<BadFile>& corpus() {
       {"truncated.svec.json", E::kBadFile, {"invalid JSON", "line 9"}},
       // Binary containers.
       {"wrong-magic.svec", E::kBadFile, {"not a .svec file: wrong magic bytes (53 55 42 56 45 58"}},
-      {"wrong-version.svec", E::kBadFile, {"unsupported .svec version 7 (this build reads 1 and 2)"}},
+      {"wrong-version.svec", E::kBadFile, {"unsupported .svec version 7 (this build reads 1, 2 and 3)"}},
       {"unknown-flags.svec", E::kBadFile, {"unsupported .svec flags 1"}},
       {"truncated-header.svec",
        E::kBadFile,

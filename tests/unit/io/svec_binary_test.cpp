@@ -75,7 +75,7 @@ TEST(SvecBinaryErrors, WrongMagicVersionAndFlags) {
   expect_binary_error(std::vector<uint8_t>(text.begin(), text.end()), ErrorCode::kBadFile,
                       {"wrong magic bytes (7b 22"});
   expect_binary_error(svec_file(square_payload().b, 7), ErrorCode::kBadFile,
-                      {"unsupported .svec version 7 (this build reads 1 and 2)"});
+                      {"unsupported .svec version 7 (this build reads 1, 2 and 3)"});
   expect_binary_error(svec_file(square_payload().b, 1, 4), ErrorCode::kBadFile,
                       {"unsupported .svec flags 4"});
 }

@@ -1,7 +1,8 @@
-// The compact `.svec` (version 2): the structure survives (matched vertex by vertex at fine
-// grids), a second write is byte-identical, the default grids keep the picture and meet the size
-// budget on a photograph, the documented worked example, and corrupt or cut files are reported,
-// never crash.
+// The compact `.svec` (versions 2 and 3: the same content as varints under zstd, or range-coded):
+// the structure survives (matched vertex by vertex at fine grids), a second write is
+// byte-identical, both versions read back alike, the default grids keep the picture and meet the
+// size budget on a photograph, the documented worked examples, and corrupt or cut files are
+// reported, never crash.
 #include <gtest/gtest.h>
 #include <zstd.h>
 
@@ -113,11 +114,15 @@ void expect_same_up_to_order(const ControlMesh& a, const ControlMesh& b, double 
   }
 }
 
+constexpr int kCompactVersions[] = {2, 3};
+
 TEST(SvecCompact, StructureSurvivesAtFineGrids) {
-  const SvecWriteOptions fine{.position_bits = 12, .color_bits = 12};
+  for (const int version : kCompactVersions)
   for (const VectorImage& image : images_to_test()) {
+    SCOPED_TRACE("version " + std::to_string(version));
+    const SvecWriteOptions fine{.compact_version = version, .position_bits = 12, .color_bits = 12};
     const std::vector<uint8_t> bytes = to_svec_binary(image, fine);
-    EXPECT_EQ(version_of(bytes), 2u);
+    EXPECT_EQ(version_of(bytes), uint32_t(version));
     const VectorImage back = parse_svec_binary(bytes);
     ASSERT_EQ(back.levels.size(), image.levels.size());
     for (size_t l = 0; l < image.levels.size(); ++l) {
@@ -136,7 +141,9 @@ TEST(SvecCompact, StructureSurvivesAtFineGrids) {
 TEST(SvecCompact, SecondWriteIsIdenticalAndValuesLieOnTheGrids) {
   for (const SvecWriteOptions& options :
        {SvecWriteOptions{}, SvecWriteOptions{.position_bits = 0, .color_bits = -4},
-        SvecWriteOptions{.position_bits = 7, .color_bits = 3}}) {
+        SvecWriteOptions{.position_bits = 7, .color_bits = 3},
+        SvecWriteOptions{.compact_version = 2},
+        SvecWriteOptions{.compact_version = 2, .position_bits = 7, .color_bits = 3}}) {
     for (const VectorImage& image : images_to_test()) {
       const std::vector<uint8_t> bytes = to_svec_binary(image, options);
       const VectorImage back = parse_svec_binary(bytes);
@@ -154,6 +161,41 @@ TEST(SvecCompact, SecondWriteIsIdenticalAndValuesLieOnTheGrids) {
   }
 }
 
+// Version 3 codes exactly version 2's content: either file reads back as the same image, and
+// each writes the other's bytes.
+TEST(SvecCompact, Versions2And3HoldTheSameImage) {
+  for (const SvecWriteOptions& options :
+       {SvecWriteOptions{}, SvecWriteOptions{.position_bits = 0, .color_bits = -4},
+        SvecWriteOptions{.position_bits = 12, .color_bits = 12}}) {
+    for (const VectorImage& image : images_to_test()) {
+      SvecWriteOptions v2 = options;
+      v2.compact_version = 2;
+      const std::vector<uint8_t> a = to_svec_binary(image, v2), b = to_svec_binary(image, options);
+      EXPECT_EQ(version_of(b), 3u);
+      const VectorImage from_a = parse_svec_binary(a), from_b = parse_svec_binary(b);
+      expect_same(from_a, from_b);
+      EXPECT_EQ(to_svec_binary(from_b, v2), a);
+      EXPECT_EQ(to_svec_binary(from_a, options), b);
+    }
+  }
+  expect_error([] { (void)to_svec_binary(square_image(), {.compact_version = 4}); },
+               ErrorCode::kInvalidArgument, {"compact .svec version 4"});
+}
+
+// Range coding makes the file smaller than version 2's varints and zstd (about 10 % on the
+// photographs; docs/format.md).
+TEST(SvecCompact, Version3IsSmaller) {
+  test::SyntheticOptions synthetic;
+  synthetic.width = 200;
+  synthetic.height = 150;
+  synthetic.vertices = 2000;
+  const VectorImage image = test::make_synthetic_image(synthetic);
+  const size_t v2 = to_svec_binary(image, {.compact_version = 2}).size();
+  const size_t v3 = to_svec_binary(image).size();
+  RecordProperty("v3_over_v2", std::to_string(double(v3) / double(v2)));
+  EXPECT_LT(double(v3), 0.97 * double(v2));
+}
+
 TEST(SvecCompact, LosslessStillWritesVersion1) {
   const std::vector<uint8_t> bytes = to_svec_binary(rich_image(), {.lossless = true});
   EXPECT_EQ(version_of(bytes), 1u);
@@ -169,7 +211,7 @@ TEST(SvecCompact, CoarseGridsThatWouldFoldTheMeshAreRepairedOrRefined) {
   m.triangles = {{0, 1, 5}, {1, 2, 5}, {2, 4, 5}, {2, 3, 4}, {3, 0, 4}, {0, 5, 4}};
   m.triangle_colors = m.triangles;
   const std::vector<uint8_t> bytes = to_svec_binary(image, {.position_bits = 0});
-  EXPECT_EQ(version_of(bytes), 2u);
+  EXPECT_EQ(version_of(bytes), 3u);
   const VectorImage back = parse_svec_binary(bytes);  // valid
   EXPECT_EQ(back.levels[0].num_triangles(), 6);
 }
@@ -213,12 +255,13 @@ TEST(SvecCompact, SharedPhotographWithinBudget) {
   EXPECT_LE(std::abs(after - before), 0.05);
 }
 
-// docs/format.md lays out the compact payload of its 4 x 4 worked example byte by byte.
-TEST(SvecCompact, WorkedExampleMatchesTheDocs) {
+// The bytes of a ```text BLOCK``` block of docs/format.md (hex, '#' starts a comment).
+std::vector<uint8_t> documented_bytes(const std::string& block) {
   const std::string doc = read_text(source_dir() / "docs" / "format.md");
-  const std::string open = "```text svec-compact-example\n";
+  const std::string open = "```text " + block + "\n";
   const size_t begin = doc.find(open);
-  ASSERT_NE(begin, std::string::npos) << "docs/format.md has no compact example block";
+  EXPECT_NE(begin, std::string::npos) << "docs/format.md has no " << block << " block";
+  if (begin == std::string::npos) return {};
   const size_t end = doc.find("```", begin + open.size());
   std::vector<uint8_t> documented;
   std::istringstream in(doc.substr(begin + open.size(), end - begin - open.size()));
@@ -229,37 +272,57 @@ TEST(SvecCompact, WorkedExampleMatchesTheDocs) {
     std::string hex;
     while (words >> hex) documented.push_back(static_cast<uint8_t>(std::stoi(hex, nullptr, 16)));
   }
-  const std::vector<uint8_t> bytes = to_svec_binary(square_image());
+  return documented;
+}
+
+// docs/format.md lays out the compact payloads of its 4 x 4 worked example byte by byte.
+TEST(SvecCompact, WorkedExampleMatchesTheDocs) {
+  const std::vector<uint8_t> documented = documented_bytes("svec-compact-example");
+  const std::vector<uint8_t> bytes = to_svec_binary(square_image(), {.compact_version = 2});
   EXPECT_EQ(payload_of(bytes), documented);
   // And the hand-made file of that payload reads as the documented image.
   const VectorImage back = parse_svec_binary(svec_file(documented, 2));
   expect_same_up_to_order(square_image().levels[0], back.levels[0], 0, 1);
 }
 
+TEST(SvecCompact, WorkedExampleVersion3MatchesTheDocs) {
+  const std::vector<uint8_t> documented = documented_bytes("svec-coded-example");
+  EXPECT_EQ(payload_of(to_svec_binary(square_image())), documented);
+  const VectorImage back = parse_svec_binary(svec_file(documented, 3));
+  expect_same_up_to_order(square_image().levels[0], back.levels[0], 0, 1);
+  expect_same(back, parse_svec_binary(svec_file(documented_bytes("svec-compact-example"), 2)));
+}
+
 // ---- bad inputs --------------------------------------------------------------------------------
 
 TEST(SvecCompactErrors, EveryTruncationIsReported) {
-  const std::vector<uint8_t> bytes = to_svec_binary(rich_image());
-  const std::vector<uint8_t> payload = payload_of(bytes);
-  for (size_t n = 0; n < payload.size(); ++n) {
-    SCOPED_TRACE("first " + std::to_string(n) + " payload bytes");
-    const std::vector<uint8_t> cut(payload.begin(), payload.begin() + long(n));
-    expect_error([&] { (void)parse_svec_binary(svec_file(cut, 2)); }, ErrorCode::kBadFile, {""});
+  for (const int version : kCompactVersions) {
+    const std::vector<uint8_t> bytes = to_svec_binary(rich_image(), {.compact_version = version});
+    const std::vector<uint8_t> payload = payload_of(bytes);
+    for (size_t n = 0; n < payload.size(); ++n) {
+      SCOPED_TRACE("version " + std::to_string(version) + ", first " + std::to_string(n) +
+                   " payload bytes");
+      const std::vector<uint8_t> cut(payload.begin(), payload.begin() + long(n));
+      expect_error([&] { (void)parse_svec_binary(svec_file(cut, uint32_t(version))); },
+                   ErrorCode::kBadFile, {""});
+    }
   }
 }
 
 TEST(SvecCompactErrors, CorruptPayloadsThrowNeverCrash) {
   // Every byte of the payload replaced by a few values: the reader either reads a valid image or
   // throws subvec::Error; it never crashes, hangs or throws anything else.
+  for (const int version : kCompactVersions)
   for (const VectorImage& image : {square_image(), rich_image()}) {
-    const std::vector<uint8_t> payload = payload_of(to_svec_binary(image));
+    const std::vector<uint8_t> payload =
+        payload_of(to_svec_binary(image, {.compact_version = version}));
     int rejected = 0;
     for (size_t i = 0; i < payload.size(); ++i) {
       for (const int value : {0, 1, 0x7F, 0x80, 0xFF, payload[i] ^ 1, payload[i] ^ 0x40}) {
         std::vector<uint8_t> bad = payload;
         bad[i] = static_cast<uint8_t>(value);
         try {
-          (void)parse_svec_binary(svec_file(bad, 2));
+          (void)parse_svec_binary(svec_file(bad, uint32_t(version)));
         } catch (const Error& e) {
           EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
           ++rejected;
@@ -271,15 +334,45 @@ TEST(SvecCompactErrors, CorruptPayloadsThrowNeverCrash) {
 }
 
 TEST(SvecCompactErrors, MessagesNameTheSection) {
-  std::vector<uint8_t> payload = payload_of(to_svec_binary(square_image()));
+  const SvecWriteOptions v2{.compact_version = 2};
+  std::vector<uint8_t> payload = payload_of(to_svec_binary(square_image(), v2));
   // Counts at 12: vertex count 5 -> 9 makes the connectivity section the wrong length.
   payload[12] = 9;
   expect_error([&] { (void)parse_svec_binary(svec_file(payload, 2)); }, ErrorCode::kBadFile,
                {"level 0 connectivity", "for 9 vertices"});
-  payload = payload_of(to_svec_binary(square_image()));
+  payload = payload_of(to_svec_binary(square_image(), v2));
   payload[32] = 13;  // position bits
   expect_error([&] { (void)parse_svec_binary(svec_file(payload, 2)); }, ErrorCode::kBadFile,
                {"level 0 precision", "position bits 13"});
+}
+
+TEST(SvecCompactErrors, Version3MessagesNameTheStream) {
+  const std::vector<uint8_t> good = payload_of(to_svec_binary(rich_image()));
+  // The level's stream length at 34 (after 12 bytes of size and level count, 20 of counts, 2 of
+  // grids): one byte shorter cuts the stream, one longer takes a byte of the trailer.
+  uint32_t n = 0;
+  for (int k = 0; k < 4; ++k) n |= uint32_t{good[34 + k]} << (8 * k);
+  auto set_length = [](std::vector<uint8_t>& p, uint32_t length) {
+    for (int k = 0; k < 4; ++k) p[34 + k] = static_cast<uint8_t>(length >> (8 * k));
+  };
+  ASSERT_GT(n, 6u);
+  std::vector<uint8_t> cut = good;
+  cut.erase(cut.begin() + 38 + long(n) - 6, cut.begin() + 38 + long(n));
+  set_length(cut, n - 6);
+  expect_error([&] { (void)parse_svec_binary(svec_file(cut, 3)); }, ErrorCode::kBadFile,
+               {"level 0 stream ", ": the coded data ends early"});
+  // Five more bytes: the decoder reads at most four past the coded ones (the zeros the writer
+  // may drop), so some are left over.
+  std::vector<uint8_t> padded = good;
+  padded.insert(padded.begin() + 38 + long(n), 5, uint8_t{0x5A});
+  set_length(padded, n + 5);
+  expect_error([&] { (void)parse_svec_binary(svec_file(padded, 3)); }, ErrorCode::kBadFile,
+               {"unexpected bytes at the end of level 0 stream"});
+  // A vertex count the stream does not hold.
+  std::vector<uint8_t> counts = good;
+  counts[12] = static_cast<uint8_t>(counts[12] + 1);
+  expect_error([&] { (void)parse_svec_binary(svec_file(counts, 3)); }, ErrorCode::kBadFile,
+               {"level 0 "});
 }
 
 }  // namespace
