@@ -48,6 +48,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -562,6 +563,11 @@ class RangeSink final : public SymbolSink {
   }
   void feature(int64_t id_delta, double saliency, uint64_t n_minus_2) override {
     put_signed(e_, m_.id, id_delta);
+    // The compact form keeps a saliency in single precision (docs/format.md, "Choosing the
+    // grids"): it only orders features, and the 29 low bits of a double are noise that cost
+    // about 4 bytes a feature. Values beyond the float range stay as they are.
+    if (std::isfinite(saliency) && std::abs(saliency) <= double(std::numeric_limits<float>::max()))
+      saliency = static_cast<double>(static_cast<float>(saliency));
     const bool zero = saliency == 0 && !std::signbit(saliency);
     e_.bit(m_.saliency_nonzero, !zero);
     if (!zero) {
