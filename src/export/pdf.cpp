@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -67,6 +68,27 @@ std::string pdf_string(const std::string& s) {
   return out + ">";
 }
 
+// The same strips, last first (each strip as it was).
+detail::Strips reversed(const detail::Strips& strips) {
+  std::vector<size_t> starts;  // a strip: three corners with flag 0, then one per triangle more
+  for (size_t i = 0; i < strips.flags.size(); ++i) {
+    if (strips.flags[i] == 0) {
+      starts.push_back(i);
+      i += 2;
+    }
+  }
+  detail::Strips out;
+  out.corners.reserve(strips.corners.size());
+  out.flags.reserve(strips.flags.size());
+  for (size_t k = starts.size(); k-- > 0;) {
+    const size_t end = k + 1 < starts.size() ? starts[k + 1] : strips.flags.size();
+    const auto begin = static_cast<std::ptrdiff_t>(starts[k]), stop = static_cast<std::ptrdiff_t>(end);
+    out.corners.insert(out.corners.end(), strips.corners.begin() + begin, strips.corners.begin() + stop);
+    out.flags.insert(out.flags.end(), strips.flags.begin() + begin, strips.flags.begin() + stop);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string to_pdf(const VectorImage& image, const ExportOptions& options, ExportReport* report) {
@@ -77,25 +99,24 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   const double w = image.width, h = image.height, s = options.scale;
 
   // The shading streams.
-  // PdfTarget::kAny: one shading with RGB at the vertices. kPoppler: one parameterized shading
-  // per channel (t = that channel's value, a linear Function onto red, green or blue), which
-  // poppler's Splash interpolates per pixel where it fills an RGB mesh in flat pieces, combined
-  // over black with /BM /Lighten (the maximum of (r,0,0), (0,g,0), (0,0,b) is (r,g,b)) and moved
-  // half an output unit up and left: Splash colors pixel (X, Y) with the shading at the pixel's
-  // corner (X, Y), not at its centre.
+  // PdfTarget::kAny: one shading with RGB at the vertices. kPoppler: parameterized shadings per
+  // channel (t = that channel's value, a linear Function onto red, green or blue), which poppler's
+  // Splash interpolates per pixel where it fills an RGB mesh in flat pieces, combined over black
+  // with /BM /Lighten (the maximum of (r,0,0), (0,g,0), (0,0,b) is (r,g,b)), in two layers (below).
   const bool channels = options.pdf_target == PdfTarget::kPoppler;
   const detail::Strips strips = detail::make_strips(mesh);
   constexpr double kCoordinateMax = double((1 << 24) - 1);
-  auto stream = [&](int channel) {  // -1: all three components
+  // Writes strips of the mesh as a shading's data; channel -1 writes all three components.
+  auto stream = [&](const detail::Strips& part, int channel) {
     std::vector<uint8_t> data;
-    data.reserve(strips.flags.size() * 13);
+    data.reserve(part.flags.size() * (channel < 0 ? 13 : 9));
     auto put = [&](uint64_t v, int bytes) {
       for (int k = bytes - 1; k >= 0; --k) data.push_back(static_cast<uint8_t>(v >> (8 * k)));
     };
-    for (size_t i = 0; i < strips.flags.size(); ++i) {
-      const auto [t, k] = strips.corners[i];
+    for (size_t i = 0; i < part.flags.size(); ++i) {
+      const auto [t, k] = part.corners[i];
       const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
-      put(strips.flags[i], 1);
+      put(part.flags[i], 1);
       put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), 3);
       put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
           3);
@@ -107,20 +128,82 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     }
     return deflate(data);
   };
-  std::vector<std::vector<uint8_t>> shadings;
-  if (channels) {
-    for (int ch = 0; ch < 3; ++ch) shadings.push_back(stream(ch));
-  } else {
-    shadings.push_back(stream(-1));
-  }
+
+  // Objects 1 to 5 are fixed (catalog, pages, page, contents, info); shadings and forms follow.
+  std::vector<std::string> extra;  // bodies of objects 6, 7, ...
+  auto add = [&](std::string body) {
+    extra.push_back(std::move(body));
+    return std::to_string(5 + extra.size()) + " 0 R";
+  };
+  auto stream_object = [](std::string dict, const std::string& data) {
+    return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data + "\nendstream";
+  };
+  const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
+  auto shading = [&](const std::vector<uint8_t>& data, int channel, double offset) {
+    std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24"
+                       " /BitsPerComponent 16 /BitsPerFlag 8 " + decode;
+    if (channel < 0) {
+      dict += " 0 1 0 1 0 1]";
+    } else {
+      // t -> (t + offset) on the channel, clipped to [0, 1] by the Range.
+      std::string c0 = "[", c1 = "[";
+      for (int k = 0; k < 3; ++k) {
+        c0 += std::string(k ? " " : "") + (k == channel ? detail::fixed(offset, 6) : "0");
+        c1 += std::string(k ? " " : "") + (k == channel ? detail::fixed(1 + offset, 6) : "0");
+      }
+      dict += " 0 1] /Function << /FunctionType 2 /Domain [0 1] /Range [0 1 0 1 0 1] /C0 " + c0 +
+              "] /C1 " + c1 + "] /N 1 >>";
+    }
+    return add(stream_object(dict + " /Filter /FlateDecode", std::string(data.begin(), data.end())));
+  };
 
   // The page: image pixels to points, y up.
   std::string content = "q " + detail::fixed(s, 6) + " 0 0 " + detail::fixed(-s, 6) + " 0 " +
-                        detail::fixed(h * s, 6) + " cm\n" +
-                        (channels ? "0 0 0 rg 0 0 " + detail::fixed(w, 6) + " " + detail::fixed(h, 6) +
-                                        " re f\nq /GS0 gs 1 0 0 1 " + detail::fixed(-0.5 / s, 6) + " " +
-                                        detail::fixed(-0.5 / s, 6) + " cm /Sh0 sh /Sh1 sh /Sh2 sh Q\n"
-                                  : "/Sh0 sh\n");
+                        detail::fixed(h * s, 6) + " cm\n";
+  std::string resources;
+  if (!channels) {
+    resources = "/Shading << /Sh0 " + shading(stream(strips, -1), -1, 0) + " >>";
+    content += "/Sh0 sh\n";
+  } else {
+    // Two layers, each the three channel meshes over black in an isolated transparency group (a
+    // form XObject), painted with alpha 1 and then 1/2: the page shows their mean. What poppler's
+    // Splash does with a parameterized mesh (docs/export.md): it rounds the vertices to whole
+    // device pixels, colors pixel (X, Y) with the value at that corner, not at the pixel's centre,
+    // and fills each triangle's boundary pixels too, so that where two triangles meet the later
+    // one wins, whole pixels, and at a tear the side drawn last takes the pixels on it. So:
+    // - both layers are shifted half an output unit up and left (centre sampling), then a quarter
+    //   unit apart along a diagonal, so their roundings differ and average;
+    // - the second layer draws the strips in the reverse order, so that each side of a tear takes
+    //   the pixels on it in one layer of the two (a two-sample anti-aliasing of the tears, under
+    //   the tear hints drawn after);
+    // - Splash's 50 % blend floors the mean of the two layers, so the second layer's colors are
+    //   rounded up (half a level added) instead of to the nearest: where the layers agree the page
+    //   gets the exact rounded value, floor((round(x) + ceil(x)) / 2) = round(x).
+    const detail::Strips backward = reversed(strips);
+    auto at = [&](double x, double y) {  // a translation by (x, y) output units
+      return detail::fixed(x / s, 6) + " " + detail::fixed(y / s, 6);
+    };
+    std::string forms;
+    for (int layer = 0; layer < 2; ++layer) {
+      std::string names, paint = "0 0 0 rg -1 -1 " + detail::fixed(w + 2, 6) + " " +
+                                 detail::fixed(h + 2, 6) + " re f /GS0 gs";
+      for (int ch = 0; ch < 3; ++ch) {
+        const std::string name = "/Sh" + std::to_string(ch);
+        const double offset = layer == 0 ? 0 : 0.5 / 255;
+        names += " " + name + " " + shading(stream(layer == 0 ? strips : backward, ch), ch, offset);
+        paint += " " + name + " sh";
+      }
+      const std::string group =
+          "<< /Type /XObject /Subtype /Form /BBox [-1 -1 " + detail::fixed(w + 1, 6) + " " +
+          detail::fixed(h + 1, 6) + "] /Group << /S /Transparency /I true /CS /DeviceRGB >>" +
+          " /Resources << /Shading <<" + names + " >> /ExtGState << /GS0 << /BM /Lighten >> >> >>";
+      forms += " /Fm" + std::to_string(layer) + " " + add(stream_object(group, paint));
+      content += "q /GA" + std::to_string(layer) + " gs 1 0 0 1 " +
+                 (layer == 0 ? at(-0.75, -0.25) : at(-0.25, -0.75)) + " cm /Fm" +
+                 std::to_string(layer) + " Do Q\n";
+    }
+    resources = "/XObject <<" + forms + " >> /ExtGState << /GA0 << /ca 1 >> /GA1 << /ca 0.5 >> >>";
+  }
   if (options.tear_hints) {
     for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
       for (const double c : band.color)
@@ -160,33 +243,11 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   object("<< /Type /Catalog /Pages 2 0 R >>");
   object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
   object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
-         detail::fixed(h * s, 6) +
-         "] /Contents 4 0 R /Resources << /Shading << /Sh0 5 0 R" +
-         (channels ? " /Sh1 7 0 R /Sh2 8 0 R >> /ExtGState << /GS0 << /BM /Lighten >> >> >> >>"
-                   : " >> >> >>"));
+         detail::fixed(h * s, 6) + "] /Contents 4 0 R /Resources << " + resources + " >> >>");
   const std::vector<uint8_t> packed = deflate(std::vector<uint8_t>(content.begin(), content.end()));
-  object("<< /Filter /FlateDecode /Length " + std::to_string(packed.size()) + " >>\nstream\n" +
-         std::string(packed.begin(), packed.end()) + "\nendstream");
-  auto shading_object = [&](int channel) {
-    const std::vector<uint8_t>& data = shadings[channel < 0 ? 0 : channel];
-    std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24 /BitsPerComponent 16"
-                       " /BitsPerFlag 8 /Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
-    if (channel < 0) {
-      dict += " 0 1 0 1 0 1]";
-    } else {
-      const char* c1[3] = {"[1 0 0]", "[0 1 0]", "[0 0 1]"};
-      dict += std::string(" 0 1] /Function << /FunctionType 2 /Domain [0 1] /C0 [0 0 0] /C1 ") +
-              c1[channel] + " /N 1 >>";
-    }
-    object(dict + " /Filter /FlateDecode /Length " + std::to_string(data.size()) + " >>\nstream\n" +
-           std::string(data.begin(), data.end()) + "\nendstream");
-  };
-  shading_object(channels ? 0 : -1);
+  object(stream_object("<< /Filter /FlateDecode", std::string(packed.begin(), packed.end())));
   object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
-  if (channels) {
-    shading_object(1);
-    shading_object(2);
-  }
+  for (const std::string& body : extra) object(body);
   const size_t xref = pdf.size();
   pdf += "xref\n0 " + std::to_string(offsets.size() + 1) + "\n0000000000 65535 f \n";
   for (const size_t o : offsets) {
@@ -195,7 +256,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     pdf += line;
   }
   pdf += "trailer\n<< /Size " + std::to_string(offsets.size() + 1) +
-         " /Root 1 0 R /Info 6 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
+         " /Root 1 0 R /Info 5 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
   return pdf;
 }
 

@@ -34,12 +34,11 @@ namespace fs = std::filesystem;
 
 // PDF viewers against the renderer, MAE on the 0-255 scale (docs/export.md explains the gaps):
 // the default PDF in pdftoppm, pdftocairo and mutool; the --pdf-target poppler PDF in pdftoppm
-// (issue 6: 0.75), and its median over the shared photographs (measured 0.82: the issue's 0.75 is
-// not met on them yet).
+// (issue 6: 0.75), on the examples and as the median over the shared photographs (measured 0.71).
 constexpr double kPdfMae = 0.9;
 constexpr double kOtherPdfViewerMae = 1.0;
 constexpr double kPopplerTargetMae = 0.75;
-constexpr double kPopplerTargetPhotoMedianMae = 0.9;
+constexpr double kPopplerTargetPhotoMedianMae = 0.75;
 
 VectorImage example(const std::string& name) {
   return read_svec(fs::path(SUBVEC_SOURCE_DIR) / "examples" / (name + ".svec.json"));
@@ -199,15 +198,20 @@ TEST(Export, PdfIsWellFormed) {
   EXPECT_EQ(to_pdf(image, {.scale = 2}), pdf);  // deterministic
 }
 
-TEST(Export, PopplerTargetPdfHasOneParameterizedShadingPerChannel) {
+// Two layers (transparency groups, the second at alpha 1/2), each one parameterized shading per
+// channel, the second's half a level up (docs/export.md, "Poppler").
+TEST(Export, PopplerTargetPdfHasTwoLayersOfOneParameterizedShadingPerChannel) {
   VectorImage image = example("02-open-tear");
   image.metadata.push_back({"title", "Tear (poppler)"});
   const ExportOptions options{.scale = 2, .pdf_target = PdfTarget::kPoppler};
   const std::string pdf = to_pdf(image, options);
   ASSERT_EQ(pdf.rfind("%PDF-1.4\n", 0), 0u);
-  EXPECT_EQ(count_of(pdf, "/ShadingType 4"), 3u);
-  for (const char* c1 : {"/C1 [1 0 0]", "/C1 [0 1 0]", "/C1 [0 0 1]"})
+  EXPECT_EQ(count_of(pdf, "/ShadingType 4"), 6u);
+  for (const char* c1 : {"/C1 [1 0 0]", "/C1 [0 1 0]", "/C1 [0 0 1]", "/C1 [1.001961 0 0]",
+                         "/C1 [0 1.001961 0]", "/C1 [0 0 1.001961]"})
     EXPECT_EQ(count_of(pdf, c1), 1u) << c1;
+  EXPECT_EQ(count_of(pdf, "/Group << /S /Transparency /I true"), 2u);
+  EXPECT_EQ(count_of(pdf, "/ca 0.5"), 1u);
   EXPECT_NE(pdf.find("/BM /Lighten"), std::string::npos);
   EXPECT_NE(pdf.find("/Title (Tear \\(poppler\\))"), std::string::npos);
   expect_consistent_xref(pdf);
