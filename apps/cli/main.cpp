@@ -603,8 +603,8 @@ int run(int argc, char** argv) {
   render
       ->add_option("--pdf-target", ra.pdf_target,
                    ".pdf: the viewers the shading is built for: any (default; one RGB Gouraud "
-                   "mesh) or poppler (per-channel meshes that pdftoppm interpolates smoothly, "
-                   "offset half a unit elsewhere)")
+                   "mesh) or poppler (per-channel meshes in two layers that pdftoppm interpolates "
+                   "smoothly, about four times larger, offset half a unit elsewhere)")
       ->check(CLI::IsMember({"any", "poppler"}, CLI::ignore_case))
       ->default_str("any");
   render->footer(

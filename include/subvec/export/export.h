@@ -18,9 +18,11 @@ namespace subvec {
 
 // Which PDF viewers the shading is built for (docs/export.md, "PDF"). kAny: one Gouraud mesh with
 // RGB vertex colors, which every viewer interpolates. kPoppler: three parameterized meshes, one per
-// channel, blended with /BM /Lighten and offset half an output unit, which poppler's pdftoppm
-// (Splash) interpolates per pixel and samples at the pixel centre at 1x; the offset shows as a
-// half-unit shift of the mesh in viewers that sample at pixel centres (cairo, MuPDF, Ghostscript).
+// channel, blended with /BM /Lighten, which poppler's pdftoppm (Splash) interpolates per pixel, in
+// two layers averaged by alpha (offset half an output unit, then a quarter apart; the second in
+// reverse order), which give Splash's unsmoothed fill its pixel-centre sampling and a two-sample
+// anti-aliasing of the tears; the offset shows as a half-unit shift of the mesh in viewers that
+// sample at pixel centres (cairo, MuPDF, Ghostscript), and the file is about four times larger.
 enum class PdfTarget { kAny, kPoppler };
 
 struct ExportOptions {
