@@ -39,6 +39,7 @@ namespace {
 
 using test::away_from_features;
 using test::contrast_across;
+using test::fine_laplacian_energy;
 using test::laplacian_energy;
 
 double median_seconds(int runs, const std::function<void()>& f) {
@@ -160,28 +161,34 @@ int run(int argc, char** argv) {
       std::fprintf(stderr, "feature %d: contrast %.2f -> %.2f (%+.1f %%), blur %.2f\n", k.id, c0, c1, 100 * (c1 / c0 - 1), cb);
   }
   // The high-frequency energy over eta (colors): should fall as eta decreases below 1, rise above.
-  std::string sweep_json;
-  bool monotone = true;
-  double last = -1;
+  // Also measured to 1/16 of a color level (fine_laplacian_energy), without the 8-bit rounding.
+  std::string sweep_json, fine_json;
+  bool monotone = true, fine_monotone = true;
+  double last = -1, fine_last = -1;
   for (const double eta : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.25, 1.5, 2.0}) {
     FilterOptions o;
     o.color_eta = {eta};
-    const double e = laplacian_energy(render_level(filter(image, o), 0), mask);
+    const VectorImage filtered = filter(image, o);
+    const double e = laplacian_energy(render_level(filtered, 0), mask);
+    const double fine = fine_laplacian_energy(filtered, mask);
     if (e <= last) monotone = false;
-    last = e;
+    if (fine <= fine_last) fine_monotone = false;
+    last = e, fine_last = fine;
     char buf[64];
     std::snprintf(buf, sizeof buf, "%s%.2f", sweep_json.empty() ? "" : ", ", e);
     sweep_json += buf;
+    std::snprintf(buf, sizeof buf, "%s%.3f", fine_json.empty() ? "" : ", ", fine);
+    fine_json += buf;
   }
   std::printf(
       "{\"vectorize_s\": %.3f, \"levels_s\": %.3f, \"added\": %.3f, \"filter_s\": %.3f, \"levels\": [%s], "
       "\"contrast\": {\"features\": %zu, \"eta_mean\": %.4f, \"eta_worst\": %.4f, \"blur_sigma\": %.3f, "
       "\"blur_mean\": %.4f, \"blur_worst\": %.4f, \"laplacian_before\": %.2f, \"laplacian_after\": %.2f, "
       "\"min_contrast\": %.2f, \"worst_levels\": %.2f, \"over_5pct\": %d, \"over_5pct_and_1_level\": %d}, "
-      "\"sweep\": {\"monotone\": %s, \"energy\": [%s]}}\n",
+      "\"sweep\": {\"monotone\": %s, \"energy\": [%s], \"fine_monotone\": %s, \"fine_energy\": [%s]}}\n",
       vectorize_s, levels_s, levels_s / vectorize_s, filter_s, levels_json.c_str(), kept.size(), eta_mean, eta_worst,
       sigma, blur_mean, blur_worst, laplacian_energy(before, mask), target, min_contrast, worst_levels, over, over_floor,
-      monotone ? "true" : "false", sweep_json.c_str());
+      monotone ? "true" : "false", sweep_json.c_str(), fine_monotone ? "true" : "false", fine_json.c_str());
 
   if (!figures.empty()) {
     const int w = 256;

@@ -9,6 +9,8 @@
 
 #include "pyramid/coarsen_p.h"
 #include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/subdiv/subdivision.h"
 
 namespace subvec {
 namespace {
@@ -44,6 +46,7 @@ struct Band {
   std::vector<Kind> kinds;                             // of every fine vertex
   std::vector<double> keep;                            // per fine vertex, see feature_keep
   std::vector<double> color_keep;                      // per fine color: its vertex's keep
+  std::vector<double> merged_keep;                     // per merged color: the largest keep of its colors
   std::vector<uint8_t> sides;                          // image sides of every fine vertex
 };
 
@@ -120,15 +123,17 @@ Rgb predict_color(const CollapseRecord::Wedge& w, Vec2 at, const std::vector<Vec
 Rgb rgb(Color c) { return {c.r, c.g, c.b}; }
 
 // The edge profile of a kept feature: how much of its color detail each fine vertex keeps whatever
-// eta. All of it on the band's kept features and their one-ring, a quarter on the second ring, none
-// beyond. The rendered color within about a triangle of a feature is made of these vertices'
-// control colors (a limit point depends on the control values within two rings, the second with a
-// small weight): their details are the profile of the edge, not texture to take away.
-// Smoothing them separately on each side (their predictions do not cross the tear) changed the
-// rendered contrast 1.5 px out by up to 68 % on the shared photographs at eta = 0.3; keeping the
-// one-ring left one feature (squirrel) at 5.7 %, the taper on the second ring brings every feature
-// within 5 % (docs/levels.md, "Edge profiles").
-constexpr double kProfileKeep[] = {1.0, 1.0, 0.25};  // by ring: the feature, its one-ring, the next
+// eta. All of it on the band's kept features and their one-ring, then a taper: a half on the second
+// ring, a fifth on the third, none beyond. The rendered color within about a triangle of a feature
+// is made of these vertices' control colors (a limit point depends on the control values within two
+// rings, the second with a small weight): their details are the profile of the edge, not texture
+// to take away. Smoothing them separately on each side (their predictions do not cross the tear)
+// changed the rendered contrast 1.5 px out by up to 68 % on the shared photographs at eta = 0.3;
+// keeping the one-ring left one feature (squirrel) at 5.7 %, a taper beyond it brings every
+// feature within 5 %. The taper is gradual because a step from kept to smoothed detail at small
+// eta is itself a ripple: with a quarter on the second ring and nothing beyond, squirrel's
+// high-frequency energy was lower at eta = 0.3 than at 0 (docs/levels.md, "Edge profiles").
+constexpr double kProfileKeep[] = {1.0, 1.0, 2.0 / 3, 1.0 / 3};  // by ring: the feature, its one-ring, ...
 
 std::vector<double> feature_keep(const ControlMesh& fine, const std::vector<int32_t>& kept_ids) {
   constexpr int kRings = static_cast<int>(std::size(kProfileKeep)) - 1;
@@ -181,6 +186,9 @@ Band analyze(const ControlMesh& fine, const ControlMesh& coarse, int width, int 
     for (int k = 0; k < 3; ++k) b.color_keep[fine.triangle_colors[f][k]] = b.keep[fine.triangles[f][k]];
   const std::vector<Rgb> merged = c.merged_colors();
   b.merged_values = merged;
+  b.merged_keep.assign(merged.size(), 0);
+  for (size_t k = 0; k < fine.colors.size(); ++k)
+    if (b.merged_of[k] >= 0) b.merged_keep[b.merged_of[k]] = std::max(b.merged_keep[b.merged_of[k]], b.color_keep[k]);
   b.merge_detail.resize(fine.colors.size());
   for (size_t k = 0; k < fine.colors.size(); ++k) {
     const Rgb f = rgb(fine.colors[k]);
@@ -284,6 +292,25 @@ Band analyze(const ControlMesh& fine, const ControlMesh& coarse, int width, int 
   return b;
 }
 
+// Per color value of `mesh`: its limit value minus its control value (the limit surface's color
+// at the vertex, on that side of a tear).
+std::vector<Rgb> coarse_limit_shift(const ControlMesh& mesh, int width, int height) {
+  const MeshTopology topology = MeshTopology::build(mesh, width, height);
+  const Subdivision at_vertices(mesh, topology, 0);
+  std::vector<float> limit(3 * static_cast<size_t>(at_vertices.num_colors()));
+  at_vertices.evaluate_colors(mesh.colors, limit, 1);
+  const RefinedMesh& out = at_vertices.topology();
+  std::vector<Rgb> shift(mesh.colors.size(), Rgb{0, 0, 0});
+  for (int32_t f = 0; f < mesh.num_triangles(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int32_t c = mesh.triangle_colors[f][k], l = out.triangle_colors[f][k];
+      const Rgb q = rgb(mesh.colors[c]);
+      for (int i = 0; i < 3; ++i) shift[c][i] = double(limit[3 * l + i]) - q[i];
+    }
+  }
+  return shift;
+}
+
 double eta_at(const std::vector<double>& etas, int band) {
   if (etas.empty()) return 1;
   return etas[std::min<size_t>(band - 1, etas.size() - 1)];
@@ -305,11 +332,20 @@ void reconstruct(const Band& b, const ControlMesh& coarse, double eta_g, double 
     pos[b.parents[i]] = {coarse.positions[i].x + b.survivor_detail[i].x,
                          coarse.positions[i].y + b.survivor_detail[i].y};
   }
+  // A kept vertex's color at eta = 0 is the coarse surface's limit value there, not its control
+  // value: the fine mesh then re-expresses the coarse surface (its limit follows its control values
+  // more closely than the coarse mesh's does, so coarse control values under it would overshoot),
+  // and the removed vertices' predictions interpolate that smooth surface. Between, the kept
+  // vertex's own detail (its fine value minus that limit) is scaled like everyone's; at eta = 1 it
+  // is its fine value exactly. Kept features' edge profiles keep their detail (`keep`).
+  const std::vector<Rgb> limit_shift = coarse_limit_shift(coarse, width, height);
   for (size_t k = 0; k < coarse.colors.size(); ++k) {
     const int32_t m = b.coarse_color_merged[k];
     if (m < 0 || b.merged_coarse[m] != static_cast<int32_t>(k)) continue;
     const Rgb q = rgb(coarse.colors[k]);
-    for (int i = 0; i < 3; ++i) merged[m][i] = q[i] + b.refit_detail[k][i];
+    const double ek = eta_c + (1 - eta_c) * b.merged_keep[m];
+    for (int i = 0; i < 3; ++i)
+      merged[m][i] = q[i] + limit_shift[k][i] + ek * (b.refit_detail[k][i] - limit_shift[k][i]);
   }
   for (size_t i = b.records.size(); i-- > 0;) {
     const CollapseRecord& r = b.records[i];

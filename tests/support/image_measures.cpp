@@ -6,6 +6,7 @@
 
 #include "mesh/polyline_p.h"
 #include "subvec/mesh/curves.h"
+#include "subvec/render/renderer.h"
 
 namespace subvec::test {
 
@@ -41,6 +42,40 @@ double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
     }
   }
   return sum / std::max(n, 1);
+}
+
+double fine_laplacian_energy(const VectorImage& image, const std::vector<uint8_t>& mask) {
+  constexpr int kRenders = 16;
+  const int w = image.width, h = image.height;
+  std::vector<double> sum(size_t(w) * h * 3, 0);
+  Renderer renderer(image);  // refines once; each offset only re-evaluates the colors
+  std::vector<Color> shifted(image.levels[0].colors.size());
+  Image8 img;
+  for (int j = 0; j < kRenders; ++j) {
+    const float offset = static_cast<float>((j + 0.5) / kRenders - 0.5);
+    for (size_t k = 0; k < shifted.size(); ++k) {
+      const Color c = image.levels[0].colors[k];
+      shifted[k] = {c.r + offset, c.g + offset, c.b + offset};
+    }
+    renderer.set_colors(0, shifted);
+    renderer.render({}, img);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < 3 * w; ++x) sum[size_t(y) * w * 3 + x] += img.row(y)[x];
+  }
+  double total = 0;
+  int n = 0;
+  for (int y = 1; y + 1 < h; ++y) {
+    for (int x = 1; x + 1 < w; ++x) {
+      if (!mask[size_t(y) * w + x]) continue;
+      for (int k = 0; k < 3; ++k) {
+        auto at = [&](int xx, int yy) { return sum[(size_t(yy) * w + xx) * 3 + k] / kRenders; };
+        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
+        total += l * l;
+      }
+      ++n;
+    }
+  }
+  return total / std::max(n, 1);
 }
 
 double contrast_across(const Image8& img, const ControlMesh& mesh, const Feature& f, double offset) {
