@@ -123,8 +123,8 @@ Rgb predict_color(const CollapseRecord::Wedge& w, Vec2 at, const std::vector<Vec
 Rgb rgb(Color c) { return {c.r, c.g, c.b}; }
 
 // The edge profile of a kept feature: how much of its color detail each fine vertex keeps whatever
-// eta. All of it on the band's kept features and their one-ring, then a taper: a half on the second
-// ring, a fifth on the third, none beyond. The rendered color within about a triangle of a feature
+// eta. All of it on the band's kept features and their one-ring, then a taper: two thirds on the
+// second ring, a third on the third, none beyond. The rendered color within about a triangle of a feature
 // is made of these vertices' control colors (a limit point depends on the control values within two
 // rings, the second with a small weight): their details are the profile of the edge, not texture
 // to take away. Smoothing them separately on each side (their predictions do not cross the tear)
@@ -132,7 +132,8 @@ Rgb rgb(Color c) { return {c.r, c.g, c.b}; }
 // keeping the one-ring left one feature (squirrel) at 5.7 %, a taper beyond it brings every
 // feature within 5 %. The taper is gradual because a step from kept to smoothed detail at small
 // eta is itself a ripple: with a quarter on the second ring and nothing beyond, squirrel's
-// high-frequency energy was lower at eta = 0.3 than at 0 (docs/levels.md, "Edge profiles").
+// high-frequency energy was lower at eta = 0.3 than at 0; with a half and a fifth it rose from 0
+// by 0.003 % (docs/levels.md, "Edge profiles").
 constexpr double kProfileKeep[] = {1.0, 1.0, 2.0 / 3, 1.0 / 3};  // by ring: the feature, its one-ring, ...
 
 std::vector<double> feature_keep(const ControlMesh& fine, const std::vector<int32_t>& kept_ids) {
