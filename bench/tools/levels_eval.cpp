@@ -185,10 +185,12 @@ int run(int argc, char** argv) {
       "\"contrast\": {\"features\": %zu, \"eta_mean\": %.4f, \"eta_worst\": %.4f, \"blur_sigma\": %.3f, "
       "\"blur_mean\": %.4f, \"blur_worst\": %.4f, \"laplacian_before\": %.2f, \"laplacian_after\": %.2f, "
       "\"min_contrast\": %.2f, \"worst_levels\": %.2f, \"over_5pct\": %d, \"over_5pct_and_1_level\": %d}, "
-      "\"sweep\": {\"monotone\": %s, \"energy\": [%s], \"fine_monotone\": %s, \"fine_energy\": [%s]}}\n",
+      "\"sweep\": {\"monotone\": %s, \"energy\": [%s], \"fine_monotone\": %s, "
+      "\"fine_energy\": [%s]}}\n",
       vectorize_s, levels_s, levels_s / vectorize_s, filter_s, levels_json.c_str(), kept.size(), eta_mean, eta_worst,
       sigma, blur_mean, blur_worst, laplacian_energy(before, mask), target, min_contrast, worst_levels, over, over_floor,
-      monotone ? "true" : "false", sweep_json.c_str(), fine_monotone ? "true" : "false", fine_json.c_str());
+      monotone ? "true" : "false", sweep_json.c_str(), fine_monotone ? "true" : "false",
+      fine_json.c_str());
 
   if (!figures.empty()) {
     const int w = 256;

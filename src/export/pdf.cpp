@@ -82,9 +82,9 @@ detail::Strips reversed(const detail::Strips& strips) {
   out.flags.reserve(strips.flags.size());
   for (size_t k = starts.size(); k-- > 0;) {
     const size_t end = k + 1 < starts.size() ? starts[k + 1] : strips.flags.size();
-    const auto begin = static_cast<std::ptrdiff_t>(starts[k]), stop = static_cast<std::ptrdiff_t>(end);
-    out.corners.insert(out.corners.end(), strips.corners.begin() + begin, strips.corners.begin() + stop);
-    out.flags.insert(out.flags.end(), strips.flags.begin() + begin, strips.flags.begin() + stop);
+    const auto from = static_cast<std::ptrdiff_t>(starts[k]), to = static_cast<std::ptrdiff_t>(end);
+    out.corners.insert(out.corners.end(), strips.corners.begin() + from, strips.corners.begin() + to);
+    out.flags.insert(out.flags.end(), strips.flags.begin() + from, strips.flags.begin() + to);
   }
   return out;
 }
@@ -136,7 +136,8 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     return std::to_string(5 + extra.size()) + " 0 R";
   };
   auto stream_object = [](std::string dict, const std::string& data) {
-    return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data + "\nendstream";
+    return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data +
+           "\nendstream";
   };
   const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
   auto shading = [&](const std::vector<uint8_t>& data, int channel, double offset) {
@@ -154,7 +155,8 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       dict += " 0 1] /Function << /FunctionType 2 /Domain [0 1] /Range [0 1 0 1 0 1] /C0 " + c0 +
               "] /C1 " + c1 + "] /N 1 >>";
     }
-    return add(stream_object(dict + " /Filter /FlateDecode", std::string(data.begin(), data.end())));
+    const std::string bytes(data.begin(), data.end());
+    return add(stream_object(dict + " /Filter /FlateDecode", bytes));
   };
 
   // The page: image pixels to points, y up.

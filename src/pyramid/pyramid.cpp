@@ -46,7 +46,7 @@ struct Band {
   std::vector<Kind> kinds;                             // of every fine vertex
   std::vector<double> keep;                            // per fine vertex, see feature_keep
   std::vector<double> color_keep;                      // per fine color: its vertex's keep
-  std::vector<double> merged_keep;                     // per merged color: the largest keep of its colors
+  std::vector<double> merged_keep;                     // per merged color: its colors' largest keep
   std::vector<uint8_t> sides;                          // image sides of every fine vertex
 };
 
@@ -124,17 +124,17 @@ Rgb rgb(Color c) { return {c.r, c.g, c.b}; }
 
 // The edge profile of a kept feature: how much of its color detail each fine vertex keeps whatever
 // eta. All of it on the band's kept features and their one-ring, then a taper: two thirds on the
-// second ring, a third on the third, none beyond. The rendered color within about a triangle of a feature
-// is made of these vertices' control colors (a limit point depends on the control values within two
-// rings, the second with a small weight): their details are the profile of the edge, not texture
-// to take away. Smoothing them separately on each side (their predictions do not cross the tear)
+// second ring, a third on the third, none beyond. The rendered color within about a triangle of a
+// feature is made of these vertices' control colors (a limit point depends on the control values
+// within two rings, the second with a small weight): their details are the profile of the edge,
+// not texture to take away. Smoothing them separately on each side (their predictions do not cross the tear)
 // changed the rendered contrast 1.5 px out by up to 68 % on the shared photographs at eta = 0.3;
 // keeping the one-ring left one feature (squirrel) at 5.7 %, a taper beyond it brings every
 // feature within 5 %. The taper is gradual because a step from kept to smoothed detail at small
 // eta is itself a ripple: with a quarter on the second ring and nothing beyond, squirrel's
 // high-frequency energy was lower at eta = 0.3 than at 0; with a half and a fifth it rose from 0
 // by 0.003 % (docs/levels.md, "Edge profiles").
-constexpr double kProfileKeep[] = {1.0, 1.0, 2.0 / 3, 1.0 / 3};  // by ring: the feature, its one-ring, ...
+constexpr double kProfileKeep[] = {1.0, 1.0, 2.0 / 3, 1.0 / 3};  // by ring from the feature out
 
 std::vector<double> feature_keep(const ControlMesh& fine, const std::vector<int32_t>& kept_ids) {
   constexpr int kRings = static_cast<int>(std::size(kProfileKeep)) - 1;
@@ -188,8 +188,10 @@ Band analyze(const ControlMesh& fine, const ControlMesh& coarse, int width, int 
   const std::vector<Rgb> merged = c.merged_colors();
   b.merged_values = merged;
   b.merged_keep.assign(merged.size(), 0);
-  for (size_t k = 0; k < fine.colors.size(); ++k)
-    if (b.merged_of[k] >= 0) b.merged_keep[b.merged_of[k]] = std::max(b.merged_keep[b.merged_of[k]], b.color_keep[k]);
+  for (size_t k = 0; k < fine.colors.size(); ++k) {
+    const int32_t m = b.merged_of[k];
+    if (m >= 0) b.merged_keep[m] = std::max(b.merged_keep[m], b.color_keep[k]);
+  }
   b.merge_detail.resize(fine.colors.size());
   for (size_t k = 0; k < fine.colors.size(); ++k) {
     const Rgb f = rgb(fine.colors[k]);

@@ -27,21 +27,33 @@ std::vector<uint8_t> away_from_features(const VectorImage& image, double margin)
   return away;
 }
 
-double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
+namespace {
+
+// Mean squared 5-point Laplacian over the interior pixels that `mask` keeps, channels summed;
+// `at(x, y, channel)` gives a pixel's value.
+template <class At>
+double masked_laplacian_energy(int width, int height, const std::vector<uint8_t>& mask, At at) {
   double sum = 0;
   int n = 0;
-  for (int y = 1; y + 1 < img.height; ++y) {
-    for (int x = 1; x + 1 < img.width; ++x) {
-      if (!mask[size_t(y) * img.width + x]) continue;
+  for (int y = 1; y + 1 < height; ++y) {
+    for (int x = 1; x + 1 < width; ++x) {
+      if (!mask[size_t(y) * width + x]) continue;
       for (int k = 0; k < 3; ++k) {
-        auto at = [&](int xx, int yy) { return double(img.row(yy)[3 * xx + k]); };
-        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
+        const double l = at(x - 1, y, k) + at(x + 1, y, k) + at(x, y - 1, k) + at(x, y + 1, k) -
+                         4 * at(x, y, k);
         sum += l * l;
       }
       ++n;
     }
   }
   return sum / std::max(n, 1);
+}
+
+}  // namespace
+
+double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask) {
+  return masked_laplacian_energy(img.width, img.height, mask,
+                                 [&](int x, int y, int k) { return double(img.row(y)[3 * x + k]); });
 }
 
 double fine_laplacian_energy(const VectorImage& image, const std::vector<uint8_t>& mask) {
@@ -62,20 +74,9 @@ double fine_laplacian_energy(const VectorImage& image, const std::vector<uint8_t
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < 3 * w; ++x) sum[size_t(y) * w * 3 + x] += img.row(y)[x];
   }
-  double total = 0;
-  int n = 0;
-  for (int y = 1; y + 1 < h; ++y) {
-    for (int x = 1; x + 1 < w; ++x) {
-      if (!mask[size_t(y) * w + x]) continue;
-      for (int k = 0; k < 3; ++k) {
-        auto at = [&](int xx, int yy) { return sum[(size_t(yy) * w + xx) * 3 + k] / kRenders; };
-        const double l = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
-        total += l * l;
-      }
-      ++n;
-    }
-  }
-  return total / std::max(n, 1);
+  return masked_laplacian_energy(w, h, mask, [&](int x, int y, int k) {
+    return sum[(size_t(y) * w + x) * 3 + k] / kRenders;
+  });
 }
 
 double contrast_across(const Image8& img, const ControlMesh& mesh, const Feature& f, double offset) {

@@ -20,9 +20,10 @@ std::vector<uint8_t> away_from_features(const VectorImage& image, double margin)
 double laplacian_energy(const Image8& img, const std::vector<uint8_t>& mask);
 
 // laplacian_energy() of level 0 of `image` as rendered to about 1/16 of a color level rather than
-// to whole levels: the mean of 16 renders whose control colors are all offset by (j + 1/2) / 16 - 1/2
-// (Loop subdivision reproduces constants, so each render is the same color field shifted). The
-// 8-bit render alone gives a smooth field a floor of rounding noise that hides small differences.
+// to whole levels: the mean of 16 renders whose control colors are all offset by
+// (j + 1/2) / 16 - 1/2 (Loop subdivision reproduces constants, so each render is the same color
+// field shifted). The 8-bit render alone gives a smooth field a floor of rounding noise that hides
+// small differences.
 double fine_laplacian_energy(const VectorImage& image, const std::vector<uint8_t>& mask);
 
 // Mean color difference across feature `f` of `mesh` in `img`: points 1 px apart along its limit

@@ -125,8 +125,9 @@ TEST(Pyramid, EtaOneReproducesEveryLevel) {
 }
 
 // Color filtering (the command's default): the high-frequency energy of the rendered image rises
-// with eta from 0 through 1 to enhancement, measured to 1/16 of a color level (fine_laplacian_energy:
-// the 8-bit render's rounding noise alone is a floor that hides the order of small differences).
+// with eta from 0 through 1 to enhancement, measured to 1/16 of a color level
+// (fine_laplacian_energy: the 8-bit render's rounding noise alone is a floor that hides the order of
+// small differences).
 TEST(Pyramid, HighFrequenciesFollowEta) {
   const VectorImage& image = shapes();
   const auto mask = away_from_features(image, 3.0);
