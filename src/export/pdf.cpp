@@ -20,10 +20,14 @@
 namespace subvec {
 namespace {
 
-std::vector<uint8_t> deflate(const std::vector<uint8_t>& data) {
+// zlib-compressed bytes, as the text of a PDF stream.
+template <class Bytes>
+std::string deflate(const Bytes& data) {
   uLongf size = compressBound(static_cast<uLong>(data.size()));
-  std::vector<uint8_t> out(size);
-  if (compress2(out.data(), &size, data.data(), static_cast<uLong>(data.size()), 9) != Z_OK)
+  std::string out(size, '\0');
+  const auto* in = reinterpret_cast<const Bytef*>(data.data());
+  if (compress2(reinterpret_cast<Bytef*>(out.data()), &size, in, static_cast<uLong>(data.size()), 9) !=
+      Z_OK)
     throw Error(ErrorCode::kIo, "zlib compression failed");
   out.resize(size);
   return out;
@@ -83,7 +87,8 @@ detail::Strips reversed(const detail::Strips& strips) {
   for (size_t k = starts.size(); k-- > 0;) {
     const size_t end = k + 1 < starts.size() ? starts[k + 1] : strips.flags.size();
     const auto from = static_cast<std::ptrdiff_t>(starts[k]), to = static_cast<std::ptrdiff_t>(end);
-    out.corners.insert(out.corners.end(), strips.corners.begin() + from, strips.corners.begin() + to);
+    const auto& c = strips.corners;
+    out.corners.insert(out.corners.end(), c.begin() + from, c.begin() + to);
     out.flags.insert(out.flags.end(), strips.flags.begin() + from, strips.flags.begin() + to);
   }
   return out;
@@ -140,7 +145,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
            "\nendstream";
   };
   const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
-  auto shading = [&](const std::vector<uint8_t>& data, int channel, double offset) {
+  auto shading = [&](const std::string& data, int channel, double offset) {
     std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24"
                        " /BitsPerComponent 16 /BitsPerFlag 8 " + decode;
     if (channel < 0) {
@@ -155,8 +160,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       dict += " 0 1] /Function << /FunctionType 2 /Domain [0 1] /Range [0 1 0 1 0 1] /C0 " + c0 +
               "] /C1 " + c1 + "] /N 1 >>";
     }
-    const std::string bytes(data.begin(), data.end());
-    return add(stream_object(dict + " /Filter /FlateDecode", bytes));
+    return add(stream_object(dict + " /Filter /FlateDecode", data));
   };
 
   // The page: image pixels to points, y up.
@@ -246,8 +250,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
   object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
          detail::fixed(h * s, 6) + "] /Contents 4 0 R /Resources << " + resources + " >> >>");
-  const std::vector<uint8_t> packed = deflate(std::vector<uint8_t>(content.begin(), content.end()));
-  object(stream_object("<< /Filter /FlateDecode", std::string(packed.begin(), packed.end())));
+  object(stream_object("<< /Filter /FlateDecode", deflate(content)));
   object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
   for (const std::string& body : extra) object(body);
   const size_t xref = pdf.size();
