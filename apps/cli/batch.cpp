@@ -308,6 +308,7 @@ void add_batch_command(CLI::App& app) {
   batch->add_option("--threads", ba.vectorize.threads, "Threads per image (default 1; 0: all cores)")
       ->check(CLI::Range(0, 1024));
   add_vertex_count_options(batch, ba.vectorize);
+  add_quality_options(batch, ba.vectorize);
   batch->add_option("--levels", ba.vectorize.levels.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
       ->check(CLI::Range(1, 16));
   batch

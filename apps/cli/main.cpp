@@ -15,6 +15,9 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
@@ -436,6 +439,7 @@ void run_vectorize(const VectorizeArgs& a) {
     j["triangles"] = report.triangles;
     j["features"] = report.features;
     j["tear_vertices"] = report.tear_vertices;
+    j["refine"] = {{"flips", report.refine.flips}, {"moves", report.refine.moves}};
     if (options.segment) {
       const subvec::PixelRect& r = *options.segment;
       j["segment"] = {{"rect", {r.x, r.y, r.width, r.height}},
@@ -472,6 +476,9 @@ void run_vectorize(const VectorizeArgs& a) {
   std::printf("size      %d x %d pixels\n", image.width, image.height);
   std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n",
               report.vertices, report.triangles, report.features, report.tear_vertices);
+  if (options.refine.rounds > 0) {
+    std::printf("refined   %d edge flips, %d vertex moves\n", report.refine.flips, report.refine.moves);
+  }
   if (options.segment) {
     std::string boundary = "is 1 closed feature";
     if (!segment_is_closed) {
@@ -674,21 +681,6 @@ int run(int argc, char** argv) {
                    "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
   vectorize
-      ->add_option("--fit", va.params.fit,
-                   "Color fit: every pixel (default) or the paper's subdivided vertices")
-      ->check(CLI::IsMember({"pixels", "vertices"}))
-      ->default_str("pixels");
-  vectorize
-      ->add_option("--l1-iterations", va.params.l1_iterations,
-                   "Reweighted refits of the pixel fit toward least absolute deviations; 0 is plain "
-                   "least squares (default)")
-      ->check(CLI::Range(0, 20));
-  vectorize
-      ->add_option("--relocate", va.params.relocate,
-                   "Gauss-Newton steps that move the smooth control vertices to lower the pixel "
-                   "error before the final color fit; 0 keeps the simplified positions (default)")
-      ->check(CLI::Range(0, 50));
-  vectorize
       ->add_option("--segment", va.params.segment,
                    "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
                    "becomes a closed tear")
@@ -698,11 +690,7 @@ int run(int argc, char** argv) {
             return subvec_cli::parse_rect(text, r);
           },
           "X,Y,W,H", "rect"));
-  vectorize
-      ->add_option("--grid-step", va.params.grid_step,
-                   "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
-                   "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
-      ->check(CLI::Range(0, 2));
+  subvec_cli::add_quality_options(vectorize, va.params);
   vectorize->add_option("--threads", va.params.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
@@ -762,7 +750,20 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
+// glibc hands freed blocks over 128 KB straight back to the kernel, so every stage's fresh arrays
+// fault their pages in again; on virtual machines where a page fault is dear that was a quarter of
+// a vectorization (docs/vectorize.md, "Speed"). Keep freed memory in the process for reuse: the
+// peak resident size is what it was, it is just not given back before exit.
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  mallopt(M_TOP_PAD, 64 << 20);
+#endif
+}
+
 int main(int argc, char** argv) {
+  keep_freed_memory();
   try {
     return run(argc, argv);
   } catch (const std::bad_alloc&) {

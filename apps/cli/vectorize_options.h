@@ -20,12 +20,19 @@ struct VectorizeParams {
   int grid_step = 0;           // 0: automatic
   int l1_iterations = 0;
   int relocate = 0;            // Gauss-Newton relocation steps (--relocate)
+  int refine = subvec::RefineOptions{}.rounds;  // --refine rounds
+  subvec::FeatureOptions features;  // --edge-*, --min-feature-length, --spur-length, --max-gap
+  double max_feature_error = 1.0;   // --max-feature-error
   int threads = 0;  // 0: all cores; the output does not depend on it
   LevelArgs levels;  // --levels, --saliency-weight, ... (pyramid_commands.h)
 };
 
 // Adds --ratio and --vertices (one or the other) to `command`.
 void add_vertex_count_options(CLI::App* command, VectorizeParams& params);
+
+// Adds the options that shape the result (--fit, --l1-iterations, --relocate, --refine, --grid-step, the
+// feature detector's and --max-feature-error), with the library's defaults and ranges.
+void add_quality_options(CLI::App* command, VectorizeParams& params);
 
 // Parses "X,Y,W,H" (integers); returns an error message, or "" and fills `r`. Whether the
 // rectangle lies inside the image is the library's check, once the image is read.

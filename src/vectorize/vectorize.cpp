@@ -94,6 +94,13 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   r.simplify = simplify(mesh, image.width, image.height, simplify_options);
   lap("simplify");
 
+  // Stage 3b: data-dependent flips and vertex moves.
+  progress("refine", 0.7);
+  RefineOptions refine_options = options.refine;
+  refine_options.threads = options.threads;
+  r.refine = refine_mesh(mesh, image, refine_options);
+  lap("refine");
+
   // Stage 4: colors.
   progress("fit", 0.8);
   ColorFitOptions fit_options = options.fit;

@@ -1,5 +1,6 @@
 // Vectorization of a photograph (paper §4): features -> dense feature-aligned mesh -> constrained
-// QEM simplification with curve refitting -> global least-squares color fit.
+// QEM simplification with curve refitting -> data-dependent refinement -> global least-squares color
+// fit.
 #pragma once
 
 #include <array>
@@ -13,6 +14,7 @@
 #include "subvec/vectorize/features.h"
 #include "subvec/vectorize/fit.h"
 #include "subvec/vectorize/initial_mesh.h"
+#include "subvec/vectorize/refine.h"
 #include "subvec/vectorize/segment.h"
 #include "subvec/vectorize/simplify.h"
 
@@ -28,6 +30,7 @@ struct VectorizeOptions {
   SegmentOptions segment_options;
   InitialMeshOptions initial_mesh;
   double max_feature_error = 1.0;  // pixels (simplification rolls back collapses beyond it)
+  RefineOptions refine;            // data-dependent flips and vertex moves (refine.h)
   ColorFitOptions fit;
   int threads = 0;       // <= 0: all cores; the result does not depend on it
   // Called with a stage name and the fraction of the whole job done (0..1).
@@ -42,8 +45,9 @@ struct StageTime {
 struct VectorizeReport {
   int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;
   double fit_rms = 0;
-  std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, fit
+  std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, refine, fit
   SimplifyStats simplify;
+  RefineStats refine;
   // The detected polyline each output feature follows (same order as the mesh's features).
   std::vector<std::vector<Vec2>> feature_targets;
   // With a segment rectangle: the cleaned GrabCut foreground, and the ids of the mesh features

@@ -1,0 +1,382 @@
+// Data-dependent refinement of the simplified mesh: edge flips and vertex moves (refine.h).
+//
+// Both work on one measure, the squared error of a triangle's linear color interpolation over the
+// pixel centres inside it (a centre on an edge counts in both triangles; every comparison counts
+// it the same way before and after, so the total over all faces falls with every accepted step).
+//
+// A flip pass evaluates every candidate edge against the pass's starting mesh (in parallel: the
+// evaluations only read), then applies the flips in order of gain, skipping any whose triangles an
+// earlier flip of the pass replaced. Vertex moves run one color class of the vertex graph at a
+// time: vertices of one class share no edge, so no move changes another's one-ring, and the class
+// can move in parallel with the same outcome as in any order.
+#include "subvec/vectorize/refine.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <unordered_set>
+
+#include <Eigen/Dense>
+
+#include "core/parallel_p.h"
+#include "mesh/collapse_p.h"
+#include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+
+namespace subvec {
+namespace {
+
+using detail::signed_area;
+
+// Calls fn(x, y, w0, w1, w2) for every pixel centre (x + 0.5, y + 0.5) of the image inside the
+// triangle (p0, p1, p2) of either orientation, with its barycentric weights. Returns false, and
+// visits nothing, when the triangle's area is at most `min_area`. Each row visits only the span
+// the three weights allow (one pixel of slack each side), stepping the weights along the row.
+template <class Fn>
+bool for_each_pixel(Vec2 p0, Vec2 p1, Vec2 p2, const Image8& image, double min_area, const Fn& fn) {
+  const double area = signed_area(p0, p1, p2);
+  if (!(std::abs(area) > min_area)) return false;
+  const double inv = 1 / area;
+  const int x0 = std::max(0, static_cast<int>(std::ceil(std::min({p0.x, p1.x, p2.x}) - 0.5)));
+  const int x1 = std::min(image.width - 1, static_cast<int>(std::floor(std::max({p0.x, p1.x, p2.x}) - 0.5)));
+  const int y0 = std::max(0, static_cast<int>(std::ceil(std::min({p0.y, p1.y, p2.y}) - 0.5)));
+  const int y1 = std::min(image.height - 1, static_cast<int>(std::floor(std::max({p0.y, p1.y, p2.y}) - 0.5)));
+  // d w / d x along a row.
+  const double d0 = 0.5 * (p1.y - p2.y) * inv, d1 = 0.5 * (p2.y - p0.y) * inv, d2 = -d0 - d1;
+  for (int y = y0; y <= y1; ++y) {
+    const Vec2 start{x0 + 0.5, y + 0.5};
+    const double s0 = signed_area(start, p1, p2) * inv, s1 = signed_area(p0, start, p2) * inv, s2 = 1 - s0 - s1;
+    // w_i(x) = s_i + (x - x0) d_i >= 0 for all three.
+    double lo = x0, hi = x1;
+    bool empty = false;
+    for (const auto& [s, d] : {std::pair{s0, d0}, std::pair{s1, d1}, std::pair{s2, d2}}) {
+      if (d > 0) lo = std::max(lo, x0 - s / d - 1);
+      else if (d < 0) hi = std::min(hi, x0 - s / d + 1);
+      else if (s < 0) empty = true;
+    }
+    if (empty || lo > hi) continue;
+    const int xa = std::max(x0, static_cast<int>(std::ceil(lo))), xb = std::min(x1, static_cast<int>(std::floor(hi)));
+    double w0 = s0 + (xa - x0) * d0, w1 = s1 + (xa - x0) * d1;
+    for (int x = xa; x <= xb; ++x, w0 += d0, w1 += d1) {
+      const double w2 = 1 - w0 - w1;
+      if (w0 >= 0 && w1 >= 0 && w2 >= 0) fn(x, y, w0, w1, w2);
+    }
+  }
+  return true;
+}
+
+const uint8_t* pixel_at(const Image8& image, int x, int y) { return image.row(y) + x * image.channels; }
+
+// The interpolation error of one triangle with corner colors c0, c1, c2; a negative value when it
+// is thinner than `min_area`.
+double triangle_error(const Image8& image, Vec2 p0, Vec2 p1, Vec2 p2, Color c0, Color c1, Color c2,
+                      double min_area) {
+  double sum = 0;
+  const bool thick = for_each_pixel(p0, p1, p2, image, min_area, [&](int x, int y, double w0, double w1, double w2) {
+    const uint8_t* px = pixel_at(image, x, y);
+    const double er = w0 * c0.r + w1 * c1.r + w2 * c2.r - px[0];
+    const double eg = w0 * c0.g + w1 * c1.g + w2 * c2.g - px[1];
+    const double eb = w0 * c0.b + w1 * c1.b + w2 * c2.b - px[2];
+    sum += er * er + eg * eg + eb * eb;
+  });
+  return thick ? sum : -1;
+}
+
+int corner_of(const Tri& t, int32_t v) { return t[0] == v ? 0 : t[1] == v ? 1 : 2; }
+
+Color corner_color(const ControlMesh& mesh, int f, int32_t v) {
+  return mesh.colors[mesh.triangle_colors[f][corner_of(mesh.triangles[f], v)]];
+}
+
+int32_t opposite(const Tri& t, int32_t a, int32_t b) {
+  for (int32_t v : t)
+    if (v != a && v != b) return v;
+  return -1;
+}
+
+// Runs job(i) for i in [0, count) in chunks over the worker threads.
+template <class Job>
+void parallel_range(int count, int threads, const Job& job) {
+  const int chunks = std::min(count, 16 * threads);
+  detail::parallel_for(chunks, threads, [&](int chunk) {
+    const int end = static_cast<int>(int64_t(count) * (chunk + 1) / chunks);
+    for (int i = static_cast<int>(int64_t(count) * chunk / chunks); i < end; ++i) job(i);
+  });
+}
+
+std::vector<double> face_errors(const ControlMesh& mesh, const Image8& image, int threads) {
+  std::vector<double> error(mesh.num_triangles());
+  parallel_range(mesh.num_triangles(), threads, [&](int f) {
+    const Tri& t = mesh.triangles[f];
+    const auto& p = mesh.positions;
+    error[f] = std::max(0.0, triangle_error(image, p[t[0]], p[t[1]], p[t[2]], corner_color(mesh, f, t[0]),
+                                            corner_color(mesh, f, t[1]), corner_color(mesh, f, t[2]), 0));
+  });
+  return error;
+}
+
+double total(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return sum;
+}
+
+// One flip pass; returns the number of flips.
+int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+  const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
+  const auto& pos = mesh.positions;
+  const std::vector<double> face_error = face_errors(mesh, image, threads);
+  struct Candidate {
+    int32_t edge = -1;
+    double gain = 0;
+  };
+  std::vector<Candidate> found(topo.num_edges());
+  parallel_range(topo.num_edges(), threads, [&](int e) {
+    if (topo.edge_tags[e] != EdgeTag::kSmooth) return;
+    const int f0 = topo.edge_faces[e][0], f1 = topo.edge_faces[e][1];
+    if (f1 < 0) return;
+    const int32_t a = topo.edges[e][0], b = topo.edges[e][1];
+    const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
+    if (c == d || topo.find_edge(c, d) >= 0) return;
+    // The quadrilateral a c b d must be strictly convex: a and b on either side of c d (c and d
+    // are on either side of a b already, the two faces being positive).
+    const double s0 = signed_area(pos[c], pos[d], pos[a]), s1 = signed_area(pos[c], pos[d], pos[b]);
+    if ((s0 > 0) == (s1 > 0)) return;
+    const Color ca = corner_color(mesh, f0, a), cb = corner_color(mesh, f0, b);
+    const Color cc = corner_color(mesh, f0, c), cd = corner_color(mesh, f1, d);
+    const double e0 = triangle_error(image, pos[c], pos[d], pos[a], cc, cd, ca, options.min_area);
+    const double e1 = triangle_error(image, pos[c], pos[d], pos[b], cc, cd, cb, options.min_area);
+    if (e0 < 0 || e1 < 0) return;
+    const double before = face_error[f0] + face_error[f1], after = e0 + e1;
+    if (after < (1 - options.min_gain) * before) found[e] = {e, before - after};
+  });
+  std::vector<Candidate> order;
+  for (const Candidate& k : found)
+    if (k.edge >= 0) order.push_back(k);
+  std::sort(order.begin(), order.end(), [](const Candidate& x, const Candidate& y) {
+    return x.gain != y.gain ? x.gain > y.gain : x.edge < y.edge;
+  });
+  std::vector<char> replaced(mesh.num_triangles(), 0);
+  std::unordered_set<int64_t> created;  // (min << 32) | max of the edges this pass made
+  int flips = 0;
+  for (const Candidate& k : order) {
+    const int f0 = topo.edge_faces[k.edge][0], f1 = topo.edge_faces[k.edge][1];
+    if (replaced[f0] || replaced[f1]) continue;
+    const int32_t a = topo.edges[k.edge][0], b = topo.edges[k.edge][1];
+    const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
+    // In a valid planar mesh no two quadrilaterals share a diagonal; checked all the same.
+    if (!created.insert(int64_t(std::min(c, d)) << 32 | std::max(c, d)).second) continue;
+    const Tri& t0 = mesh.triangles[f0];
+    const Tri& k0 = mesh.triangle_colors[f0];
+    const int32_t ka = k0[corner_of(t0, a)], kb = k0[corner_of(t0, b)], kc = k0[corner_of(t0, c)];
+    const int32_t kd = mesh.triangle_colors[f1][corner_of(mesh.triangles[f1], d)];
+    // The new faces (c, d, a) and (d, c, b), each turned to positive area like every face.
+    Tri n0{c, d, a}, m0{kc, kd, ka}, n1{d, c, b}, m1{kd, kc, kb};
+    if (signed_area(pos[c], pos[d], pos[a]) < 0) std::swap(n0[0], n0[1]), std::swap(m0[0], m0[1]);
+    if (signed_area(pos[d], pos[c], pos[b]) < 0) std::swap(n1[0], n1[1]), std::swap(m1[0], m1[1]);
+    mesh.triangles[f0] = n0, mesh.triangle_colors[f0] = m0;
+    mesh.triangles[f1] = n1, mesh.triangle_colors[f1] = m1;
+    replaced[f0] = replaced[f1] = 1;
+    ++flips;
+  }
+  return flips;
+}
+
+int flip_passes(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+  int flips = 0;
+  for (int pass = 0; pass < options.flip_passes; ++pass) {
+    const int n = flip_pass(mesh, image, options, threads);
+    flips += n;
+    if (n == 0) break;
+  }
+  return flips;
+}
+
+// Greedy coloring of the vertices in index order: no two vertices of one class share an edge.
+// Returns the classes.
+std::vector<std::vector<int32_t>> vertex_classes(const ControlMesh& mesh, const MeshTopology& topo) {
+  const int nv = mesh.num_vertices();
+  std::vector<int32_t> offsets(nv + 1, 0), neighbors(2 * topo.edges.size());
+  for (const EdgeVerts& e : topo.edges) ++offsets[e[0] + 1], ++offsets[e[1] + 1];
+  for (int v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (const EdgeVerts& e : topo.edges) neighbors[fill[e[0]]++] = e[1], neighbors[fill[e[1]]++] = e[0];
+  std::vector<int32_t> color(nv, -1);
+  std::vector<std::vector<int32_t>> classes;
+  std::vector<char> used;
+  for (int v = 0; v < nv; ++v) {
+    used.assign(classes.size() + 1, 0);
+    for (int i = offsets[v]; i < offsets[v + 1]; ++i)
+      if (color[neighbors[i]] >= 0) used[color[neighbors[i]]] = 1;
+    const int c = static_cast<int>(std::find(used.begin(), used.end(), 0) - used.begin());
+    if (c == static_cast<int>(classes.size())) classes.emplace_back();
+    color[v] = c;
+    classes[c].push_back(v);
+  }
+  return classes;
+}
+
+// How vertex v may move: both coordinates (smooth), along the image border (a border vertex
+// that is no corner), or not at all (tears, creases, corners: their colors still adapt).
+struct Freedom {
+  bool x = false, y = false;
+};
+Freedom freedom_of(const ControlMesh& mesh, const MeshTopology& topo, const Image8& image, int32_t v) {
+  switch (topo.vertex_tags[v]) {
+    case VertexTag::kSmooth:
+      return {true, true};
+    case VertexTag::kCrease: {
+      const Vec2 p = mesh.positions[v];
+      if (p.x == 0 || p.x == image.width) return {false, true};
+      if (p.y == 0 || p.y == image.height) return {true, false};
+      return {};
+    }
+    default:
+      return {};
+  }
+}
+
+// One Gauss-Newton step for vertex v on its free coordinates and the colors of its corners (one
+// per side of a tear), kept only when the one-ring's error falls; returns whether it was kept.
+bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& image, int32_t v,
+                 const RefineOptions& options) {
+  constexpr int kMaxSides = 4;
+  // The one-ring as (p1, p2) with v first in each face's order, those corners' colors, and which
+  // of v's color values (sides) the face uses.
+  struct Wedge {
+    Vec2 p1, p2;
+    Color c1, c2;
+    int side;
+  };
+  std::vector<Wedge> ring;
+  std::array<int32_t, kMaxSides> side_color{};
+  int sides = 0;
+  for (auto [it, end] = topo.faces_of(v); it != end; ++it) {
+    const Tri& t = mesh.triangles[*it];
+    const Tri& k = mesh.triangle_colors[*it];
+    const int i = corner_of(t, v), i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    int side = static_cast<int>(std::find(side_color.begin(), side_color.begin() + sides, k[i]) - side_color.begin());
+    if (side == sides) {
+      if (sides == kMaxSides) return false;
+      side_color[sides++] = k[i];
+    }
+    ring.push_back({mesh.positions[t[i1]], mesh.positions[t[i2]], mesh.colors[k[i1]], mesh.colors[k[i2]], side});
+  }
+  const Freedom free = freedom_of(mesh, topo, image, v);
+  const Vec2 x = mesh.positions[v];
+  std::array<Color, kMaxSides> color{};
+  for (int k = 0; k < sides; ++k) color[k] = mesh.colors[side_color[k]];
+  // The ring's error with v at x and colors c; negative when a face gets too thin.
+  auto ring_error = [&](Vec2 at, const std::array<Color, kMaxSides>& c) {
+    double sum = 0;
+    for (const Wedge& w : ring) {
+      // Positive like every face (the error alone would accept a face turned over).
+      if (!(signed_area(at, w.p1, w.p2) > options.min_area)) return -1.0;
+      const double e = triangle_error(image, at, w.p1, w.p2, c[w.side], w.c1, w.c2, options.min_area);
+      if (e < 0) return -1.0;
+      sum += e;
+    }
+    return sum;
+  };
+  // Residuals f - I per pixel and channel, where f = (c a0 + c1 a1(x) + c2 a2(x)) / A(x) with
+  // a0 = area(s, p1, p2), a1 = area(x, s, p2), a2 = area(x, p1, s), A = area(x, p1, p2). The
+  // gradient of area(x, q, r) in x is (q.y - r.y, r.x - q.x) / 2. Unknowns: x, y, then r, g, b of
+  // each side.
+  const int n = 2 + 3 * sides;
+  Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd jtr = Eigen::VectorXd::Zero(n);
+  double before = 0;
+  for (const Wedge& w : ring) {
+    const Vec2 p1 = w.p1, p2 = w.p2;
+    const double inv = 1 / signed_area(x, p1, p2);
+    const double ax = 0.5 * (p1.y - p2.y), ay = 0.5 * (p2.x - p1.x);
+    const double cv[3] = {color[w.side].r, color[w.side].g, color[w.side].b};
+    const double c1[3] = {w.c1.r, w.c1.g, w.c1.b}, c2[3] = {w.c2.r, w.c2.g, w.c2.b};
+    const int col = 2 + 3 * w.side;
+    for_each_pixel(x, p1, p2, image, 0, [&](int px, int py, double w0, double w1, double w2) {
+      const Vec2 s{px + 0.5, py + 0.5};
+      const double g1x = 0.5 * (s.y - p2.y), g1y = 0.5 * (p2.x - s.x);
+      const double g2x = 0.5 * (p1.y - s.y), g2y = 0.5 * (s.x - p1.x);
+      const uint8_t* target = pixel_at(image, px, py);
+      for (int ch = 0; ch < 3; ++ch) {
+        const double f = w0 * cv[ch] + w1 * c1[ch] + w2 * c2[ch];
+        const double r = f - target[ch];
+        before += r * r;
+        const double jx = (c1[ch] * g1x + c2[ch] * g2x - f * ax) * inv;
+        const double jy = (c1[ch] * g1y + c2[ch] * g2y - f * ay) * inv;
+        // Jacobian row (jx, jy, and w0 in this side's and channel's color column).
+        jtj(0, 0) += jx * jx, jtj(0, 1) += jx * jy, jtj(1, 1) += jy * jy;
+        jtj(0, col + ch) += jx * w0, jtj(1, col + ch) += jy * w0, jtj(col + ch, col + ch) += w0 * w0;
+        jtr(0) += jx * r, jtr(1) += jy * r, jtr(col + ch) += w0 * r;
+      }
+    });
+  }
+  if (!(before > 0)) return false;
+  jtj.triangularView<Eigen::StrictlyLower>() = jtj.transpose().triangularView<Eigen::StrictlyLower>();
+  // A fixed coordinate: its row and column say "no step".
+  for (int axis = 0; axis < 2; ++axis) {
+    if (axis == 0 ? free.x : free.y) continue;
+    jtj.row(axis).setZero(), jtj.col(axis).setZero(), jtj(axis, axis) = 1, jtr(axis) = 0;
+  }
+  // Levenberg-Marquardt damping, scale-free, and a floor for a color no pixel sees.
+  jtj.diagonal() = jtj.diagonal() * 1.001 + Eigen::VectorXd::Constant(n, 1e-9);
+  Eigen::VectorXd step = -jtj.ldlt().solve(jtr);
+  if (!step.allFinite()) return false;
+  const double length = std::hypot(step(0), step(1));
+  if (length > options.max_step) step.head<2>() *= options.max_step / length;
+  // Tried over-relaxed first (the sweeps converge faster), then halved until the error falls.
+  step *= options.over_relaxation;
+  for (int halving = 0; halving < 4; ++halving, step *= 0.5) {
+    Vec2 at{x.x + step(0), x.y + step(1)};
+    if (!free.x) at.x = x.x;
+    if (!free.y) at.y = x.y;
+    std::array<Color, kMaxSides> c = color;
+    for (int k = 0; k < sides; ++k) {
+      c[k] = {static_cast<float>(color[k].r + step(2 + 3 * k)), static_cast<float>(color[k].g + step(3 + 3 * k)),
+              static_cast<float>(color[k].b + step(4 + 3 * k))};
+    }
+    const double after = ring_error(at, c);
+    if (after >= 0 && after < before) {
+      mesh.positions[v] = at;
+      for (int k = 0; k < sides; ++k) mesh.colors[side_color[k]] = c[k];
+      return true;
+    }
+  }
+  return false;
+}
+
+int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+  const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
+  int moves = 0;
+  for (const std::vector<int32_t>& members : vertex_classes(mesh, topo)) {
+    std::vector<char> moved(members.size(), 0);
+    parallel_range(static_cast<int>(members.size()), threads,
+                   [&](int i) { moved[i] = move_vertex(mesh, topo, image, members[i], options); });
+    moves += static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+  }
+  return moves;
+}
+
+}  // namespace
+
+RefineStats refine_mesh(ControlMesh& mesh, const Image8& image, const RefineOptions& options) {
+  if (options.rounds < 0 || options.flip_passes < 0 || !(options.min_gain >= 0 && options.min_gain < 1) ||
+      !(options.min_area >= 0) || !(options.max_step > 0) ||
+      !(options.over_relaxation >= 1 && options.over_relaxation <= 2)) {
+    throw Error(ErrorCode::kInvalidArgument, "refine_mesh: options out of range");
+  }
+  RefineStats stats;
+  if (options.rounds == 0) return stats;
+  const int threads = detail::resolve_threads(options.threads);
+  stats.error_before = total(face_errors(mesh, image, threads));
+  stats.flips += flip_passes(mesh, image, options, threads);
+  for (int round = 0; round < options.rounds; ++round) {
+    stats.moves += move_vertices(mesh, image, options, threads);
+    stats.flips += flip_passes(mesh, image, options, threads);
+  }
+  stats.error_after = total(face_errors(mesh, image, threads));
+  return stats;
+}
+
+}  // namespace subvec
