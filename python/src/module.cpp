@@ -685,7 +685,8 @@ PYBIND11_MODULE(_subvec, m) {
 
   m.def(
       "vectorize",
-      [](const py::object& image, double ratio, int vertices, int levels, int threads) {
+      [](const py::object& image, double ratio, int vertices, int levels, int refine, int relocate,
+         int l1_iterations, int threads) {
         if (!(std::isfinite(ratio) && ratio > 0 && ratio <= 1)) {
           invalid("ratio must be in (0, 1], got " + std::to_string(ratio));
         }
@@ -694,10 +695,19 @@ PYBIND11_MODULE(_subvec, m) {
           invalid("levels must be in 1 to 16" + std::string() +
                   ", got " + std::to_string(levels));
         }
+        // The ranges of `subvec vectorize --refine, --relocate, --l1-iterations`.
+        if (refine < 0 || refine > 50) invalid("refine must be in 0 to 50, got " + std::to_string(refine));
+        if (relocate < 0 || relocate > 50) invalid("relocate must be in 0 to 50, got " + std::to_string(relocate));
+        if (l1_iterations < 0 || l1_iterations > 20) {
+          invalid("l1_iterations must be in 0 to 20, got " + std::to_string(l1_iterations));
+        }
         subvec::Image8 img = image_from_array(image);
         subvec::VectorizeOptions options;
         options.ratio = ratio;
         options.vertices = vertices;
+        options.refine.rounds = refine;
+        options.fit.relocate_iterations = relocate;
+        options.fit.l1_iterations = l1_iterations;
         options.threads = threads;
         py::gil_scoped_release release;
         VectorImage v = subvec::vectorize(img, options);
@@ -709,7 +719,7 @@ PYBIND11_MODULE(_subvec, m) {
         return v;
       },
       "image"_a, py::kw_only(), "ratio"_a = 0.01, "vertices"_a = 0, "levels"_a = 3,
-      "threads"_a = 0);
+      "refine"_a = subvec::RefineOptions{}.rounds, "relocate"_a = 0, "l1_iterations"_a = 0, "threads"_a = 0);
 
   m.def(
       "load",

@@ -83,6 +83,13 @@ double triangle_error(const Image8& image, Vec2 p0, Vec2 p1, Vec2 p2, Color c0, 
   return thick ? sum : -1;
 }
 
+// 4 sqrt(3) area / (sum of squared edge lengths): 1 for an equilateral triangle, 0 for a flat one.
+double shape_quality(Vec2 p, Vec2 q, Vec2 r) {
+  const double sum = (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y) + (r.x - q.x) * (r.x - q.x) +
+                     (r.y - q.y) * (r.y - q.y) + (p.x - r.x) * (p.x - r.x) + (p.y - r.y) * (p.y - r.y);
+  return sum > 0 ? 4 * std::sqrt(3.0) * std::abs(signed_area(p, q, r)) / sum : 0;
+}
+
 int corner_of(const Tri& t, int32_t v) { return t[0] == v ? 0 : t[1] == v ? 1 : 2; }
 
 Color corner_color(const ControlMesh& mesh, int f, int32_t v) {
@@ -138,11 +145,14 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
     if (f1 < 0) return;
     const int32_t a = topo.edges[e][0], b = topo.edges[e][1];
     const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
-    if (c == d || topo.find_edge(c, d) >= 0) return;
     // The quadrilateral a c b d must be strictly convex: a and b on either side of c d (c and d
     // are on either side of a b already, the two faces being positive).
     const double s0 = signed_area(pos[c], pos[d], pos[a]), s1 = signed_area(pos[c], pos[d], pos[b]);
     if ((s0 > 0) == (s1 > 0)) return;
+    // No new sliver: both new triangles keep min_quality, or the pair's worst quality.
+    const double old_quality = std::min(shape_quality(pos[a], pos[b], pos[c]), shape_quality(pos[a], pos[b], pos[d]));
+    const double new_quality = std::min(shape_quality(pos[c], pos[d], pos[a]), shape_quality(pos[c], pos[d], pos[b]));
+    if (new_quality < std::min(old_quality, options.min_quality)) return;
     const Color ca = corner_color(mesh, f0, a), cb = corner_color(mesh, f0, b);
     const Color cc = corner_color(mesh, f0, c), cd = corner_color(mesh, f1, d);
     const double e0 = triangle_error(image, pos[c], pos[d], pos[a], cc, cd, ca, options.min_area);
@@ -267,8 +277,17 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
   const Vec2 x = mesh.positions[v];
   std::array<Color, kMaxSides> color{};
   for (int k = 0; k < sides; ++k) color[k] = mesh.colors[side_color[k]];
+  // The ring's worst shape quality with v at x; a move may not take it under min_move_quality
+  // unless it already was.
+  auto ring_quality = [&](Vec2 at) {
+    double worst = 1;
+    for (const Wedge& w : ring) worst = std::min(worst, shape_quality(at, w.p1, w.p2));
+    return worst;
+  };
+  const double quality_floor = std::min(ring_quality(mesh.positions[v]), options.min_move_quality);
   // The ring's error with v at x and colors c; negative when a face gets too thin.
   auto ring_error = [&](Vec2 at, const std::array<Color, kMaxSides>& c) {
+    if (!(at == mesh.positions[v]) && ring_quality(at) < quality_floor) return -1.0;
     double sum = 0;
     for (const Wedge& w : ring) {
       // Positive like every face (the error alone would accept a face turned over).
@@ -363,7 +382,9 @@ int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& o
 RefineStats refine_mesh(ControlMesh& mesh, const Image8& image, const RefineOptions& options) {
   if (options.rounds < 0 || options.flip_passes < 0 || !(options.min_gain >= 0 && options.min_gain < 1) ||
       !(options.min_area >= 0) || !(options.max_step > 0) ||
-      !(options.over_relaxation >= 1 && options.over_relaxation <= 2)) {
+      !(options.over_relaxation >= 1 && options.over_relaxation <= 2) ||
+      !(options.min_quality >= 0 && options.min_quality <= 1) ||
+      !(options.min_move_quality >= 0 && options.min_move_quality <= 1)) {
     throw Error(ErrorCode::kInvalidArgument, "refine_mesh: options out of range");
   }
   RefineStats stats;

@@ -243,6 +243,10 @@ def test_bad_arrays_raise_invalid_argument():
         subvec.vectorize(disk_image(), ratio=0)
     with pytest.raises(subvec.InvalidArgumentError, match="levels"):
         subvec.vectorize(disk_image(), levels=0)
+    with pytest.raises(subvec.InvalidArgumentError, match="refine"):
+        subvec.vectorize(disk_image(), refine=-1)
+    with pytest.raises(subvec.InvalidArgumentError, match="relocate"):
+        subvec.vectorize(disk_image(), relocate=51)
     with pytest.raises(ValueError):  # the built-in base class works for callers that know no subvec
         subvec.vectorize(np.zeros((0, 4, 3), np.uint8))
 
@@ -365,6 +369,11 @@ def test_levels_and_filter_equal_the_cli(tmp_path, cli, disk):
         "--levels", "3")
     image.save(tmp_path / "py.svec")
     assert (tmp_path / "py.svec").read_bytes() == (tmp_path / "cli.svec").read_bytes()
+    # The quality options reach the library as the command's do.
+    cli("vectorize", tmp_path / "photo.png", "-o", tmp_path / "cli2.svec", "--ratio", "0.05",
+        "--levels", "1", "--refine", "2", "--l1-iterations", "1")
+    assert subvec.vectorize(photo, ratio=0.05, levels=1, refine=2, l1_iterations=1).to_bytes() == \
+        (tmp_path / "cli2.svec").read_bytes()
     assert np.array_equal(subvec.load(tmp_path / "py.svec").render(level=2),
                           subvec.load(tmp_path / "cli.svec").render(level=2))
     flat = image.filter(geometry_eta=[1], color_eta=[0])

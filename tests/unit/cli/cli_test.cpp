@@ -441,8 +441,9 @@ TEST_F(Cli, VectorizeWritesAValidImageAndReportsIt) {
   EXPECT_LE(j["vertices"].get<int>(), 60);
   EXPECT_GE(j["features"].get<int>(), 1);
   EXPECT_LT(j["mae"].get<double>(), 6.0);
-  for (const char* stage : {"features", "mesh", "simplify", "fit"})
+  for (const char* stage : {"features", "mesh", "simplify", "refine", "fit"})
     EXPECT_TRUE(j["seconds"].contains(stage));
+  EXPECT_GT(j["refine"]["moves"].get<int>(), 0);
   // The output is a valid vector image that renders at the photo's size.
   const CliResult info = subvec("info " + q(out) + " --json");
   ASSERT_EQ(info.status, 0) << info.err;
@@ -451,6 +452,26 @@ TEST_F(Cli, VectorizeWritesAValidImageAndReportsIt) {
   const fs::path again = dir_ / "again.svec";
   ASSERT_EQ(subvec("vectorize " + q(photo) + " -o " + q(again) + " --vertices 60").status, 0);
   EXPECT_EQ(read_text(out), read_text(again));
+}
+
+// The feature detector's options reach it: no features when none may be that long, more when the
+// threshold's floor is lower; --refine 0 keeps the simplified mesh.
+TEST_F(Cli, VectorizeFeatureAndRefineOptions) {
+  const fs::path photo = dir_ / "photo.png", out = dir_ / "photo.svec";
+  write_test_photo(photo);
+  auto run = [&](const std::string& options) {
+    const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 60 --levels 1 --json " + options);
+    EXPECT_EQ(r.status, 0) << options << ": " << r.err;
+    return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+  };
+  const auto plain = run(""), none = run("--min-feature-length 100000"), unrefined = run("--refine 0");
+  ASSERT_FALSE(plain.is_null() || none.is_null() || unrefined.is_null());
+  EXPECT_GE(plain["features"].get<int>(), 1);
+  EXPECT_EQ(none["features"], 0);
+  EXPECT_EQ(none["tear_vertices"], 0);
+  EXPECT_EQ(unrefined["refine"]["flips"], 0);
+  EXPECT_EQ(unrefined["refine"]["moves"], 0);
+  EXPECT_GT(plain["refine"]["moves"].get<int>(), 0);
 }
 
 TEST_F(Cli, VectorizeBadInputs) {
@@ -463,6 +484,11 @@ TEST_F(Cli, VectorizeBadInputs) {
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio 1.5"), "--ratio");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --ratio -1"), "--ratio");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --vertices 2"), "--vertices");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --edge-quantile 2"), "--edge-quantile");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --edge-blur nan"), "--edge-blur");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-feature-error 0"),
+                 "--max-feature-error");
+  expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --refine -1"), "--refine");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(dir_ / "out.png")), ".png");
   expect_failure(subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-pixels 100"),
                  "64x48 pixels is over the limit of 100 pixels (--max-pixels raises the limit)");

@@ -146,7 +146,8 @@ TEST(Refine, RejectsOptionsOutOfRange) {
   for (auto change : std::initializer_list<void (*)(RefineOptions&)>{
            [](RefineOptions& o) { o.rounds = -1; }, [](RefineOptions& o) { o.min_gain = 1; },
            [](RefineOptions& o) { o.min_area = -1; }, [](RefineOptions& o) { o.max_step = 0; },
-           [](RefineOptions& o) { o.over_relaxation = 2.5; }, [](RefineOptions& o) { o.flip_passes = -1; }}) {
+           [](RefineOptions& o) { o.over_relaxation = 2.5; }, [](RefineOptions& o) { o.flip_passes = -1; },
+           [](RefineOptions& o) { o.min_quality = 1.5; }, [](RefineOptions& o) { o.min_move_quality = -1; }}) {
     RefineOptions options;
     change(options);
     EXPECT_THROW(refine_mesh(mesh, img, options), Error);
