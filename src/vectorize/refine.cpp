@@ -145,6 +145,7 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
     if (f1 < 0) return;
     const int32_t a = topo.edges[e][0], b = topo.edges[e][1];
     const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
+    if (c == d || topo.find_edge(c, d) >= 0) return;
     // The quadrilateral a c b d must be strictly convex: a and b on either side of c d (c and d
     // are on either side of a b already, the two faces being positive).
     const double s0 = signed_area(pos[c], pos[d], pos[a]), s1 = signed_area(pos[c], pos[d], pos[b]);
