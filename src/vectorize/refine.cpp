@@ -112,28 +112,50 @@ void parallel_range(int count, int threads, const Job& job) {
   });
 }
 
-std::vector<double> face_errors(const ControlMesh& mesh, const Image8& image, int threads) {
-  std::vector<double> error(mesh.num_triangles());
-  parallel_range(mesh.num_triangles(), threads, [&](int f) {
-    const Tri& t = mesh.triangles[f];
-    const auto& p = mesh.positions;
-    error[f] = std::max(0.0, triangle_error(image, p[t[0]], p[t[1]], p[t[2]], corner_color(mesh, f, t[0]),
-                                            corner_color(mesh, f, t[1]), corner_color(mesh, f, t[2]), 0));
-  });
-  return error;
+double face_error(const ControlMesh& mesh, const Image8& image, int f) {
+  const Tri& t = mesh.triangles[f];
+  const auto& p = mesh.positions;
+  return std::max(0.0, triangle_error(image, p[t[0]], p[t[1]], p[t[2]], corner_color(mesh, f, t[0]),
+                                      corner_color(mesh, f, t[1]), corner_color(mesh, f, t[2]), 0));
 }
 
-double total(const std::vector<double>& values) {
-  double sum = 0;
-  for (double v : values) sum += v;
-  return sum;
-}
+// What a refinement carries from step to step, so that each step looks only at what changed:
+// every face's error; which faces changed since the flip candidates were last evaluated (a
+// candidate depends only on its edge's two faces, so an edge between unchanged faces has none);
+// when each face last changed and when each vertex's move was last refused (the step depends
+// only on the vertex's one-ring, so a ring that has not changed since refuses it again). Skipping
+// those evaluations gives the same mesh as doing them.
+struct Tracker {
+  std::vector<double> error;        // per face
+  std::vector<char> flip_dirty;     // per face
+  std::vector<int64_t> changed_at;  // per face: the epoch of its last change
+  std::vector<int64_t> refused_at;  // per vertex: the epoch of its last refused move, or -1
+  int64_t epoch = 1;
+
+  Tracker(const ControlMesh& mesh, const Image8& image, int threads)
+      : error(mesh.num_triangles()), flip_dirty(mesh.num_triangles(), 1), changed_at(mesh.num_triangles(), 0),
+        refused_at(mesh.num_vertices(), -1) {
+    std::vector<int> all(mesh.num_triangles());
+    for (int f = 0; f < mesh.num_triangles(); ++f) all[f] = f;
+    update(mesh, image, all, threads);
+  }
+  // Faces `changed` have new corners, positions or colors.
+  void update(const ControlMesh& mesh, const Image8& image, const std::vector<int>& changed, int threads) {
+    parallel_range(static_cast<int>(changed.size()), threads,
+                   [&](int i) { error[changed[i]] = face_error(mesh, image, changed[i]); });
+    for (int f : changed) flip_dirty[f] = 1, changed_at[f] = epoch;
+  }
+  double total() const {
+    double sum = 0;
+    for (double e : error) sum += e;
+    return sum;
+  }
+};
 
 // One flip pass; returns the number of flips.
-int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& options, Tracker& track, int threads) {
   const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
   const auto& pos = mesh.positions;
-  const std::vector<double> face_error = face_errors(mesh, image, threads);
   struct Candidate {
     int32_t edge = -1;
     double gain = 0;
@@ -142,7 +164,7 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
   parallel_range(topo.num_edges(), threads, [&](int e) {
     if (topo.edge_tags[e] != EdgeTag::kSmooth) return;
     const int f0 = topo.edge_faces[e][0], f1 = topo.edge_faces[e][1];
-    if (f1 < 0) return;
+    if (f1 < 0 || !(track.flip_dirty[f0] || track.flip_dirty[f1])) return;
     const int32_t a = topo.edges[e][0], b = topo.edges[e][1];
     const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
     if (c == d || topo.find_edge(c, d) >= 0) return;
@@ -159,7 +181,7 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
     const double e0 = triangle_error(image, pos[c], pos[d], pos[a], cc, cd, ca, options.min_area);
     const double e1 = triangle_error(image, pos[c], pos[d], pos[b], cc, cd, cb, options.min_area);
     if (e0 < 0 || e1 < 0) return;
-    const double before = face_error[f0] + face_error[f1], after = e0 + e1;
+    const double before = track.error[f0] + track.error[f1], after = e0 + e1;
     if (after < (1 - options.min_gain) * before) found[e] = {e, before - after};
   });
   std::vector<Candidate> order;
@@ -168,16 +190,22 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
   std::sort(order.begin(), order.end(), [](const Candidate& x, const Candidate& y) {
     return x.gain != y.gain ? x.gain > y.gain : x.edge < y.edge;
   });
+  // Every edge has been evaluated against the faces as they are; a candidate not applied below
+  // lost to a flip that replaced one of its faces, which makes that face dirty again.
+  std::fill(track.flip_dirty.begin(), track.flip_dirty.end(), 0);
   std::vector<char> replaced(mesh.num_triangles(), 0);
+  std::vector<int> changed;
   std::unordered_set<int64_t> created;  // (min << 32) | max of the edges this pass made
-  int flips = 0;
   for (const Candidate& k : order) {
     const int f0 = topo.edge_faces[k.edge][0], f1 = topo.edge_faces[k.edge][1];
     if (replaced[f0] || replaced[f1]) continue;
     const int32_t a = topo.edges[k.edge][0], b = topo.edges[k.edge][1];
     const int32_t c = opposite(mesh.triangles[f0], a, b), d = opposite(mesh.triangles[f1], a, b);
     // In a valid planar mesh no two quadrilaterals share a diagonal; checked all the same.
-    if (!created.insert(int64_t(std::min(c, d)) << 32 | std::max(c, d)).second) continue;
+    if (!created.insert(int64_t(std::min(c, d)) << 32 | std::max(c, d)).second) {
+      track.flip_dirty[f0] = track.flip_dirty[f1] = 1;  // evaluated again next pass
+      continue;
+    }
     const Tri& t0 = mesh.triangles[f0];
     const Tri& k0 = mesh.triangle_colors[f0];
     const int32_t ka = k0[corner_of(t0, a)], kb = k0[corner_of(t0, b)], kc = k0[corner_of(t0, c)];
@@ -189,15 +217,17 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
     mesh.triangles[f0] = n0, mesh.triangle_colors[f0] = m0;
     mesh.triangles[f1] = n1, mesh.triangle_colors[f1] = m1;
     replaced[f0] = replaced[f1] = 1;
-    ++flips;
+    changed.push_back(f0), changed.push_back(f1);
   }
-  return flips;
+  track.update(mesh, image, changed, threads);
+  ++track.epoch;
+  return static_cast<int>(changed.size() / 2);
 }
 
-int flip_passes(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+int flip_passes(ControlMesh& mesh, const Image8& image, const RefineOptions& options, Tracker& track, int threads) {
   int flips = 0;
   for (int pass = 0; pass < options.flip_passes; ++pass) {
-    const int n = flip_pass(mesh, image, options, threads);
+    const int n = flip_pass(mesh, image, options, track, threads);
     flips += n;
     if (n == 0) break;
   }
@@ -285,10 +315,11 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
     for (const Wedge& w : ring) worst = std::min(worst, shape_quality(at, w.p1, w.p2));
     return worst;
   };
-  const double quality_floor = std::min(ring_quality(mesh.positions[v]), options.min_move_quality);
+  const double quality_floor =
+      options.min_move_quality > 0 ? std::min(ring_quality(mesh.positions[v]), options.min_move_quality) : 0;
   // The ring's error with v at x and colors c; negative when a face gets too thin.
   auto ring_error = [&](Vec2 at, const std::array<Color, kMaxSides>& c) {
-    if (!(at == mesh.positions[v]) && ring_quality(at) < quality_floor) return -1.0;
+    if (quality_floor > 0 && !(at == mesh.positions[v]) && ring_quality(at) < quality_floor) return -1.0;
     double sum = 0;
     for (const Wedge& w : ring) {
       // Positive like every face (the error alone would accept a face turned over).
@@ -366,14 +397,29 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
   return false;
 }
 
-int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& options, int threads) {
+int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& options, Tracker& track,
+                  int threads) {
   const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
   int moves = 0;
   for (const std::vector<int32_t>& members : vertex_classes(mesh, topo)) {
-    std::vector<char> moved(members.size(), 0);
-    parallel_range(static_cast<int>(members.size()), threads,
-                   [&](int i) { moved[i] = move_vertex(mesh, topo, image, members[i], options); });
-    moves += static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+    // 0: not tried (its ring is as it was when its move was last refused), 1: refused, 2: moved.
+    std::vector<char> outcome(members.size(), 0);
+    parallel_range(static_cast<int>(members.size()), threads, [&](int i) {
+      const int32_t v = members[i];
+      bool ring_changed = track.refused_at[v] < 0;
+      for (auto [it, end] = topo.faces_of(v); it != end && !ring_changed; ++it)
+        ring_changed = track.changed_at[*it] > track.refused_at[v];
+      if (ring_changed) outcome[i] = move_vertex(mesh, topo, image, v, options) ? 2 : 1;
+    });
+    std::vector<int> changed;
+    for (size_t i = 0; i < members.size(); ++i) {
+      if (outcome[i] == 1) track.refused_at[members[i]] = track.epoch;
+      if (outcome[i] != 2) continue;
+      ++moves;
+      for (auto [it, end] = topo.faces_of(members[i]); it != end; ++it) changed.push_back(*it);
+    }
+    track.update(mesh, image, changed, threads);
+    ++track.epoch;
   }
   return moves;
 }
@@ -391,13 +437,14 @@ RefineStats refine_mesh(ControlMesh& mesh, const Image8& image, const RefineOpti
   RefineStats stats;
   if (options.rounds == 0) return stats;
   const int threads = detail::resolve_threads(options.threads);
-  stats.error_before = total(face_errors(mesh, image, threads));
-  stats.flips += flip_passes(mesh, image, options, threads);
+  Tracker track(mesh, image, threads);
+  stats.error_before = track.total();
+  stats.flips += flip_passes(mesh, image, options, track, threads);
   for (int round = 0; round < options.rounds; ++round) {
-    stats.moves += move_vertices(mesh, image, options, threads);
-    stats.flips += flip_passes(mesh, image, options, threads);
+    stats.moves += move_vertices(mesh, image, options, track, threads);
+    stats.flips += flip_passes(mesh, image, options, track, threads);
   }
-  stats.error_after = total(face_errors(mesh, image, threads));
+  stats.error_after = track.total();
   return stats;
 }
 
