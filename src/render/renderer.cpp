@@ -284,6 +284,9 @@ struct State {
   std::unique_ptr<detail::GpuRasterizer> gpu;
   bool gpu_tried = false;
   Backend last_backend = Backend::kCpu;
+  // A single frame (render()): the refinement is evaluated once, level by level, without the
+  // stencils that make a Renderer's later frames (edits) fast.
+  bool one_frame = false;
 };
 
 LevelState& level_state(const VectorImage& image, State& state, int level) {
@@ -373,7 +376,11 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
     c.refined = RefinedMesh{};
     c.blocks.clear();
     c.subdivision.emplace(mesh, *ls.topology, plan.depth, plan.faces);
-    c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
+    if (state.one_frame) {
+      c.subdivision->evaluate_once(mesh.positions, mesh.colors, c.refined, threads);
+    } else {
+      c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
+    }
     c.level = options.level;
     c.depth = plan.depth;
     c.faces = std::move(plan.faces);
@@ -409,6 +416,7 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
 
 Image8 render(const VectorImage& image, const RenderOptions& options) {
   State state;
+  state.one_frame = true;
   Image8 out;
   render_with(image, state, options, out);
   return out;

@@ -261,6 +261,9 @@ struct Subdivision::Impl {
   // Refines N channels of data; writes channel c of output value i to out[i * stride + offset + c].
   template <int N, bool FaceVarying, class Gather>
   void refine_and_limit(Gather gather, std::span<float> out, int stride = N, int offset = 0) const;
+  // Level-by-level evaluation, never through the stencils.
+  void refine_positions(std::span<const Vec2> positions, std::span<float> out) const;
+  void refine_colors(std::span<const Color> colors, std::span<float> out, int threads) const;
   SparseMatrix limit_stencils(bool face_varying) const;
 };
 
@@ -430,17 +433,11 @@ void apply_stencils(const SparseMatrix& s, Get get, std::span<float> out, int th
 
 }  // namespace
 
-void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads) const {
-  if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
+void Subdivision::Impl::refine_positions(std::span<const Vec2> positions, std::span<float> out) const {
+  if (static_cast<int>(positions.size()) != num_control_vertices) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
   }
-  if (impl_->use_stencils()) {
-    apply_stencils<2>(
-        position_stencils(), [&](int i) { return std::array<double, 2>{positions[i].x, positions[i].y}; }, out,
-        threads);
-    return;
-  }
-  impl_->refine_and_limit<2, false>(
+  refine_and_limit<2, false>(
       [&](int i, double* v) {
         v[0] = positions[i].x;
         v[1] = positions[i].y;
@@ -448,33 +445,15 @@ void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<
       out);
 }
 
-void Subdivision::evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const {
-  if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
-    throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
-  }
-  impl_->refine_and_limit<2, false>(
-      [&](int i, double* v) {
-        v[0] = positions[i].x;
-        v[1] = positions[i].y;
-      },
-      out);
-}
-
-void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
-  if (static_cast<int>(colors.size()) != impl_->num_control_colors) {
+void Subdivision::Impl::refine_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
+  if (static_cast<int>(colors.size()) != num_control_colors) {
     throw Error(ErrorCode::kInvalidArgument, "evaluate: color count does not match the mesh");
-  }
-  if (impl_->use_stencils()) {
-    apply_stencils<3>(
-        color_stencils(), [&](int i) { return std::array<double, 3>{colors[i].r, colors[i].g, colors[i].b}; },
-        out, threads);
-    return;
   }
   if (resolve_threads(threads) > 1) {
     // Channels refine independently with the same weights in the same order, so splitting them
     // over threads gives bit-identical results: (r, g) on a helper thread, b here.
     std::thread rg([&] {
-      impl_->refine_and_limit<2, true>(
+      refine_and_limit<2, true>(
           [&](int i, double* v) {
             v[0] = colors[i].r;
             v[1] = colors[i].g;
@@ -482,7 +461,7 @@ void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float
           out, 3, 0);
     });
     try {
-      impl_->refine_and_limit<1, true>([&](int i, double* v) { v[0] = colors[i].b; }, out, 3, 2);
+      refine_and_limit<1, true>([&](int i, double* v) { v[0] = colors[i].b; }, out, 3, 2);
     } catch (...) {
       rg.join();
       throw;
@@ -490,7 +469,7 @@ void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float
     rg.join();
     return;
   }
-  impl_->refine_and_limit<3, true>(
+  refine_and_limit<3, true>(
       [&](int i, double* v) {
         v[0] = colors[i].r;
         v[1] = colors[i].g;
@@ -499,28 +478,76 @@ void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float
       out);
 }
 
-void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Color> colors,
-                           RefinedMesh& out, int threads) const {
+void Subdivision::evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads) const {
+  if (!impl_->use_stencils()) return impl_->refine_positions(positions, out);
+  if (static_cast<int>(positions.size()) != impl_->num_control_vertices) {
+    throw Error(ErrorCode::kInvalidArgument, "evaluate: position count does not match the mesh");
+  }
+  apply_stencils<2>(
+      position_stencils(), [&](int i) { return std::array<double, 2>{positions[i].x, positions[i].y}; }, out,
+      threads);
+}
+
+void Subdivision::evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const {
+  impl_->refine_positions(positions, out);
+}
+
+void Subdivision::evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads) const {
+  if (!impl_->use_stencils()) return impl_->refine_colors(colors, out, threads);
+  if (static_cast<int>(colors.size()) != impl_->num_control_colors) {
+    throw Error(ErrorCode::kInvalidArgument, "evaluate: color count does not match the mesh");
+  }
+  apply_stencils<3>(
+      color_stencils(), [&](int i) { return std::array<double, 3>{colors[i].r, colors[i].g, colors[i].b}; }, out,
+      threads);
+}
+
+void Subdivision::evaluate_with(std::span<const Vec2> positions, std::span<const Color> colors, RefinedMesh& out,
+                                int threads, bool once) const {
   const RefinedMesh& topo = impl_->topology;
   if (out.triangles.size() != topo.triangles.size() || out.depth != topo.depth) {
     out = topo;
   }
   out.positions.resize(impl_->out_vertices.size() * 2);
   out.colors.resize(impl_->out_colors.size() * 3);
+  auto evaluate_positions_here = [&] {
+    if (once) {
+      impl_->refine_positions(positions, out.positions);
+    } else {
+      evaluate_positions(positions, out.positions);
+    }
+  };
+  auto evaluate_colors_here = [&] {
+    if (once) {
+      impl_->refine_colors(colors, out.colors, 1);
+    } else {
+      evaluate_colors(colors, out.colors, 1);
+    }
+  };
   // Positions and colors are independent passes over the same topology: run them side by side.
   if (resolve_threads(threads) > 1) {
-    std::thread color_thread([&] { evaluate_colors(colors, out.colors, 1); });
+    std::thread color_thread(evaluate_colors_here);
     try {
-      evaluate_positions(positions, out.positions);
+      evaluate_positions_here();
     } catch (...) {
       color_thread.join();
       throw;
     }
     color_thread.join();
   } else {
-    evaluate_positions(positions, out.positions);
-    evaluate_colors(colors, out.colors, 1);
+    evaluate_positions_here();
+    evaluate_colors_here();
   }
+}
+
+void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Color> colors,
+                           RefinedMesh& out, int threads) const {
+  evaluate_with(positions, colors, out, threads, false);
+}
+
+void Subdivision::evaluate_once(std::span<const Vec2> positions, std::span<const Color> colors,
+                                RefinedMesh& out, int threads) const {
+  evaluate_with(positions, colors, out, threads, true);
 }
 
 namespace {

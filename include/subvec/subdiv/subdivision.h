@@ -72,8 +72,11 @@ class Subdivision {
                 int threads = 0) const;
   void evaluate_positions(std::span<const Vec2> positions, std::span<float> out, int threads = 0) const;
   void evaluate_colors(std::span<const Color> colors, std::span<float> out, int threads = 0) const;
-  // The positions of evaluate_positions() (to float precision) for a single evaluation: refines
-  // level by level and never builds the position stencils, which cost several evaluations.
+  // The values of evaluate() and evaluate_positions() (to float precision) for a single
+  // evaluation: they refine level by level and never build the stencils, which cost several
+  // evaluations (a one-off render, the fit's limit positions).
+  void evaluate_once(std::span<const Vec2> positions, std::span<const Color> colors, RefinedMesh& out,
+                     int threads = 0) const;
   void evaluate_positions_once(std::span<const Vec2> positions, std::span<float> out) const;
 
   // Limit stencils: row i expresses refined vertex i (color value i) as a combination of control
@@ -84,6 +87,8 @@ class Subdivision {
   const SparseMatrix& color_stencils() const;
 
  private:
+  void evaluate_with(std::span<const Vec2> positions, std::span<const Color> colors, RefinedMesh& out,
+                     int threads, bool once) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
