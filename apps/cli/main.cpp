@@ -15,9 +15,6 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
@@ -38,6 +35,7 @@
 
 #include "batch.h"
 #include "edit_commands.h"
+#include "memory.h"
 #include "progress.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
 #include "vectorize_options.h"
@@ -750,20 +748,8 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-// glibc hands freed blocks over 128 KB straight back to the kernel, so every stage's fresh arrays
-// fault their pages in again; on virtual machines where a page fault is dear that was a quarter of
-// a vectorization (docs/vectorize.md, "Speed"). Keep freed memory in the process for reuse: the
-// peak resident size is what it was, it is just not given back before exit.
-void keep_freed_memory() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  mallopt(M_TOP_PAD, 64 << 20);
-#endif
-}
-
 int main(int argc, char** argv) {
-  keep_freed_memory();
+  subvec_cli::tune_memory();
   try {
     return run(argc, argv);
   } catch (const std::bad_alloc&) {

@@ -1,0 +1,34 @@
+#include "memory.h"
+
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#include <sys/mman.h>
+#endif
+
+namespace subvec_cli {
+
+void tune_memory() {
+#if defined(__GLIBC__)
+  constexpr size_t kReserve = size_t(1) << 30;
+  constexpr uintptr_t kHugePage = uintptr_t(2) << 20;
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
+  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());  // above the reserve: it stays
+  mallopt(M_TOP_PAD, 64 << 20);
+  mallopt(M_ARENA_MAX, 1);
+#if defined(MADV_HUGEPAGE)
+  mallopt(M_MMAP_MAX, 0);  // the reserve must come from the heap, not from a mapping of its own
+  void* block = std::malloc(kReserve);
+  mallopt(M_MMAP_MAX, 65536);  // glibc's default
+  if (block == nullptr) return;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(block) + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(block) + kReserve) & ~(kHugePage - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  std::free(block);  // to the heap's free top, which stays under the trim threshold
+#endif
+#endif
+}
+
+}  // namespace subvec_cli
