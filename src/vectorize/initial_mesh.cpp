@@ -4,22 +4,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <set>
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Constrained_triangulation_plus_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include "subvec/core/error.h"
-#include "subvec/mesh/topology.h"
 
 namespace subvec {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<int32_t, Kernel>;
-using FaceBase = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+using FaceBase =
+    CGAL::Constrained_triangulation_face_base_2<Kernel, CGAL::Triangulation_face_base_with_info_2<int32_t, Kernel>>;
 using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 // Exact_predicates_tag: constraints may cross (features that touch after subpixel location);
 // CGAL then inserts their intersection point instead of throwing.
@@ -127,8 +129,45 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     v->info() = next++;
     mesh.positions.push_back({v->point().x(), v->point().y()});
   }
+  next = 0;
   for (auto f : cdt.finite_face_handles()) {
+    f->info() = next++;
     mesh.triangles.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()});
+  }
+
+  // Face-varying colors: the corners of a vertex share one color value unless a tear (a
+  // constrained interior edge) separates them. A union of the corners across every other interior
+  // edge, read off the triangulation's adjacency; values numbered in order of first use, as
+  // face_varying_indices() (topology.h) numbers them.
+  const int nf = mesh.num_triangles();
+  std::vector<int32_t> parent(size_t(nf) * 3);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto unite = [&](int32_t a, int32_t b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  for (auto f : cdt.finite_face_handles()) {
+    for (int j = 0; j < 3; ++j) {
+      const auto g = f->neighbor(j);
+      if (cdt.is_infinite(g) || g->info() < f->info() || f->is_constrained(j)) continue;
+      for (const int k : {CdtPlus::ccw(j), CdtPlus::cw(j)}) {
+        unite(3 * f->info() + k, 3 * g->info() + g->index(f->vertex(k)));
+      }
+    }
+  }
+  int num_colors = 0;
+  mesh.triangle_colors.resize(nf);
+  {
+    std::vector<int32_t> index(parent.size(), -1);
+    for (int32_t c = 0; c < 3 * nf; ++c) {
+      int32_t& id = index[find(c)];
+      if (id < 0) id = num_colors++;
+      mesh.triangle_colors[c / 3][c % 3] = id;
+    }
   }
 
   // Features: each constraint's vertex sequence (including any intersection vertices CGAL added),
@@ -166,9 +205,7 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     flush();
   }
 
-  // Face-varying colors: one value per tear-bounded sector of each vertex, sampled on its side.
-  int num_colors = 0;
-  mesh.triangle_colors = face_varying_indices(mesh, MeshTopology::build(mesh, w, h), num_colors);
+  // Each color value sampled at its vertex, or on its side of the tears.
   std::vector<Vec2> toward(num_colors, Vec2{0, 0});
   std::vector<int32_t> owner(num_colors, -1);
   std::vector<int> sectors(mesh.num_vertices(), 0);

@@ -75,6 +75,23 @@ TEST(InitialMesh, IsValidAndFollowsTheFeatures) {
   int split = 0;
   for (VertexTag tag : topo.vertex_tags) split += tag == VertexTag::kTear;
   EXPECT_EQ(mesh.num_colors(), mesh.num_vertices() + split);
+  int num_colors = 0;
+  EXPECT_EQ(face_varying_indices(mesh, topo, num_colors), mesh.triangle_colors);
+  EXPECT_EQ(num_colors, mesh.num_colors());
+}
+
+// The dense mesh reads its color values off the triangulation; they must be the ones the
+// topology implies, also where features meet and cross (many do on the astronaut).
+TEST(InitialMesh, ColorValuesAreTheTopologysOnAPhotograph) {
+  const auto path = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "astronaut.png";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  const Image8 img = read_image(path);
+  const ControlMesh mesh = build_initial_mesh(img, detect_features(img));
+  const MeshTopology topo = validate_level(mesh, img.width, img.height);
+  ASSERT_GT(mesh.features.size(), 100u);
+  int num_colors = 0;
+  EXPECT_EQ(face_varying_indices(mesh, topo, num_colors), mesh.triangle_colors);
+  EXPECT_EQ(num_colors, mesh.num_colors());
 }
 
 TEST(InitialMesh, CoarseGridKeepsPixelCentresNearFeaturesOnly) {
