@@ -617,12 +617,11 @@ StencilRows compose_rows(const Masks& masks, const StencilRows& in, std::span<co
   return out;
 }
 
-// compose_rows() with large row sets split over all cores; rows are independent, so the result is
-// the same for any split.
-StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
-                    bool sorted) {
+// compose_rows() with large row sets split over all cores, as parts in row order; rows are
+// independent, so the rows are the same for any split.
+std::vector<StencilRows> compose_parts(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows,
+                                       int num_control, bool sorted) {
   const int parts = rows.size() < 65536 ? 1 : resolve_threads(0);
-  if (parts == 1) return compose_rows(masks, in, rows, num_control, sorted);
   std::vector<StencilRows> part(parts);
   std::vector<std::thread> pool;
   auto run = [&](int i) {
@@ -632,14 +631,41 @@ StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const i
   for (int i = 1; i < parts; ++i) pool.emplace_back(run, i);
   run(0);
   for (std::thread& t : pool) t.join();
+  return part;
+}
+
+StencilRows compose(const Masks& masks, const StencilRows& in, std::span<const int32_t> rows, int num_control,
+                    bool sorted) {
+  std::vector<StencilRows> part = compose_parts(masks, in, rows, num_control, sorted);
   StencilRows out = std::move(part[0]);
-  for (int i = 1; i < parts; ++i) {
+  for (size_t i = 1; i < part.size(); ++i) {
     const int32_t base = static_cast<int32_t>(out.columns.size());
     for (size_t r = 1; r < part[i].offsets.size(); ++r) out.offsets.push_back(base + part[i].offsets[r]);
     out.columns.insert(out.columns.end(), part[i].columns.begin(), part[i].columns.end());
     out.weights.insert(out.weights.end(), part[i].weights.begin(), part[i].weights.end());
   }
   return out;
+}
+
+// The parts' rows, one after the other, as a compressed row-major matrix (written once, in place).
+SparseMatrix to_matrix(const std::vector<StencilRows>& parts, int num_control) {
+  int num_rows = 0;
+  size_t nnz = 0;
+  for (const StencilRows& p : parts) num_rows += p.num_rows(), nnz += p.columns.size();
+  SparseMatrix m(num_rows, num_control);
+  m.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  int32_t* offsets = m.outerIndexPtr();
+  int32_t* columns = m.innerIndexPtr();
+  double* weights = m.valuePtr();
+  int32_t row = 0, base = 0;
+  for (const StencilRows& p : parts) {
+    for (int r = 0; r < p.num_rows(); ++r) offsets[row++] = base + p.offsets[r];
+    std::copy(p.columns.begin(), p.columns.end(), columns + base);
+    std::copy(p.weights.begin(), p.weights.end(), weights + base);
+    base += static_cast<int32_t>(p.columns.size());
+  }
+  offsets[row] = base;
+  return m;
 }
 
 }  // namespace
@@ -696,10 +722,7 @@ SparseMatrix Subdivision::Impl::limit_stencils(bool face_varying) const {
     for (int i = 0; i < num_last; ++i) triplets.emplace_back(i, i, 1.0);
   }
   const std::vector<int32_t>& out_map = face_varying ? out_colors : out_vertices;
-  const StencilRows out = compose(group_masks(triplets, num_last), rows, out_map, num_control, true);
-  return Eigen::Map<const SparseMatrix>(static_cast<int32_t>(out_map.size()), num_control,
-                                        static_cast<int32_t>(out.columns.size()), out.offsets.data(),
-                                        out.columns.data(), out.weights.data());
+  return to_matrix(compose_parts(group_masks(triplets, num_last), rows, out_map, num_control, true), num_control);
 }
 
 const SparseMatrix& Subdivision::position_stencils() const {
