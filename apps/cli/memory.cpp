@@ -10,8 +10,21 @@
 
 namespace subvec_cli {
 
+// Under AddressSanitizer malloc is its own, and a 1 GB block would cost every run its shadow.
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+#define SUBVEC_TUNE_MEMORY 1
+#else
+#define SUBVEC_TUNE_MEMORY 0
+#endif
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#undef SUBVEC_TUNE_MEMORY
+#define SUBVEC_TUNE_MEMORY 0
+#endif
+#endif
+
 void tune_memory() {
-#if defined(__GLIBC__)
+#if SUBVEC_TUNE_MEMORY
   constexpr size_t kReserve = size_t(1) << 30;
   constexpr uintptr_t kHugePage = uintptr_t(2) << 20;
   mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
