@@ -12,9 +12,6 @@
 #include <thread>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "assets.h"
 #include "editor.h"
@@ -185,13 +182,8 @@ bool is_loopback_host(const std::string& host) {
 }
 
 std::string png_bytes(const subvec::Image8& image) {
-  cv::Mat mat(image.height, image.width, image.channels == 4 ? CV_8UC4 : CV_8UC3,
-              const_cast<uint8_t*>(image.pixels.data()));
-  cv::Mat bgr;
-  cv::cvtColor(mat, bgr, image.channels == 4 ? cv::COLOR_RGBA2BGRA : cv::COLOR_RGB2BGR);
-  std::vector<uchar> out;
-  if (!cv::imencode(".png", bgr, out)) throw Error(ErrorCode::kIo, "PNG encoding failed");
-  return std::string(out.begin(), out.end());
+  const std::vector<uint8_t> png = subvec::encode_png(image);
+  return std::string(png.begin(), png.end());
 }
 
 }  // namespace

@@ -19,9 +19,14 @@
 // are muted during the decode; libjpeg may still print a warning about a damaged but readable JPEG
 // ("Corrupt JPEG data: ...").
 //
-// Writing: encoded to memory, then written atomically.
+// OpenCV's image codecs depend on some 120 shared libraries (GDAL, GDCM, HDF5, poppler, ...), and
+// loading them cost every start of a program 0.15 s. PNG, what the tools read and write most, goes
+// through libpng; the codecs are loaded (dlopen) when the first other image is read.
+//
+// Writing: PNG through libpng, encoded to memory, then written atomically.
 #include "subvec/io/image_io.h"
 
+#include <dlfcn.h>
 #include <png.h>
 
 #include <array>
@@ -36,6 +41,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "subvec/core/error.h"
@@ -95,6 +101,23 @@ class MutedCerr {
     return s;
   }
 };
+
+// cv::imdecode from OpenCV's codec library, loaded on first use (see the top of this file), or
+// what kept it from loading.
+using Imdecode = cv::Mat (*)(cv::InputArray, int);
+// Compiles only while the header declares cv::imdecode with this type (unevaluated: not linked).
+static_assert(sizeof(static_cast<Imdecode>(&cv::imdecode)) > 0);
+std::pair<Imdecode, std::string> load_imdecode() {
+  static const std::pair<Imdecode, std::string> loaded = []() -> std::pair<Imdecode, std::string> {
+    void* library = dlopen(SUBVEC_OPENCV_IMGCODECS, RTLD_NOW | RTLD_LOCAL);
+    if (library == nullptr) return {nullptr, dlerror()};
+    // cv::imdecode(cv::InputArray, int) under its C++ (Itanium ABI) name.
+    void* symbol = dlsym(library, "_ZN2cv8imdecodeERKNS_11_InputArrayEi");
+    if (symbol == nullptr) return {nullptr, dlerror()};
+    return {reinterpret_cast<Imdecode>(symbol), ""};
+  }();
+  return loaded;
+}
 
 uint32_t big_endian_u32(const uint8_t* p) {
   return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
@@ -484,11 +507,13 @@ Image8 read_image(const fs::path& path, int64_t max_pixels) {
   if (is_png(bytes)) {
     decoded = decode_png(bytes, path, max_pixels);
   } else {
+    const auto [imdecode, why] = load_imdecode();
+    if (imdecode == nullptr) fail(ErrorCode::kIo, path, "OpenCV's image codecs did not load (" + why + ")");
     try {
       // cv::imdecode takes a non-const Mat header over the buffer but does not write to it.
       const cv::Mat buffer(1, int(bytes.size()), CV_8U, const_cast<uint8_t*>(bytes.data()));
       const MutedCerr quiet;
-      decoded = cv::imdecode(buffer, flags);
+      decoded = imdecode(buffer, flags);
     } catch (const cv::Exception&) {
       decoded.release();
     }
@@ -529,26 +554,64 @@ Image8 read_image(const fs::path& path, int64_t max_pixels) {
   return image;
 }
 
+namespace {
+
+void png_write_bytes(png_structp png, png_bytep data, png_size_t n) {
+  auto* out = static_cast<std::vector<uint8_t>*>(png_get_io_ptr(png));
+  try {
+    out->insert(out->end(), data, data + n);
+  } catch (const std::bad_alloc&) {
+    png_error(png, "out of memory");
+  }
+}
+void png_flush(png_structp) {}
+
+}  // namespace
+
+std::vector<uint8_t> encode_png(const Image8& image) {
+  if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
+      image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
+    throw Error(ErrorCode::kInvalidArgument, "PNG encoding: the image is empty or malformed");
+  }
+  PngError error;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_on_error, png_on_warning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, &info);
+    throw std::bad_alloc();
+  }
+  std::vector<uint8_t> out;
+  std::vector<png_bytep> rows(image.height);
+  for (int y = 0; y < image.height; ++y) rows[y] = const_cast<png_bytep>(image.row(y));
+  // libpng reports errors by longjmp back here; only C frames and the callbacks lie between.
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    throw Error(ErrorCode::kIo, "PNG encoding failed (" + error.message + ")");
+  }
+  png_set_write_fn(png, &out, png_write_bytes, png_flush);
+  png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), 8,
+               image.channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, 1);  // fast: renders are written often and read once
+  png_write_info(png, info);
+  png_write_image(png, rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
+}
+
 void write_png(const fs::path& path, const Image8& image) {
-  silence_opencv();
   if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
       image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
     throw Error(ErrorCode::kInvalidArgument,
                 "cannot write " + in_quotes(path) + ": the image is empty or malformed");
   }
-  // A header over the caller's pixels (not written to), then RGB(A) -> BGR(A) for OpenCV.
-  const cv::Mat rgb(image.height, image.width, CV_8UC(image.channels),
-                    const_cast<uint8_t*>(image.pixels.data()));
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, image.channels == 4 ? cv::COLOR_RGBA2BGRA : cv::COLOR_RGB2BGR);
   std::vector<uint8_t> encoded;
-  bool ok = false;
   try {
-    ok = cv::imencode(".png", bgr, encoded);
-  } catch (const cv::Exception&) {
-    ok = false;
+    encoded = encode_png(image);
+  } catch (const Error& e) {
+    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": " + e.what());
   }
-  if (!ok) throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": PNG encoding failed");
   write_file_atomic(path, encoded);
 }
 

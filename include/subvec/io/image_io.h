@@ -1,7 +1,9 @@
-// Raster image files through OpenCV.
+// Raster image files: PNG through libpng, the other formats through OpenCV's codecs.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "subvec/core/image.h"
 
@@ -12,6 +14,10 @@ namespace subvec {
 // EXIF orientation applied. Images over `max_pixels` are refused, from the header before decoding
 // (PNG, JPEG, BMP, WebP, classic TIFF). Throws Error(kIo / kBadFile / kLimit) with the path in the message.
 Image8 read_image(const std::filesystem::path& path, int64_t max_pixels = int64_t{1} << 28);
+
+// The PNG file (8-bit RGB or RGBA) of an image. Throws Error(kInvalidArgument) for an empty or
+// malformed image, Error(kIo) if encoding fails.
+std::vector<uint8_t> encode_png(const Image8& image);
 
 // Writes a PNG (RGB or RGBA) atomically: to a temporary file beside `path`, then renamed.
 void write_png(const std::filesystem::path& path, const Image8& image);
