@@ -15,6 +15,7 @@
 #include "subvec/io/file.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/validate.h"
+#include "validators.h"
 
 namespace subvec_cli {
 namespace {
@@ -151,13 +152,7 @@ void add_edit_commands(CLI::App& app) {
       stylize->add_option("--threshold", sa.threshold,
                           "Saliency threshold; features at or above it always get a stroke "
                           "(default: the median over the region)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v);
-                return ok ? std::string() : "expected a number, got '" + text + "'";
-              },
-              "NUMBER", "finite"));
+          ->check(finite_number());
   stylize->add_option("--seed", sa.seed, "Seed for choosing features below the threshold (default 1)");
   stylize
       ->add_option("--probability", sa.probability,

@@ -38,6 +38,7 @@
 #include "memory.h"
 #include "progress.h"
 #include "pyramid_commands.h"  // levels: vectorize --levels, filter
+#include "validators.h"
 #include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
 #include "serve_command.h"
@@ -555,13 +556,7 @@ int run(int argc, char** argv) {
       render
           ->add_option("--scale", ra.scale,
                        "Output size as a multiple of the window's size (default 1)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0;
-                return ok ? std::string() : "expected a positive number, got '" + text + "'";
-              },
-              "POSITIVE", "positive"));
+          ->check(subvec_cli::positive_number());
   width_opt->excludes(scale_opt);
   render
       ->add_option("--window", ra.window,
@@ -598,13 +593,7 @@ int run(int argc, char** argv) {
       ->add_option("--tolerance", ra.tolerance,
                    ".pdf, .svg: largest deviation of the drawn triangles from the limit surface, in "
                    "output pixels (default 0.25)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            double v = 0;
-            const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0;
-            return ok ? std::string() : "expected a positive number, got '" + text + "'";
-          },
-          "POSITIVE", "positive"));
+      ->check(subvec_cli::positive_number());
   render
       ->add_option("--pdf-target", ra.pdf_target,
                    ".pdf: the viewers the shading is built for: any (default; one RGB Gouraud "

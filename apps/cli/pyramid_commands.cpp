@@ -8,6 +8,7 @@
 #include "subvec/core/error.h"
 #include "subvec/io/svec.h"
 #include "subvec/pyramid/pyramid.h"
+#include "validators.h"
 
 namespace subvec_cli {
 namespace {
@@ -136,13 +137,7 @@ void add_pyramid_commands(CLI::App& app) {
       "filter", "Smooth or enhance a multilevel vector image through its pyramid (paper 6.4)");
   filter->add_option("input", fa.input, "Vector image with levels (vectorize --levels)")->required();
   filter->add_option("-o,--output", fa.output, "Output vector image (.svec or .svec.json)")->required();
-  auto finite = CLI::Validator(
-      [](std::string& text) {
-        double v = 0;
-        const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v);
-        return ok ? std::string() : "expected a number, got '" + text + "'";
-      },
-      "NUMBER", "finite");
+  const CLI::Validator finite = finite_number();
   CLI::Option* eta = filter->add_option("--eta", fa.eta,
                                         "Detail scale for every band: < 1 smooths, > 1 enhances (default 1)")
                          ->check(finite);

@@ -2,8 +2,9 @@
 #include "vectorize_options.h"
 
 #include <charconv>
-#include <cmath>
 #include <sstream>
+
+#include "validators.h"
 
 namespace subvec_cli {
 
@@ -12,41 +13,12 @@ void add_vertex_count_options(CLI::App* command, VectorizeParams& params) {
       command
           ->add_option("--ratio", params.ratio,
                        "Control vertices as a fraction of the pixel count (default 0.01)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                const bool ok =
-                    CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v > 0 && v <= 1;
-                return ok ? std::string() : "expected a number in (0, 1], got '" + text + "'";
-              },
-              "RATIO", "ratio"));
+          ->check(fraction());
   CLI::Option* vertices =
       command->add_option("--vertices", params.vertices, "Control vertex count instead of --ratio")
           ->check(CLI::Range(4, 1 << 26));
   ratio->excludes(vertices);
 }
-
-namespace {
-
-// A finite number in [lo, hi], named in the error.
-CLI::Validator number_in(double lo, double hi) {
-  return CLI::Validator(
-      [lo, hi](std::string& text) {
-        double v = 0;
-        if (CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v >= lo && v <= hi) return std::string();
-        std::ostringstream s;
-        s << "expected a number in [" << lo << ", " << hi << "], got '" << text << "'";
-        return s.str();
-      },
-      [lo, hi] {
-        std::ostringstream s;
-        s << "FLOAT in [" << lo << " - " << hi << "]";
-        return s.str();
-      }(),
-      "number_in");
-}
-
-}  // namespace
 
 void add_quality_options(CLI::App* command, VectorizeParams& params) {
   command
@@ -75,62 +47,51 @@ void add_quality_options(CLI::App* command, VectorizeParams& params) {
                    "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
       ->check(CLI::Range(0, 2));
 
-  // The feature detector (FeatureOptions, features.h); defaults as the library's.
+  // The feature detector (FeatureOptions, features.h), defaults as the library's, and the
+  // simplifier's feature bound: finite numbers in a range.
   const subvec::FeatureOptions d;
   auto text = [](double v) {
     std::ostringstream s;
     s << v;
     return s.str();
   };
-  const std::string group = "Features";
-  command
-      ->add_option("--edge-blur", params.features.blur_sigma,
-                   "Gaussian blur before the color gradient, pixels (default " + text(d.blur_sigma) +
-                       ")")
-      ->check(number_in(0, 20))
-      ->group(group);
-  command
-      ->add_option("--edge-quantile", params.features.high_quantile,
-                   "Canny's high threshold as this quantile of the image's gradient magnitudes "
-                   "(default " + text(d.high_quantile) + ")")
-      ->check(number_in(0.01, 0.999))
-      ->group(group);
-  command
-      ->add_option("--edge-min-threshold", params.features.min_high_threshold,
-                   "Floor on the high threshold, gray levels per pixel, so that flat or noisy "
-                   "images do not sprout features (default " + text(d.min_high_threshold) + ")")
-      ->check(number_in(0, 1e4))
-      ->group(group);
-  command
-      ->add_option("--edge-low-ratio", params.features.low_ratio,
-                   "Canny's low threshold as a fraction of the high one (default " +
-                       text(d.low_ratio) + ")")
-      ->check(number_in(0.01, 1))
-      ->group(group);
-  command
-      ->add_option("--min-feature-length", params.features.min_length,
-                   "Shorter features are dropped, pixels (default " + text(d.min_length) +
-                       "; a length beyond the image keeps none)")
-      ->check(number_in(0, 1e6))
-      ->group(group);
-  command
-      ->add_option("--spur-length", params.features.spur_length,
-                   "Branches shorter than this at a junction are pruned, pixels (default " +
-                       text(d.spur_length) + ")")
-      ->check(number_in(0, 1e3))
-      ->group(group);
-  command
-      ->add_option("--max-gap", params.features.max_gap,
-                   "Feature ends closer than this are joined, pixels (default " + text(d.max_gap) +
-                       ")")
-      ->check(number_in(0, 100))
-      ->group(group);
-  command
-      ->add_option("--max-feature-error", params.max_feature_error,
-                   "Simplification keeps every feature's limit curve this close to the detected "
-                   "edge, pixels (default 1)")
-      ->check(number_in(0.05, 100))
-      ->group(group);
+  struct NumberOption {
+    const char* flag;
+    double* value;
+    std::string help;
+    double lo, hi;
+  };
+  subvec::FeatureOptions& f = params.features;
+  const NumberOption feature_options[] = {
+      {"--edge-blur", &f.blur_sigma,
+       "Gaussian blur before the color gradient, pixels (default " + text(d.blur_sigma) + ")", 0, 20},
+      {"--edge-quantile", &f.high_quantile,
+       "Canny's high threshold as this quantile of the image's gradient magnitudes (default " +
+           text(d.high_quantile) + ")",
+       0.01, 0.999},
+      {"--edge-min-threshold", &f.min_high_threshold,
+       "Floor on the high threshold, gray levels per pixel, so that flat or noisy images do not "
+       "sprout features (default " + text(d.min_high_threshold) + ")",
+       0, 1e4},
+      {"--edge-low-ratio", &f.low_ratio,
+       "Canny's low threshold as a fraction of the high one (default " + text(d.low_ratio) + ")", 0.01, 1},
+      {"--min-feature-length", &f.min_length,
+       "Shorter features are dropped, pixels (default " + text(d.min_length) +
+           "; a length beyond the image keeps none)",
+       0, 1e6},
+      {"--spur-length", &f.spur_length,
+       "Branches shorter than this at a junction are pruned, pixels (default " + text(d.spur_length) + ")", 0,
+       1e3},
+      {"--max-gap", &f.max_gap, "Feature ends closer than this are joined, pixels (default " + text(d.max_gap) + ")",
+       0, 100},
+      {"--max-feature-error", &params.max_feature_error,
+       "Simplification keeps every feature's limit curve this close to the detected edge, pixels "
+       "(default 1)",
+       0.05, 100},
+  };
+  for (const NumberOption& o : feature_options) {
+    command->add_option(o.flag, *o.value, o.help)->check(number_in(o.lo, o.hi))->group("Features");
+  }
 }
 
 std::string parse_rect(const std::string& text, subvec::PixelRect& r) {
