@@ -583,19 +583,39 @@ void Simplifier::setup() {
       if (kind_[nodes_[i].vertex] != Kind::kFeature) corner_nodes_[fill[nodes_[i].vertex]++] = i;
   }
 
-  // Quadrics per color index from the corners' 5D points.
-  quadric_.assign(mesh_.num_colors(), Quadric{});
+  // Quadrics per color index from the corners' 5D points, each the sum of its faces' quadrics in
+  // face order. The color indices are cut into ranges over the threads; each thread visits every
+  // face and computes the quadric of those with a corner in its range (colors follow the vertex
+  // order, so few faces straddle two ranges and are computed twice). The sums do not depend on
+  // the thread count.
+  const int nc = mesh_.num_colors();
+  quadric_.assign(nc, Quadric{});
   const double cs = options_.color_scale;
-  for (int f = 0; f < nf; ++f) {
-    Point5 p[3];
-    for (int k = 0; k < 3; ++k) {
-      const Vec2 x = pos_[mesh_.triangles[f][k]];
-      const Color c = mesh_.colors[mesh_.triangle_colors[f][k]];
-      p[k] = {x.x, x.y, cs * c.r, cs * c.g, cs * c.b};
+  const int parts = std::min(detail::resolve_threads(options_.threads), std::max(1, nc / 4096));
+  detail::parallel_for(parts, parts, [&](int part) {
+    const int32_t begin = static_cast<int32_t>(int64_t(nc) * part / parts);
+    const int32_t end = static_cast<int32_t>(int64_t(nc) * (part + 1) / parts);
+    for (int f = 0; f < nf; ++f) {
+      const Tri& t = mesh_.triangles[f];
+      const Tri& colors = mesh_.triangle_colors[f];
+      int32_t target[3];
+      bool any = false;
+      for (int k = 0; k < 3; ++k) {
+        target[k] = color_of[colors[k]];
+        any |= target[k] >= begin && target[k] < end;
+      }
+      if (!any) continue;
+      Point5 p[3];
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 x = pos_[t[k]];
+        const Color c = mesh_.colors[colors[k]];
+        p[k] = {x.x, x.y, cs * c.r, cs * c.g, cs * c.b};
+      }
+      const Quadric q = triangle_quadric(p[0], p[1], p[2]);
+      for (int k = 0; k < 3; ++k)
+        if (target[k] >= begin && target[k] < end) quadric_[target[k]] += q;
     }
-    const Quadric q = triangle_quadric(p[0], p[1], p[2]);
-    for (int k = 0; k < 3; ++k) quadric_[color_of[mesh_.triangle_colors[f][k]]] += q;
-  }
+  });
 }
 
 // The distinct neighbours of v, in no particular order.
