@@ -136,10 +136,12 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   }
 
   // Face-varying colors: the corners of a vertex share one color value unless a tear (a
-  // constrained interior edge) separates them. A union of the corners across every other interior
-  // edge, read off the triangulation's adjacency; values numbered in order of first use, as
-  // face_varying_indices() (topology.h) numbers them.
+  // constrained interior edge) separates them; values numbered in order of first use, as
+  // face_varying_indices() (topology.h) numbers them. Only vertices on a constraint can have
+  // several: around each of those, a union of the corners across every unconstrained edge, read
+  // off the triangulation's adjacency.
   const int nf = mesh.num_triangles();
+  std::vector<uint8_t> on_constraint(mesh.num_vertices(), 0);
   std::vector<int32_t> parent(size_t(nf) * 3);
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int32_t x) {
@@ -150,21 +152,28 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     a = find(a), b = find(b);
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
   };
-  for (auto f : cdt.finite_face_handles()) {
-    for (int j = 0; j < 3; ++j) {
-      const auto g = f->neighbor(j);
-      if (cdt.is_infinite(g) || g->info() < f->info() || f->is_constrained(j)) continue;
-      for (const int k : {CdtPlus::ccw(j), CdtPlus::cw(j)}) {
-        unite(3 * f->info() + k, 3 * g->info() + g->index(f->vertex(k)));
-      }
+  for (CdtPlus::Constraint_id cid : ids) {
+    for (auto it = cdt.vertices_in_constraint_begin(cid); it != cdt.vertices_in_constraint_end(cid); ++it) {
+      const auto v = *it;
+      if (on_constraint[v->info()]) continue;
+      on_constraint[v->info()] = 1;
+      auto face = cdt.incident_faces(v);
+      const auto first = face;
+      do {
+        const auto f = face, g = std::next(face);
+        if (cdt.is_infinite(f) || cdt.is_infinite(g)) continue;
+        const int j = f->index(g);  // the edge f and g share (it ends at v)
+        if (!f->is_constrained(j)) unite(3 * f->info() + f->index(v), 3 * g->info() + g->index(v));
+      } while (++face != first);
     }
   }
   int num_colors = 0;
   mesh.triangle_colors.resize(nf);
   {
-    std::vector<int32_t> index(parent.size(), -1);
+    std::vector<int32_t> index(parent.size(), -1), vertex_color(mesh.num_vertices(), -1);
     for (int32_t c = 0; c < 3 * nf; ++c) {
-      int32_t& id = index[find(c)];
+      const int32_t v = mesh.triangles[c / 3][c % 3];
+      int32_t& id = on_constraint[v] ? index[find(c)] : vertex_color[v];
       if (id < 0) id = num_colors++;
       mesh.triangle_colors[c / 3][c % 3] = id;
     }
