@@ -73,11 +73,14 @@ const uint8_t* pixel_at(const Image8& image, int x, int y) { return image.row(y)
 double triangle_error(const Image8& image, Vec2 p0, Vec2 p1, Vec2 p2, Color c0, Color c1, Color c2,
                       double min_area) {
   double sum = 0;
-  const bool thick = for_each_pixel(p0, p1, p2, image, min_area, [&](int x, int y, double w0, double w1, double w2) {
+  // The interpolated color is linear: c0 + (c1 - c0) w1 + (c2 - c0) w2.
+  const double r1 = c1.r - c0.r, g1 = c1.g - c0.g, b1 = c1.b - c0.b;
+  const double r2 = c2.r - c0.r, g2 = c2.g - c0.g, b2 = c2.b - c0.b;
+  const bool thick = for_each_pixel(p0, p1, p2, image, min_area, [&](int x, int y, double, double w1, double w2) {
     const uint8_t* px = pixel_at(image, x, y);
-    const double er = w0 * c0.r + w1 * c1.r + w2 * c2.r - px[0];
-    const double eg = w0 * c0.g + w1 * c1.g + w2 * c2.g - px[1];
-    const double eb = w0 * c0.b + w1 * c1.b + w2 * c2.b - px[2];
+    const double er = c0.r + w1 * r1 + w2 * r2 - px[0];
+    const double eg = c0.g + w1 * g1 + w2 * g2 - px[1];
+    const double eb = c0.b + w1 * b1 + w2 * b2 - px[2];
     sum += er * er + eg * eg + eb * eb;
   });
   return thick ? sum : -1;
@@ -141,10 +144,13 @@ struct Tracker {
   }
   // Faces `changed` have new corners, positions or colors.
   void update(const ControlMesh& mesh, const Image8& image, const std::vector<int>& changed, int threads) {
+    std::vector<double> errors(changed.size());
     parallel_range(static_cast<int>(changed.size()), threads,
-                   [&](int i) { error[changed[i]] = face_error(mesh, image, changed[i]); });
-    for (int f : changed) flip_dirty[f] = 1, changed_at[f] = epoch;
+                   [&](int i) { errors[i] = face_error(mesh, image, changed[i]); });
+    for (size_t i = 0; i < changed.size(); ++i) set(changed[i], errors[i]);
   }
+  // Face f changed and has this error.
+  void set(int f, double face_error) { error[f] = face_error, flip_dirty[f] = 1, changed_at[f] = epoch; }
   double total() const {
     double sum = 0;
     for (double e : error) sum += e;
@@ -279,16 +285,18 @@ Freedom freedom_of(const ControlMesh& mesh, const MeshTopology& topo, const Imag
 }
 
 // One Gauss-Newton step for vertex v on its free coordinates and the colors of its corners (one
-// per side of a tear), kept only when the one-ring's error falls; returns whether it was kept.
-bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& image, int32_t v,
-                 const RefineOptions& options) {
+// per side of a tear), kept only when the one-ring's error, `before` now, falls; returns whether it
+// was kept, and then the new error of each face of the ring (in topo.faces_of(v) order, measured
+// as face_error() measures it) in `face_errors`.
+bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& image, int32_t v, double before,
+                 const RefineOptions& options, std::vector<double>& face_errors) {
   constexpr int kMaxSides = 4;
-  // The one-ring as (p1, p2) with v first in each face's order, those corners' colors, and which
-  // of v's color values (sides) the face uses.
+  // The one-ring as (p1, p2) with v first in each face's order, those corners' colors, which of
+  // v's color values (sides) the face uses, and v's corner in the face.
   struct Wedge {
     Vec2 p1, p2;
     Color c1, c2;
-    int side;
+    int side, corner;
   };
   std::vector<Wedge> ring;
   std::array<int32_t, kMaxSides> side_color{};
@@ -302,7 +310,7 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
       if (sides == kMaxSides) return false;
       side_color[sides++] = k[i];
     }
-    ring.push_back({mesh.positions[t[i1]], mesh.positions[t[i2]], mesh.colors[k[i1]], mesh.colors[k[i2]], side});
+    ring.push_back({mesh.positions[t[i1]], mesh.positions[t[i2]], mesh.colors[k[i1]], mesh.colors[k[i2]], side, i});
   }
   const Freedom free = freedom_of(mesh, topo, image, v);
   const Vec2 x = mesh.positions[v];
@@ -318,14 +326,24 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
   const double quality_floor =
       options.min_move_quality > 0 ? std::min(ring_quality(mesh.positions[v]), options.min_move_quality) : 0;
   // The ring's error with v at x and colors c; negative when a face gets too thin.
+  face_errors.resize(ring.size());
   auto ring_error = [&](Vec2 at, const std::array<Color, kMaxSides>& c) {
     if (quality_floor > 0 && !(at == mesh.positions[v]) && ring_quality(at) < quality_floor) return -1.0;
     double sum = 0;
-    for (const Wedge& w : ring) {
+    for (size_t j = 0; j < ring.size(); ++j) {
+      const Wedge& w = ring[j];
       // Positive like every face (the error alone would accept a face turned over).
       if (!(signed_area(at, w.p1, w.p2) > options.min_area)) return -1.0;
-      const double e = triangle_error(image, at, w.p1, w.p2, c[w.side], w.c1, w.c2, options.min_area);
+      // In the face's own corner order, so that a pixel centre on an edge counts as face_error()
+      // counts it.
+      const int i = w.corner, i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      std::array<Vec2, 3> p;
+      std::array<Color, 3> k;
+      p[i] = at, p[i1] = w.p1, p[i2] = w.p2;
+      k[i] = c[w.side], k[i1] = w.c1, k[i2] = w.c2;
+      const double e = triangle_error(image, p[0], p[1], p[2], k[0], k[1], k[2], options.min_area);
       if (e < 0) return -1.0;
+      face_errors[j] = e;
       sum += e;
     }
     return sum;
@@ -337,7 +355,6 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
   const int n = 2 + 3 * sides;
   Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd jtr = Eigen::VectorXd::Zero(n);
-  double before = 0;
   for (const Wedge& w : ring) {
     const Vec2 p1 = w.p1, p2 = w.p2;
     const double inv = 1 / signed_area(x, p1, p2);
@@ -353,7 +370,6 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
       for (int ch = 0; ch < 3; ++ch) {
         const double f = w0 * cv[ch] + w1 * c1[ch] + w2 * c2[ch];
         const double r = f - target[ch];
-        before += r * r;
         const double jx = (c1[ch] * g1x + c2[ch] * g2x - f * ax) * inv;
         const double jy = (c1[ch] * g1y + c2[ch] * g2y - f * ay) * inv;
         // Jacobian row (jx, jy, and w0 in this side's and channel's color column).
@@ -402,23 +418,27 @@ int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& o
   const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
   int moves = 0;
   for (const std::vector<int32_t>& members : vertex_classes(mesh, topo)) {
-    // 0: not tried (its ring is as it was when its move was last refused), 1: refused, 2: moved.
+    // 0: not tried (its ring is as it was when its move was last refused), 1: refused, 2: moved;
+    // and a moved vertex's ring errors.
     std::vector<char> outcome(members.size(), 0);
+    std::vector<std::vector<double>> ring_errors(members.size());
     parallel_range(static_cast<int>(members.size()), threads, [&](int i) {
       const int32_t v = members[i];
       bool ring_changed = track.refused_at[v] < 0;
       for (auto [it, end] = topo.faces_of(v); it != end && !ring_changed; ++it)
         ring_changed = track.changed_at[*it] > track.refused_at[v];
-      if (ring_changed) outcome[i] = move_vertex(mesh, topo, image, v, options) ? 2 : 1;
+      if (!ring_changed) return;
+      double before = 0;
+      for (auto [it, end] = topo.faces_of(v); it != end; ++it) before += track.error[*it];
+      outcome[i] = move_vertex(mesh, topo, image, v, before, options, ring_errors[i]) ? 2 : 1;
     });
-    std::vector<int> changed;
     for (size_t i = 0; i < members.size(); ++i) {
       if (outcome[i] == 1) track.refused_at[members[i]] = track.epoch;
       if (outcome[i] != 2) continue;
       ++moves;
-      for (auto [it, end] = topo.faces_of(members[i]); it != end; ++it) changed.push_back(*it);
+      int k = 0;
+      for (auto [it, end] = topo.faces_of(members[i]); it != end; ++it) track.set(*it, ring_errors[i][k++]);
     }
-    track.update(mesh, image, changed, threads);
     ++track.epoch;
   }
   return moves;
