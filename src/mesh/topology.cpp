@@ -4,6 +4,7 @@
 #include <numeric>
 #include <string>
 
+#include "mesh/disjoint_sets_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -178,17 +179,7 @@ MeshTopology MeshTopology::build(const ControlMesh& mesh, int width, int height)
 
 std::vector<Tri> face_varying_indices(const ControlMesh& mesh, const MeshTopology& topo, int& num_colors) {
   const int nf = mesh.num_triangles();
-  // Union-find over the 3F corners.
-  std::vector<int32_t> parent(size_t(nf) * 3);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  auto unite = [&](int32_t a, int32_t b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
+  detail::DisjointSets corners(size_t(nf) * 3);  // over the 3F corners
   auto corner = [&](int f, int v) {
     for (int k = 0; k < 3; ++k)
       if (mesh.triangles[f][k] == v) return f * 3 + k;
@@ -197,13 +188,13 @@ std::vector<Tri> face_varying_indices(const ControlMesh& mesh, const MeshTopolog
   for (int e = 0; e < topo.num_edges(); ++e) {
     const auto [f, g] = topo.edge_faces[e];
     if (g < 0 || topo.edge_tags[e] == EdgeTag::kTear) continue;
-    for (int v : topo.edges[e]) unite(corner(f, v), corner(g, v));
+    for (int v : topo.edges[e]) corners.unite(corner(f, v), corner(g, v));
   }
-  std::vector<int32_t> index(parent.size(), -1);
+  std::vector<int32_t> index(size_t(nf) * 3, -1);
   std::vector<Tri> out(nf);
   num_colors = 0;
   for (int c = 0; c < nf * 3; ++c) {
-    int32_t& id = index[find(c)];
+    int32_t& id = index[corners.find(c)];
     if (id < 0) id = num_colors++;
     out[c / 3][c % 3] = id;
   }

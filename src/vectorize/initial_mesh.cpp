@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <set>
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
@@ -13,6 +12,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include "mesh/disjoint_sets_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -142,16 +142,7 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   // off the triangulation's adjacency.
   const int nf = mesh.num_triangles();
   std::vector<uint8_t> on_constraint(mesh.num_vertices(), 0);
-  std::vector<int32_t> parent(size_t(nf) * 3);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  auto unite = [&](int32_t a, int32_t b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
+  detail::DisjointSets corners(size_t(nf) * 3);
   for (CdtPlus::Constraint_id cid : ids) {
     for (auto it = cdt.vertices_in_constraint_begin(cid); it != cdt.vertices_in_constraint_end(cid); ++it) {
       const auto v = *it;
@@ -163,17 +154,17 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
         const auto f = face, g = std::next(face);
         if (cdt.is_infinite(f) || cdt.is_infinite(g)) continue;
         const int j = f->index(g);  // the edge f and g share (it ends at v)
-        if (!f->is_constrained(j)) unite(3 * f->info() + f->index(v), 3 * g->info() + g->index(v));
+        if (!f->is_constrained(j)) corners.unite(3 * f->info() + f->index(v), 3 * g->info() + g->index(v));
       } while (++face != first);
     }
   }
   int num_colors = 0;
   mesh.triangle_colors.resize(nf);
   {
-    std::vector<int32_t> index(parent.size(), -1), vertex_color(mesh.num_vertices(), -1);
+    std::vector<int32_t> index(size_t(nf) * 3, -1), vertex_color(mesh.num_vertices(), -1);
     for (int32_t c = 0; c < 3 * nf; ++c) {
       const int32_t v = mesh.triangles[c / 3][c % 3];
-      int32_t& id = on_constraint[v] ? index[find(c)] : vertex_color[v];
+      int32_t& id = on_constraint[v] ? index[corners.find(c)] : vertex_color[v];
       if (id < 0) id = num_colors++;
       mesh.triangle_colors[c / 3][c % 3] = id;
     }
