@@ -425,12 +425,12 @@ int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& o
     parallel_range(static_cast<int>(members.size()), threads, [&](int i) {
       const int32_t v = members[i];
       bool ring_changed = track.refused_at[v] < 0;
-      for (auto [it, end] = topo.faces_of(v); it != end && !ring_changed; ++it)
-        ring_changed = track.changed_at[*it] > track.refused_at[v];
-      if (!ring_changed) return;
       double before = 0;
-      for (auto [it, end] = topo.faces_of(v); it != end; ++it) before += track.error[*it];
-      outcome[i] = move_vertex(mesh, topo, image, v, before, options, ring_errors[i]) ? 2 : 1;
+      for (auto [it, end] = topo.faces_of(v); it != end; ++it) {
+        ring_changed |= track.changed_at[*it] > track.refused_at[v];
+        before += track.error[*it];
+      }
+      if (ring_changed) outcome[i] = move_vertex(mesh, topo, image, v, before, options, ring_errors[i]) ? 2 : 1;
     });
     for (size_t i = 0; i < members.size(); ++i) {
       if (outcome[i] == 1) track.refused_at[members[i]] = track.epoch;
