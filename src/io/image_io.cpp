@@ -571,7 +571,7 @@ void png_flush(png_structp) {}
 std::vector<uint8_t> encode_png(const Image8& image) {
   if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
       image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
-    throw Error(ErrorCode::kInvalidArgument, "PNG encoding: the image is empty or malformed");
+    throw Error(ErrorCode::kInvalidArgument, "the image is empty or malformed");
   }
   PngError error;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_on_error, png_on_warning);
@@ -601,16 +601,11 @@ std::vector<uint8_t> encode_png(const Image8& image) {
 }
 
 void write_png(const fs::path& path, const Image8& image) {
-  if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
-      image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "cannot write " + in_quotes(path) + ": the image is empty or malformed");
-  }
   std::vector<uint8_t> encoded;
   try {
     encoded = encode_png(image);
   } catch (const Error& e) {
-    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": " + e.what());
+    throw Error(e.code(), "cannot write " + in_quotes(path) + ": " + e.what());
   }
   write_file_atomic(path, encoded);
 }
