@@ -268,7 +268,7 @@ int default_fit_depth(const ControlMesh& mesh) {
   }
   double mean = count ? total / count : 0;
   int depth = 0;
-  while (mean > 2.5 && depth < 5) mean /= 2, ++depth;
+  while (mean > kFitEdgePixels && depth < 5) mean /= 2, ++depth;
   return depth;
 }
 
