@@ -44,7 +44,7 @@ void add_quality_options(CLI::App* command, VectorizeParams& params) {
   command
       ->add_option("--grid-step", params.grid_step,
                    "Dense mesh away from features: 1 a vertex per pixel, 2 per 2x2 block, 0 "
-                   "automatic (default: 2 over 2^20 pixels at ratios up to 1/16)")
+                   "automatic (default: 2 from 2^18 pixels, 512x512, at ratios up to 1/16)")
       ->check(CLI::Range(0, 2));
 
   // The feature detector (FeatureOptions, features.h), defaults as the library's, and the

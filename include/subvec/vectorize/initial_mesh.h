@@ -19,7 +19,8 @@ struct InitialMeshOptions {
   // 1: a vertex at every pixel centre. 2: away from the features, one vertex per 2 x 2 block at
   // its centre (a pixel corner, whose bilinear color is the block's mean); blocks with a pixel
   // within `fine_band` of a feature keep their pixel centres. 0: automatic in vectorize() (2 for
-  // images over 2^20 pixels when the target is at most 1/16 of the pixels, else 1); here, 1.
+  // images of 2^18 pixels (512 x 512) or more when the target is at most 1/16 of the pixels,
+  // else 1); here, 1.
   int grid_step = 0;
   double fine_band = 3.0;
 };
