@@ -296,6 +296,40 @@ TEST(ColorFit, ReweightingResistsOutliers) {
   EXPECT_THROW(fit_colors(mesh, clean.width, clean.height, noisy, bad), Error);
 }
 
+// The fit refines one level coarser than the renderer draws (kFitEdgePixels, docs/vectorize.md "Fit
+// depth"): its refined edges average at most 5 px, and the rendered image is within 1 % of the one
+// fitted at the renderer's depth, on a crop of the bundled photograph.
+TEST(ColorFit, OneLevelCoarserThanTheRendererCostsUnderOnePercent) {
+  const Image8 photo = read_image(std::filesystem::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png");
+  Image8 crop(200, 160, 3);
+  for (int y = 0; y < crop.height; ++y) std::copy_n(photo.row(y + 60) + 3 * 100, 3 * crop.width, crop.row(y));
+  VectorizeOptions options;
+  options.ratio = 0.01;
+  VectorImage image = vectorize(crop, options);
+  const int depth = default_fit_depth(image.levels[0]);
+  ASSERT_GE(depth, 1);
+  double total = 0;
+  int count = 0;
+  for (const Tri& t : image.levels[0].triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 a = image.levels[0].positions[t[k]], b = image.levels[0].positions[t[(k + 1) % 3]];
+      total += std::hypot(b.x - a.x, b.y - a.y), ++count;
+    }
+  }
+  const double refined_edge = total / count / std::pow(2.0, depth);
+  EXPECT_LE(refined_edge, kFitEdgePixels);
+  EXPECT_GT(refined_edge, kFitEdgePixels / 2);  // one level less would be over the limit
+  auto rendered_error = [&](int fit_depth) {
+    VectorImage fitted = image;
+    ColorFitOptions fit;
+    fit.depth = fit_depth;
+    fit_colors(fitted.levels[0], crop.width, crop.height, crop, fit);
+    return compare(crop, render(fitted, {})).mae_mean;
+  };
+  const double coarse = rendered_error(depth), fine = rendered_error(depth + 1);
+  EXPECT_LT(coarse, 1.01 * fine) << "fit depth " << depth << ": " << coarse << ", one deeper: " << fine;
+}
+
 // Relocation moves smooth control vertices only, keeps the mesh valid, lowers the squared pixel
 // error, and does not depend on the thread count: on a 160 x 120 crop of the bundled photograph.
 TEST(ColorFit, RelocationLowersTheErrorAndMovesOnlySmoothVertices) {
