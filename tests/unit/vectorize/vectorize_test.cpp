@@ -296,13 +296,19 @@ TEST(ColorFit, ReweightingResistsOutliers) {
   EXPECT_THROW(fit_colors(mesh, clean.width, clean.height, noisy, bad), Error);
 }
 
+// A w x h crop of the bundled photograph (examples/04-rocket.png) from (x, y).
+Image8 rocket_crop(int x, int y, int w, int h) {
+  const Image8 photo = read_image(std::filesystem::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png");
+  Image8 crop(w, h, 3);
+  for (int row = 0; row < h; ++row) std::copy_n(photo.row(row + y) + 3 * x, 3 * w, crop.row(row));
+  return crop;
+}
+
 // The fit refines one level coarser than the renderer draws (kFitEdgePixels, docs/vectorize.md "Fit
 // depth"): its refined edges average at most 5 px, and the rendered image is within 1 % of the one
 // fitted at the renderer's depth, on a crop of the bundled photograph.
 TEST(ColorFit, OneLevelCoarserThanTheRendererCostsUnderOnePercent) {
-  const Image8 photo = read_image(std::filesystem::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png");
-  Image8 crop(200, 160, 3);
-  for (int y = 0; y < crop.height; ++y) std::copy_n(photo.row(y + 60) + 3 * 100, 3 * crop.width, crop.row(y));
+  const Image8 crop = rocket_crop(100, 60, 200, 160);
   VectorizeOptions options;
   options.ratio = 0.01;
   VectorImage image = vectorize(crop, options);
@@ -333,9 +339,7 @@ TEST(ColorFit, OneLevelCoarserThanTheRendererCostsUnderOnePercent) {
 // Relocation moves smooth control vertices only, keeps the mesh valid, lowers the squared pixel
 // error, and does not depend on the thread count: on a 160 x 120 crop of the bundled photograph.
 TEST(ColorFit, RelocationLowersTheErrorAndMovesOnlySmoothVertices) {
-  const Image8 photo = read_image(std::filesystem::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png");
-  Image8 crop(160, 120, 3);
-  for (int y = 0; y < crop.height; ++y) std::copy_n(photo.row(y + 70) + 3 * 110, 3 * crop.width, crop.row(y));
+  const Image8 crop = rocket_crop(110, 70, 160, 120);
   VectorizeOptions options;
   options.ratio = 0.02;
   options.refine.rounds = 0;  // relocation on the simplified mesh, as it was measured
