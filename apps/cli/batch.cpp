@@ -35,7 +35,7 @@
 #include "subvec/io/file.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 #include "progress.h"
@@ -157,7 +157,7 @@ void process(Item& item, const BatchArgs& a) {
   std::vector<uint8_t> bytes;
   if (!saved) {
     subvec::VectorImage vectorized = subvec::vectorize(photo, vectorize_options(a.vectorize));
-    // Levels of abstraction as `subvec vectorize --levels` makes them (pyramid/levels.h).
+    // Levels of abstraction as `subvec vectorize --levels` makes them (vectorize/levels.h).
     build_levels(a.vectorize.levels, vectorized, photo);
     bytes = subvec::to_svec_binary(vectorized);
     // What the file holds (positions and colors on the .svec grids), measured and drawn below.

@@ -9,7 +9,7 @@
 
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 
 namespace subvec_cli {
 

@@ -28,7 +28,7 @@
 #include "subvec/core/error.h"
 #include "subvec/core/metrics.h"
 #include "subvec/io/image_io.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"

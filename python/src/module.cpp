@@ -34,7 +34,7 @@
 #include "subvec/io/svec.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"

@@ -13,7 +13,7 @@
 #include "subvec/edit/selection.h"
 #include "subvec/mesh/curves.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/render/renderer.h"
 
 namespace subvec {
@@ -76,7 +76,7 @@ std::vector<double> feature_saliency(const VectorImage& image, int level, double
   const Image8 raster = render(bare, RenderOptions{});
   for (size_t f = 0; f < mesh.features.size(); ++f) {
     if (saliency[f] != 0) continue;
-    // Eq. 2 as vectorization measures it (pyramid/levels.h), per piece: lengths add, and the
+    // Eq. 2 as vectorization measures it (vectorize/levels.h), per piece: lengths add, and the
     // contrast is the length-weighted mean of the pieces' contrasts.
     double length = 0, weighted = 0;
     for (const auto& line : curves[f]) {

@@ -1,5 +1,5 @@
 // Walking along polylines (the sampled limit curves of mesh/curves.h), for the layers that measure
-// along features: levels (pyramid/levels.cpp) and stylization (edit/stylize.cpp).
+// along features: levels (vectorize/levels.cpp) and stylization (edit/stylize.cpp).
 #pragma once
 
 #include <cmath>

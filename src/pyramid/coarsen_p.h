@@ -5,7 +5,7 @@
 // finer one's, and every removed vertex can be predicted from the neighbours it had when it went
 // (the records the vector image pyramid replays, pyramid.cpp).
 //
-// Design note. The level building (levels.cpp) decides which collapses to make; the pyramid
+// Design note. The level building (vectorize/levels.cpp) decides which collapses to make; the pyramid
 // (pyramid.cpp) replays the same collapses from a saved file. Both go through this one class, so
 // the two can never disagree about what a collapse does to the topology or the colors.
 #pragma once

@@ -2,7 +2,7 @@
 // image through its inter-level details.
 //
 // Every level l >= 1 records how it was made from level l - 1 (ControlMesh::parent_vertices and
-// collapses; levels.h). Replaying that record gives, for every vertex removed on the way down, the
+// collapses; vectorize/levels.h). Replaying that record gives, for every vertex removed on the way down, the
 // coarse neighbourhood it was removed from, and its detail: the difference from its prediction
 // R(v) = sum w_i v_i over that neighbourhood with Fujiwara weights w_i ~ 1 / |v' - v'_i| (eq. 3).
 // Positions are predicted from the one-ring (from the two neighbours along the chain or the border

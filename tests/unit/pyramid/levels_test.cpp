@@ -1,4 +1,4 @@
-// Levels of abstraction (pyramid/levels.h, paper §5): saliency order, nested feature sets, vertex
+// Levels of abstraction (vectorize/levels.h, paper §5): saliency order, nested feature sets, vertex
 // counts that halve, overrides, closed seams, and the shared photographs.
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "subvec/core/image.h"
-#include "subvec/pyramid/levels.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/vectorize/vectorize.h"
 
 namespace subvec::test {

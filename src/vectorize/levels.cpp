@@ -1,5 +1,5 @@
-// Levels of abstraction (pyramid/levels.h, paper §5).
-#include "subvec/pyramid/levels.h"
+// Levels of abstraction (vectorize/levels.h, paper §5).
+#include "subvec/vectorize/levels.h"
 
 #include <algorithm>
 #include <chrono>
