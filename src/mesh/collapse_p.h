@@ -1,13 +1,15 @@
-// Validity checks for an edge collapse on an index mesh: triangles as vertex triples and, per
-// vertex, the ids of its incident faces (any range of int32_t). Shared by the simplification of
-// vectorization (vectorize/simplify.cpp) and the coarsening between levels (pyramid/coarsen.cpp),
-// so that the two agree about what a collapse may not do to a mesh: break the link condition, fold
-// two sharp edges into one, or flip or flatten a triangle.
+// The edge collapse on an index mesh: triangles as vertex triples, face-varying color indices and,
+// per vertex, the ids of its incident faces (any range of int32_t). Shared by the simplification of
+// vectorization (vectorize/simplify.cpp) and the coarsening between levels (mesh/coarsen.cpp), so
+// that the two agree about what a collapse may not do to a mesh (break the link condition, fold
+// two sharp edges into one, flip or flatten a triangle) and about what it does to the faces and
+// their colors (collapse_faces). The 5D quadric they order collapses by is mesh/quadric_p.h.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "subvec/mesh/vector_image.h"
@@ -113,6 +115,32 @@ bool faces_keep_area(const Faces& faces_of_x, const std::vector<Tri>& tri, int32
     if (signed_area(position(t[0]), position(t[1]), position(t[2])) <= min_area) return false;
   }
   return true;
+}
+
+// Applies the half-edge collapse of u into v to u's faces (`faces_of_u`: a copy, since the lists
+// change): a face that has v dies, and `dies(f)` is told; every other face takes v in u's place,
+// the corner with v's color on its side of the edge (the pair among the `npairs` (color of u, color
+// of v) of edge_color_pairs whose u color it had, else the first), and `survives(f)` is told.
+template <class Dies, class Survives>
+void collapse_faces(std::span<const int32_t> faces_of_u, std::vector<Tri>& tri, std::vector<Tri>& tcol,
+                    int32_t u, int32_t v, const std::array<std::array<int32_t, 2>, 2>& pairs, int npairs,
+                    Dies&& dies, Survives&& survives) {
+  for (int32_t f : faces_of_u) {
+    Tri& t = tri[f];
+    if (t[0] == v || t[1] == v || t[2] == v) {
+      dies(f);
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] != u) continue;
+      t[k] = v;
+      int32_t cv = npairs > 0 ? pairs[0][1] : tcol[f][k];
+      for (int i = 0; i < npairs; ++i)
+        if (pairs[i][0] == tcol[f][k]) cv = pairs[i][1];
+      tcol[f][k] = cv;
+    }
+    survives(f);
+  }
 }
 
 }  // namespace subvec::detail

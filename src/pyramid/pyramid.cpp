@@ -7,7 +7,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "pyramid/coarsen_p.h"
+#include "mesh/coarsen_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/subdiv/subdivision.h"
@@ -15,10 +15,10 @@
 namespace subvec {
 namespace {
 
-using pyramid_detail::Coarsener;
-using pyramid_detail::CollapseRecord;
-using pyramid_detail::Kind;
-using pyramid_detail::Rgb;
+using coarsen_detail::Coarsener;
+using coarsen_detail::CollapseRecord;
+using coarsen_detail::Kind;
+using coarsen_detail::Rgb;
 
 // One band: the step from level b - 1 (fine) to level b (coarse), with its details.
 struct Band {

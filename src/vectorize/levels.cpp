@@ -7,63 +7,26 @@
 #include <queue>
 #include <string>
 
-#include <Eigen/Dense>
-
 #include "mesh/polyline_p.h"
-#include "pyramid/coarsen_p.h"
+#include "mesh/quadric_p.h"
+#include "mesh/coarsen_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
 
 namespace subvec {
 namespace {
 
+using detail::plane_quadric;
+using detail::Point5;
 using detail::polyline_length;
+using detail::Quadric5;
+using detail::reduce;
 using detail::walk;
-using pyramid_detail::Coarsener;
-using pyramid_detail::Kind;
+using coarsen_detail::Coarsener;
+using coarsen_detail::Kind;
 
 [[noreturn]] void invalid(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, "levels: " + message);
-}
-
-// Garland-Heckbert quadric in (x, y, r, g, b): Q(x) = x'Ax + 2b'x + c.
-struct Quadric {
-  Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
-  double c = 0;
-  Quadric& operator+=(const Quadric& o) {
-    a += o.a, b += o.b, c += o.c;
-    return *this;
-  }
-  // min over the colors of Q at position p.
-  double min_over_colors(Vec2 p) const {
-    const Eigen::Vector2d x(p.x, p.y);
-    Eigen::Matrix3d acc = a.block<3, 3>(2, 2);
-    acc.diagonal().array() += 1e-9;
-    const Eigen::Vector3d rhs = a.block<3, 2>(2, 0) * x + b.tail<3>();
-    const Eigen::Vector3d col = -acc.ldlt().solve(rhs);
-    Eigen::Matrix<double, 5, 1> full;
-    full << x, col;
-    return std::max(0.0, full.dot(a * full) + 2 * b.dot(full) + c);
-  }
-};
-
-Quadric triangle_quadric(const Eigen::Matrix<double, 5, 1>& p, const Eigen::Matrix<double, 5, 1>& q,
-                         const Eigen::Matrix<double, 5, 1>& r) {
-  Quadric out;
-  Eigen::Matrix<double, 5, 1> e1 = q - p;
-  if (e1.norm() <= 0) return out;
-  e1.normalize();
-  Eigen::Matrix<double, 5, 1> e2 = r - p;
-  e2 -= e1.dot(e2) * e1;
-  if (e2.norm() <= 0) return out;
-  e2.normalize();
-  const double area = 0.5 * std::abs((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
-  const double pe1 = p.dot(e1), pe2 = p.dot(e2);
-  out.a = area * (Eigen::Matrix<double, 5, 5>::Identity() - e1 * e1.transpose() - e2 * e2.transpose());
-  out.b = area * (pe1 * e1 + pe2 * e2 - p);
-  out.c = area * (p.dot(p) - pe1 * pe1 - pe2 * pe2);
-  return out;
 }
 
 // Greedy half-edge collapses by quadric cost until `target` vertices remain. Kept chains stay within
@@ -73,18 +36,18 @@ constexpr double kMaxLoosening = 8;
 std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const LevelOptions& options) {
   const int nv = c.num_vertices();
   // Quadrics per merged color value, from the triangles' 5D points.
-  std::vector<Quadric> quadric(c.num_merged());
+  std::vector<Quadric5> quadric(c.num_merged());
   const double cs = options.color_scale;
   const auto& tri = c.triangles();
   const auto& tcol = c.triangle_colors();
   for (size_t f = 0; f < tri.size(); ++f) {
-    Eigen::Matrix<double, 5, 1> p[3];
+    Point5 p[3];
     for (int k = 0; k < 3; ++k) {
       const Vec2 x = c.positions()[tri[f][k]];
       const auto& m = c.merged_colors()[tcol[f][k]];
-      p[k] << x.x, x.y, cs * m[0], cs * m[1], cs * m[2];
+      p[k] = {x.x, x.y, cs * m[0], cs * m[1], cs * m[2]};
     }
-    const Quadric q = triangle_quadric(p[0], p[1], p[2]);
+    const Quadric5 q = plane_quadric(p[0], p[1], p[2]);
     for (int k = 0; k < 3; ++k) quadric[tcol[f][k]] += q;
   }
   struct Entry {
@@ -107,9 +70,9 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
     const Vec2 pu = c.positions()[u], pv = c.positions()[v];
     double cost = 1e-8 * ((pu.x - pv.x) * (pu.x - pv.x) + (pu.y - pv.y) * (pu.y - pv.y));
     for (int i = 0; i < n; ++i) {
-      Quadric q = quadric[pairs[i][0]];
+      Quadric5 q = quadric[pairs[i][0]];
       q += quadric[pairs[i][1]];
-      cost += q.min_over_colors(pv);
+      cost += std::max(0.0, reduce(q)(pv.x, pv.y));
     }
     queue.push({cost, u, v, version[u], version[v]});
   };
@@ -144,7 +107,7 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
     if (!c.can_collapse(e.u, e.v, tolerance)) continue;
     std::array<std::array<int32_t, 2>, 2> pairs;
     const int n = c.edge_color_pairs(e.u, e.v, pairs);
-    for (int i = 0; i < n; ++i) quadric[pairs[i][1]] += quadric[pairs[i][0]];
+    detail::merge_side_by_side(quadric, pairs, n);
     c.neighbours(e.u, ring);
     c.collapse(e.u, e.v);
     collapses.push_back({e.u, e.v});

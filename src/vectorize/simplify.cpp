@@ -37,123 +37,20 @@
 
 #include "core/parallel_p.h"
 #include "mesh/collapse_p.h"
+#include "mesh/quadric_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
+#include "vectorize/simplify_p.h"
 
 namespace subvec {
 namespace {
 
-
-// Q(x) = x'Ax + 2b'x + c over x = (x, y, r, g, b). A is symmetric and kept as its upper
-// triangle, row by row (xx xy xr xg xb | yy yr yg yb | rr rg rb | gg gb | bb): 21 doubles, padded
-// to three cache lines, so that merging and reducing two quadrics touch six lines.
-struct alignas(64) Quadric {
-  std::array<double, 15> a{};
-  std::array<double, 5> b{};
-  double c = 0;
-  Quadric& operator+=(const Quadric& o) {
-    for (int i = 0; i < 15; ++i) a[i] += o.a[i];
-    for (int i = 0; i < 5; ++i) b[i] += o.b[i];
-    c += o.c;
-    return *this;
-  }
-};
-
-// Garland-Heckbert quadric of the plane through three 5D points, weighted by the xy area. (Written
-// out with the sums in the order Eigen's vectorized 5-vector reductions use, which earlier versions
-// called: the same bits, a third of the instructions.)
-using Point5 = std::array<double, 5>;  // (x, y, r, g, b)
-double dot5(const Point5& a, const Point5& b) {
-  return ((a[0] * b[0] + a[2] * b[2]) + (a[1] * b[1] + a[3] * b[3])) + a[4] * b[4];
-}
-Quadric triangle_quadric(const Point5& p, const Point5& q, const Point5& r) {
-  Quadric out;
-  Point5 e1, e2;  // orthonormal, spanning the triangle's plane
-  for (int i = 0; i < 5; ++i) e1[i] = q[i] - p[i];
-  const double l1 = std::sqrt(dot5(e1, e1));
-  if (l1 <= 0) return out;
-  for (int i = 0; i < 5; ++i) e1[i] /= l1;
-  for (int i = 0; i < 5; ++i) e2[i] = r[i] - p[i];
-  const double along = dot5(e1, e2);
-  for (int i = 0; i < 5; ++i) e2[i] -= along * e1[i];
-  const double l2 = std::sqrt(dot5(e2, e2));
-  if (l2 <= 0) return out;
-  for (int i = 0; i < 5; ++i) e2[i] /= l2;
-  const double area = 0.5 * std::abs((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
-  const double pe1 = dot5(p, e1), pe2 = dot5(p, e2);
-  // A = area (I - e1 e1' - e2 e2'), b = area (pe1 e1 + pe2 e2 - p), c = area (p'p - pe1^2 - pe2^2).
-  for (int i = 0, n = 0; i < 5; ++i)
-    for (int j = i; j < 5; ++j) out.a[n++] = area * (((i == j ? 1.0 : 0.0) - e1[i] * e1[j]) - e2[i] * e2[j]);
-  for (int i = 0; i < 5; ++i) out.b[i] = area * ((pe1 * e1[i] + pe2 * e2[i]) - p[i]);
-  out.c = area * ((dot5(p, p) - pe1 * pe1) - pe2 * pe2);
-  return out;
-}
-
-// The quadric with the colors minimized out: R(p) = p'Mp + 2g'p + k over positions p, with M
-// symmetric (m00, m01, m11).
-struct Quadric2 {
-  double m00 = 0, m01 = 0, m11 = 0, g0 = 0, g1 = 0, k = 0;
-  double operator()(double x, double y) const {
-    return x * (m00 * x + m01 * y) + y * (m01 * x + m11 * y) + 2 * (g0 * x + g1 * y) + k;
-  }
-  Quadric2& operator+=(const Quadric2& o) {
-    m00 += o.m00, m01 += o.m01, m11 += o.m11, g0 += o.g0, g1 += o.g1, k += o.k;
-    return *this;
-  }
-};
-
-// The color block of a quadric, regularized, as the adjugate C (symmetric: c00 c01 c02 c11 c12
-// c22) and determinant of Acc + 1e-9 I: (Acc + 1e-9 I)^-1 = C / det.
-struct ColorInverse {
-  double c00, c01, c02, c11, c12, c22, det;
-};
-ColorInverse color_inverse(const std::array<double, 15>& a) {
-  constexpr double kEps = 1e-9;
-  const double rr = a[9] + kEps, rg = a[10], rb = a[11], gg = a[12] + kEps, gb = a[13], bb = a[14] + kEps;
-  ColorInverse v;
-  v.c00 = gg * bb - gb * gb;
-  v.c01 = rb * gb - rg * bb;
-  v.c02 = rg * gb - rb * gg;
-  v.c11 = rr * bb - rb * rb;
-  v.c12 = rg * rb - rr * gb;
-  v.c22 = rr * gg - rg * rg;
-  v.det = rr * v.c00 + rg * v.c01 + rb * v.c02;
-  return v;
-}
-
-// Schur complement of the color block: min over colors of Q(p, colors).
-Quadric2 reduce(const Quadric& q) {
-  const auto& a = q.a;
-  const ColorInverse ci = color_inverse(a);
-  // Columns x and y of the color-position block, and the color part of b.
-  const double xr = a[2], xg = a[3], xb = a[4], yr = a[6], yg = a[7], yb = a[8];
-  const double br = q.b[2], bg = q.b[3], bb = q.b[4];
-  // C times (x column, y column, b colors).
-  const double wx0 = ci.c00 * xr + ci.c01 * xg + ci.c02 * xb, wx1 = ci.c01 * xr + ci.c11 * xg + ci.c12 * xb,
-               wx2 = ci.c02 * xr + ci.c12 * xg + ci.c22 * xb;
-  const double wy0 = ci.c00 * yr + ci.c01 * yg + ci.c02 * yb, wy1 = ci.c01 * yr + ci.c11 * yg + ci.c12 * yb,
-               wy2 = ci.c02 * yr + ci.c12 * yg + ci.c22 * yb;
-  const double wb0 = ci.c00 * br + ci.c01 * bg + ci.c02 * bb, wb1 = ci.c01 * br + ci.c11 * bg + ci.c12 * bb,
-               wb2 = ci.c02 * br + ci.c12 * bg + ci.c22 * bb;
-  const double inv_det = 1 / ci.det;
-  Quadric2 r;
-  r.m00 = a[0] - (xr * wx0 + xg * wx1 + xb * wx2) * inv_det;
-  r.m01 = a[1] - (xr * wy0 + xg * wy1 + xb * wy2) * inv_det;
-  r.m11 = a[5] - (yr * wy0 + yg * wy1 + yb * wy2) * inv_det;
-  r.g0 = q.b[0] - (xr * wb0 + xg * wb1 + xb * wb2) * inv_det;
-  r.g1 = q.b[1] - (yr * wb0 + yg * wb1 + yb * wb2) * inv_det;
-  r.k = q.c - (br * wb0 + bg * wb1 + bb * wb2) * inv_det;
-  return r;
-}
-
-// Colors minimizing q at position (x, y).
-std::array<double, 3> best_color(const Quadric& q, double x, double y) {
-  const auto& a = q.a;
-  const ColorInverse ci = color_inverse(a);
-  const double r = a[2] * x + a[6] * y + q.b[2], g = a[3] * x + a[7] * y + q.b[3], b = a[4] * x + a[8] * y + q.b[4];
-  return {-(ci.c00 * r + ci.c01 * g + ci.c02 * b) / ci.det, -(ci.c01 * r + ci.c11 * g + ci.c12 * b) / ci.det,
-          -(ci.c02 * r + ci.c12 * g + ci.c22 * b) / ci.det};
-}
+using detail::best_color;
+using detail::plane_quadric;
+using detail::Point5;
+using detail::Quadric2;
+using detail::reduce;
+using Quadric = detail::Quadric5;
 
 enum class Kind : uint8_t { kSmooth, kBorder, kFeature, kCorner };
 
@@ -381,8 +278,9 @@ class IncidenceLists {
 
 class Simplifier {
  public:
-  Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options)
-      : mesh_(mesh), w_(width), h_(height), options_(options) {}
+  Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options,
+             detail::SimplifySchedule schedule)
+      : mesh_(mesh), w_(width), h_(height), options_(options), schedule_(schedule) {}
 
   SimplifyStats run();
 
@@ -395,8 +293,9 @@ class Simplifier {
   // Who simplifies what: one worker per region in the parallel phase, one for the whole mesh
   // after. A worker collapses and moves only vertices it owns and reads its neighbourhood, which
   // nobody else writes meanwhile; it has its own queue, statistics and scratch space.
+  static constexpr int32_t kEveryVertex = -1, kUnfrozen = -2;
   struct Worker {
-    int32_t region = -1;  // -1: every vertex
+    int32_t region = kEveryVertex;  // a region, every vertex, or every unfrozen vertex
     int64_t alive = 0;    // live vertices of the region
     int64_t stop = 0;     // simplify down to this many
     CollapseQueue queue;
@@ -407,10 +306,25 @@ class Simplifier {
   };
 
   void setup();
+  void renumber_for_locality(std::vector<int32_t>& face_of, std::vector<int32_t>& color_of);
+  void build_incidence(const std::vector<int32_t>& face_of);
+  void classify_vertices();
+  void build_chains();
+  void initial_quadrics(const std::vector<int32_t>& color_of);
   void split_regions(int num_regions_x, int num_regions_y);
-  bool owns(const Worker& w, int32_t v) const { return w.region < 0 || (region_[v] == w.region && !frozen_[v]); }
+  bool owns(const Worker& w, int32_t v) const {
+    if (w.region < 0) return w.region == kEveryVertex || !frozen_[v];
+    return region_[v] == w.region && !frozen_[v];
+  }
+  bool live(const Entry& e) const {
+    const int32_t remove = e.remove();
+    return vertex_alive_[remove] && vertex_alive_[e.keep] &&
+           static_cast<uint16_t>(version_[remove]) == e.version_remove &&
+           static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
+  }
   bool owns_window(const Worker& w, int32_t removed_node) const;
   void simplify_with(Worker& w);
+  void simplify_regions_serially(std::vector<Worker>& regions);
   Plan plan(int32_t a, int32_t b) const;
   Plan plan_direction(int32_t u, int32_t v) const;
   void push_edges(Worker& w, int32_t v);
@@ -425,13 +339,32 @@ class Simplifier {
   bool tear_edge(int32_t a, int32_t b) const;
   void write_back();
 
-  // Feature refit for the removal of node `removed`: fills moved vertices and returns the largest
-  // parametric error of the affected piece of curve.
+  // Feature refit (eq. 1), in three steps: the window of chain nodes it reads and moves, the rows
+  // of the least-squares problem, the solve and the largest parametric error.
+  static constexpr int kRefitReach = 5;  // nodes on each side of a removal
+  struct RefitWindow {
+    std::array<int32_t, 2 * kRefitReach + 2> win{};  // nodes w_0..w_K in chain order
+    int count = 0, centre = 0;                        // K + 1; the slot after the removal
+    bool periodic = false, hard_start = false, hard_end = false;
+    std::array<int, 4> free_slots{};                  // slots that move
+    int nfree = 0;
+    int seg_lo = 0, seg_hi = -1;                      // segments (w_k, w_k+1) checked
+    int K() const { return count - 1; }
+    int wrap(int k) const { return periodic ? ((k % count) + count) % count : k; }
+  };
+  struct FitRow {  // a target point, and the limit curve there as (slot, weight) pairs
+    std::array<std::pair<int, double>, 6> w;
+    int nw = 0;
+    Vec2 target;
+  };
+  bool refit_window(int32_t removed, RefitWindow& out) const;
+  void fit_rows(const RefitWindow& win, const FeatureState& f, std::vector<FitRow>& rows) const;
   double refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved, int& num_moved) const;
 
   ControlMesh& mesh_;
   int w_, h_;
   SimplifyOptions options_;
+  detail::SimplifySchedule schedule_;
 
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
@@ -453,9 +386,20 @@ class Simplifier {
   std::vector<uint8_t> frozen_;   // left alone in the parallel phase (seams, shared closed features)
 };
 
+// Stage 3 starts from the dense mesh (paper §4, "Mesh simplification"): its faces and colors in a
+// cache-friendly order, the incidence lists, the vertex types, the feature chains, the quadrics.
 void Simplifier::setup() {
-  const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   pos_ = mesh_.positions;
+  std::vector<int32_t> face_of, color_of;
+  renumber_for_locality(face_of, color_of);
+  build_incidence(face_of);
+  classify_vertices();
+  build_chains();
+  initial_quadrics(color_of);
+}
+
+void Simplifier::renumber_for_locality(std::vector<int32_t>& face_of, std::vector<int32_t>& color_of) {
+  const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   // Faces and color values are renumbered to follow the vertex order, which is spatially coherent,
   // so that a vertex's neighbourhood and its quadrics share cache lines: faces by their smallest
   // vertex, color values by their vertex. Everything that depends on an order (incidence lists,
@@ -471,13 +415,13 @@ void Simplifier::setup() {
   std::vector<int32_t> min_vertex(nf);
   for (int f = 0; f < nf; ++f) min_vertex[f] = std::min({mesh_.triangles[f][0], mesh_.triangles[f][1], mesh_.triangles[f][2]});
   face_order_ = stable_order(min_vertex);
-  std::vector<int32_t> face_of(nf);
+  face_of.assign(nf, 0);
   for (int i = 0; i < nf; ++i) face_of[face_order_[i]] = i;
   std::vector<int32_t> color_vertex(mesh_.num_colors(), 0);
   for (int f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) color_vertex[mesh_.triangle_colors[f][k]] = mesh_.triangles[f][k];
   const std::vector<int32_t> color_order = stable_order(color_vertex);
-  std::vector<int32_t> color_of(mesh_.num_colors());
+  color_of.assign(mesh_.num_colors(), 0);
   for (int i = 0; i < mesh_.num_colors(); ++i) color_of[color_order[i]] = i;
   tri_.resize(nf);
   tcol_.resize(nf);
@@ -485,6 +429,12 @@ void Simplifier::setup() {
     tri_[i] = mesh_.triangles[face_order_[i]];
     for (int k = 0; k < 3; ++k) tcol_[i][k] = color_of[mesh_.triangle_colors[face_order_[i]][k]];
   }
+}
+
+// Per vertex: its incident faces (in input face order), a version for the lazy queue, and its
+// color when it has only one.
+void Simplifier::build_incidence(const std::vector<int32_t>& face_of) {
+  const int nv = mesh_.num_vertices(), nf = mesh_.num_triangles();
   face_alive_.assign(nf, 1);
   vertex_alive_.assign(nv, 1);
   {
@@ -507,6 +457,10 @@ void Simplifier::setup() {
     }
   }
 
+}
+
+void Simplifier::classify_vertices() {
+  const int nv = mesh_.num_vertices();
   kind_.resize(nv);
   // Vertex types as in MeshTopology (paper §3.2), counted directly: border edges join two vertices on
   // one side of the image (in a valid mesh no other edge does), creases are listed, tears are the
@@ -545,6 +499,11 @@ void Simplifier::setup() {
     else kind_[v] = Kind::kCorner;
   }
 
+}
+
+// The feature chains as linked nodes; their initial positions are the targets of the refit (eq. 1).
+void Simplifier::build_chains() {
+  const int nv = mesh_.num_vertices();
   feature_.assign(nv, -1);
   node_of_.assign(nv, -1);
   for (const Feature& f : mesh_.features) {
@@ -582,7 +541,10 @@ void Simplifier::setup() {
     for (int32_t i = 0; i < static_cast<int32_t>(nodes_.size()); ++i)
       if (kind_[nodes_[i].vertex] != Kind::kFeature) corner_nodes_[fill[nodes_[i].vertex]++] = i;
   }
+}
 
+void Simplifier::initial_quadrics(const std::vector<int32_t>& color_of) {
+  const int nf = mesh_.num_triangles();
   // Quadrics per color index from the corners' 5D points, each the sum of its faces' quadrics in
   // face order. The color indices are cut into ranges over the threads; each thread visits every
   // face and computes the quadric of those with a corner in its range (colors follow the vertex
@@ -611,7 +573,7 @@ void Simplifier::setup() {
         const Color c = mesh_.colors[colors[k]];
         p[k] = {x.x, x.y, cs * c.r, cs * c.g, cs * c.b};
       }
-      const Quadric q = triangle_quadric(p[0], p[1], p[2]);
+      const Quadric q = plane_quadric(p[0], p[1], p[2]);
       for (int k = 0; k < 3; ++k)
         if (target[k] >= begin && target[k] < end) quadric_[target[k]] += q;
     }
@@ -755,42 +717,43 @@ void Simplifier::rebuild_queue(Worker& worker) {
 }
 
 
-double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved,
-                         int& num_moved) const {
-  // The limit curve of a chain is the uniform cubic B-spline of its control vertices; at a corner
-  // (feature end or junction) it ends with the phantom point 2 Q0 - Q1, which is what the crease
-  // masks with a fixed corner produce. The B-spline is local, so only a window of five nodes on
-  // each side of the removal matters: up to two free nodes per side, the segments they touch, and
-  // fixed context beyond. Windows stop early at corners ("hard" ends).
+// The piece of chain that the refit after removing node `removed` reads and changes, and the
+// segments it checks; false when there is nothing to refit or check. The limit curve of a chain is
+// the uniform cubic B-spline of its control vertices; at a corner (feature end or junction) it
+// ends with the phantom point 2 Q0 - Q1, which is what the crease masks with a fixed corner
+// produce. The B-spline is local, so only a window of five nodes on each side of the removal
+// matters: up to two free nodes per side, the segments they touch, and fixed context beyond.
+// Windows stop early at corners ("hard" ends).
+bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
+  out = RefitWindow{};
   const Node& r = nodes_[removed];
   const FeatureState& f = features_[feature_[r.vertex]];
-  const int total = static_cast<int>(f.target.size());
-  constexpr int kReach = 5;
-  std::array<int32_t, 2 * kReach + 1> back{}, fwd{};
+  std::array<int32_t, 2 * kRefitReach + 1> back{}, fwd{};
   int nb = 0, nf = 0;
-  bool hard_start = false, hard_end = false;
+  bool& hard_start = out.hard_start;
+  bool& hard_end = out.hard_end;
   for (int32_t n = r.prev;; n = nodes_[n].prev) {
     if (n < 0 || n == removed) { hard_start = true; break; }
     back[nb++] = n;
     if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_start = true; break; }
-    if (nb == kReach) break;
+    if (nb == kRefitReach) break;
   }
   for (int32_t n = r.next;; n = nodes_[n].next) {
     if (n < 0 || n == removed) { hard_end = true; break; }
     if (nb > 0 && n == back[nb - 1] && !hard_start) break;  // a short loop met itself
     fwd[nf++] = n;
     if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_end = true; break; }
-    if (nf == kReach) break;
+    if (nf == kRefitReach) break;
   }
   // Window w_0..w_K in chain order; `centre` is the index of the node after the removal.
-  std::array<int32_t, 2 * kReach + 2> win{};
-  int count = 0;
+  auto& win = out.win;
+  int& count = out.count;
   for (int i = nb - 1; i >= 0; --i) win[count++] = back[i];
-  const int centre = count;
+  const int centre = out.centre = count;
   for (int i = 0; i < nf; ++i) win[count++] = fwd[i];
   // A short closed loop: the window wraps onto itself; treat the whole loop as periodic.
-  bool periodic = false;
-  if (f.closed && !hard_start && !hard_end && f.size - 1 <= 2 * kReach) {
+  bool& periodic = out.periodic;
+  if (f.closed && !hard_start && !hard_end && f.size - 1 <= 2 * kRefitReach) {
     std::vector<int32_t> loop;
     for (int32_t n = r.next; n != removed && static_cast<int>(loop.size()) < f.size; n = nodes_[n].next) loop.push_back(n);
     count = 0;
@@ -798,12 +761,12 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
     periodic = true;
   }
   const int K = count - 1;
-  if (K < 1) return 0;
+  if (K < 1) return false;
   auto slot_ok = [&](int k) { return periodic || (k >= 0 && k <= K); };
-  auto wrap = [&](int k) { return periodic ? ((k % count) + count) % count : k; };
+  auto wrap = [&](int k) { return out.wrap(k); };
   // Free nodes: tear vertices among the two before and two after the removal.
-  std::array<int, 4> free_slots{};
-  int nfree = 0;
+  auto& free_slots = out.free_slots;
+  int& nfree = out.nfree;
   for (int k = periodic ? 0 : centre - 2; k <= (periodic ? K : centre + 1); ++k) {
     if (!slot_ok(k)) continue;
     if (periodic && nfree == 4) break;
@@ -812,30 +775,34 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
   // Segments k (between w_k and w_{k+1}) that the removal or a free node can change, and that the
   // window can evaluate (soft ends need one more node of context).
   const int nseg = periodic ? count : K;
-  int seg_lo = periodic ? 0 : centre - 4, seg_hi = periodic ? nseg - 1 : centre + 2;
+  int& seg_lo = out.seg_lo;
+  int& seg_hi = out.seg_hi;
+  seg_lo = periodic ? 0 : centre - 4, seg_hi = periodic ? nseg - 1 : centre + 2;
   if (!periodic) {
     seg_lo = std::max(seg_lo, hard_start ? 0 : 1);
     seg_hi = std::min(seg_hi, hard_end ? K - 1 : K - 2);
   }
-  if (seg_hi < seg_lo) return 0;
+  return seg_lo <= seg_hi;
 
-  struct Row {
-    std::array<std::pair<int, double>, 6> w;
-    int nw = 0;
-    Vec2 target;
-  };
-  thread_local std::vector<Row> rows;
+}
+
+// The rows of eq. 1 over the window's segments: each target point of the detected polyline
+// between two nodes, and the limit curve at its parameter as weights on the window's slots.
+void Simplifier::fit_rows(const RefitWindow& win, const FeatureState& f, std::vector<FitRow>& rows) const {
+  const int K = win.K(), total = static_cast<int>(f.target.size());
+  const bool periodic = win.periodic;
+  auto wrap = [&](int k) { return win.wrap(k); };
   rows.clear();
-  for (int k = seg_lo; k <= seg_hi; ++k) {
-    const double p0 = nodes_[win[wrap(k)]].param;
-    double p1 = nodes_[win[wrap(k + 1)]].param;
+  for (int k = win.seg_lo; k <= win.seg_hi; ++k) {
+    const double p0 = nodes_[win.win[wrap(k)]].param;
+    double p1 = nodes_[win.win[wrap(k + 1)]].param;
     if (p1 <= p0) p1 += total;  // wraps around a closed target
     const int j_begin = static_cast<int>(std::ceil(p0));
-    const int j_end = static_cast<int>(std::floor(p1)) - (k < seg_hi && p1 == std::floor(p1) ? 1 : 0);
+    const int j_end = static_cast<int>(std::floor(p1)) - (k < win.seg_hi && p1 == std::floor(p1) ? 1 : 0);
     for (int j = j_begin; j <= j_end; ++j) {
       const double s = (j - p0) / (p1 - p0);
       const auto b = bspline(s);
-      Row row;
+      FitRow row;
       row.target = f.target[((j % total) + total) % total];
       auto add = [&](int slot, double weight) {
         for (int i = 0; i < row.nw; ++i) {
@@ -859,15 +826,28 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
       rows.push_back(row);
     }
   }
+}
 
-  std::array<Vec2, 2 * kReach + 2> q;
+// Feature refit after the removal of node `removed` (paper §4, eq. 1): the free nodes of the
+// window move to the least-squares fit of the limit curve to the detected polyline. Fills the
+// moved vertices and returns the largest parametric error of the affected piece of curve.
+double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved,
+                         int& num_moved) const {
+  RefitWindow window;
+  if (!refit_window(removed, window)) return 0;
+  thread_local std::vector<FitRow> rows;
+  fit_rows(window, features_[feature_[nodes_[removed].vertex]], rows);
+  const auto& win = window.win;
+  const int count = window.count, nfree = window.nfree;
+  const auto& free_slots = window.free_slots;
+  std::array<Vec2, 2 * kRefitReach + 2> q;
   for (int i = 0; i < count; ++i) q[i] = pos_[nodes_[win[i]].vertex];
   if (nfree > 0 && !rows.empty()) {
     // Normal equations of the small least-squares problem (eq. 1), x and y at once, with a light
     // pull toward the current positions for free nodes that no target point constrains.
     Eigen::Matrix4d ata = Eigen::Matrix4d::Zero();
     Eigen::Matrix<double, 4, 2> atb = Eigen::Matrix<double, 4, 2>::Zero();
-    for (const Row& row : rows) {
+    for (const FitRow& row : rows) {
       double coef[4] = {0, 0, 0, 0};
       double bx = row.target.x, by = row.target.y;
       for (int i = 0; i < row.nw; ++i) {
@@ -898,7 +878,7 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
     }
   }
   double worst = 0;
-  for (const Row& row : rows) {
+  for (const FitRow& row : rows) {
     double x = 0, y = 0;
     for (int i = 0; i < row.nw; ++i) x += row.w[i].second * q[row.w[i].first].x, y += row.w[i].second * q[row.w[i].first].y;
     worst = std::max(worst, std::hypot(x - row.target.x, y - row.target.y));
@@ -956,39 +936,22 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
     }
   }
 
-  // Apply: colors of v per side, faces of u handed to v, quadrics merged, chain updated.
+  // Apply: quadrics merged side by side, u's faces handed to v with v's colors, chain updated.
   int32_t faces[2];
-  const int nfaces = faces_with_edge(u, v, faces);
-  std::array<std::pair<int32_t, int32_t>, 2> side;  // (color of u, color of v) per edge face
-  for (int i = 0; i < nfaces; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      if (tri_[faces[i]][k] == u) side[i].first = tcol_[faces[i]][k];
-      if (tri_[faces[i]][k] == v) side[i].second = tcol_[faces[i]][k];
-    }
-  }
-  for (int i = 0; i < nfaces; ++i) {
-    if (i == 1 && side[1] == side[0]) break;
-    quadric_[side[i].second] += quadric_[side[i].first];
-  }
+  const int nfaces = std::min(faces_with_edge(u, v, faces), 2);
+  std::array<std::array<int32_t, 2>, 2> pairs;
+  const int npairs = detail::edge_color_pairs(faces, nfaces, tri_, tcol_, u, v, pairs);
+  detail::merge_side_by_side(quadric_, pairs, npairs);
   std::vector<int32_t>& faces_of_u = worker.faces;
   faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may move
-  for (int32_t f : faces_of_u) {
-    Tri& t = tri_[f];
-    const bool dies = t[0] == v || t[1] == v || t[2] == v;
-    if (dies) {
-      face_alive_[f] = 0;
-      for (int32_t w : t)
-        if (w != u) vfaces_.erase(w, f);
-      continue;
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] != u) continue;
-      t[k] = v;
-      const int32_t cu = tcol_[f][k];
-      tcol_[f][k] = nfaces == 2 && side[1].first == cu ? side[1].second : side[0].second;
-    }
-    vfaces_.push_back(v, f, worker.arena);
-  }
+  detail::collapse_faces(
+      faces_of_u, tri_, tcol_, u, v, pairs, npairs,
+      [&](int32_t f) {
+        face_alive_[f] = 0;
+        for (int32_t w : tri_[f])
+          if (w != u) vfaces_.erase(w, f);
+      },
+      [&](int32_t f) { vfaces_.push_back(v, f, worker.arena); });
   vfaces_.clear(u);
   vertex_alive_[u] = 0;
   --worker.alive;
@@ -1020,12 +983,7 @@ void Simplifier::simplify_with(Worker& worker) {
   worker.marks.mark.assign(pos_.size(), 0);
   rebuild_queue(worker);
   size_t rebuild_at = 4 * worker.queue.size();
-  auto live = [&](const Entry& e) {
-    const int32_t remove = e.remove();
-    return vertex_alive_[remove] && vertex_alive_[e.keep] &&
-           static_cast<uint16_t>(version_[remove]) == e.version_remove &&
-           static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
-  };
+  auto live = [&](const Entry& e) { return this->live(e); };
   Entry e;
   while (worker.alive > worker.stop && worker.queue.pop(e, live)) {
     if (!live(e)) continue;
@@ -1042,6 +1000,7 @@ void Simplifier::simplify_with(Worker& worker) {
 }
 
 SimplifyStats Simplifier::run() {
+  using detail::SimplifySchedule;
   setup();
   const int64_t target = options_.target_vertices;
   SimplifyStats stats;
@@ -1054,12 +1013,14 @@ SimplifyStats Simplifier::run() {
 
   // Parallel phase (deterministic whatever the thread count): the image is cut into a fixed grid of
   // regions, and each region is simplified on its own, its seams frozen, down to `target`
-  // vertices plus its frozen ones. The collapses of a region do not depend on the other regions,
-  // and however the final vertices are shared among regions, none ends with more than `target`:
-  // so this is the start of what one global pass would do in the region, up to the seams.
+  // vertices plus its frozen ones. The collapses of a region do not depend on the other regions:
+  // the phase is one global pass with the seams frozen in which each region stops at its own count
+  // (kRegionsSerial, which the tests compare bit for bit). However the final vertices are shared
+  // among regions, none ends with more than `target`, so away from the seams this is how one
+  // global pass would start.
   constexpr int kRegionsX = 2, kRegionsY = 2;
   const int64_t nv = static_cast<int64_t>(pos_.size());
-  if (nv > 4 * kRegionsX * kRegionsY * target) {
+  if (schedule_ != SimplifySchedule::kGlobal && nv > 4 * kRegionsX * kRegionsY * target) {
     split_regions(kRegionsX, kRegionsY);
     std::vector<Worker> workers(kRegionsX * kRegionsY);
     for (int64_t v = 0; v < nv; ++v) {
@@ -1071,7 +1032,11 @@ SimplifyStats Simplifier::run() {
       workers[r].region = static_cast<int32_t>(r);
       workers[r].stop += target;
     }
-    detail::parallel_for(static_cast<int>(workers.size()), options_.threads, [&](int r) { simplify_with(workers[r]); });
+    if (schedule_ == SimplifySchedule::kRegionsSerial) {
+      simplify_regions_serially(workers);
+    } else {
+      detail::parallel_for(static_cast<int>(workers.size()), options_.threads, [&](int r) { simplify_with(workers[r]); });
+    }
     for (Worker& w : workers) {
       merge(w.stats);
       arenas_.push_back(std::move(w.arena));
@@ -1079,13 +1044,49 @@ SimplifyStats Simplifier::run() {
   }
 
   // Then everything, one collapse at a time.
-  Worker all;
-  for (int64_t v = 0; v < nv; ++v) all.alive += vertex_alive_[v];
-  all.stop = target;
-  simplify_with(all);
-  merge(all.stats);
+  if (schedule_ == SimplifySchedule::kRegionsThenGlobal || schedule_ == SimplifySchedule::kGlobal) {
+    Worker all;
+    for (int64_t v = 0; v < nv; ++v) all.alive += vertex_alive_[v];
+    all.stop = target;
+    simplify_with(all);
+    merge(all.stats);
+  }
   write_back();
   return stats;
+}
+
+// The reference for the parallel phase: the same regions' collapses from one queue, cheapest first
+// over all of them, on one thread; an entry of a region that is down to its count is dropped.
+// Statistics go to the region of each collapse.
+void Simplifier::simplify_regions_serially(std::vector<Worker>& regions) {
+  Worker all;
+  all.region = kUnfrozen;
+  all.marks.mark.assign(pos_.size(), 0);
+  rebuild_queue(all);
+  size_t rebuild_at = 4 * all.queue.size();
+  auto live = [&](const Entry& e) { return this->live(e); };
+  auto open = [&] {
+    return std::any_of(regions.begin(), regions.end(), [](const Worker& w) { return w.alive > w.stop; });
+  };
+  Entry e;
+  while (open() && all.queue.pop(e, live)) {
+    if (!live(e)) continue;
+    Worker& region = regions[region_[e.remove()]];
+    if (region.alive <= region.stop) continue;
+    const Plan p = plan_direction(e.remove(), e.keep);
+    if (p.remove < 0) continue;
+    all.stats = {};
+    if (try_collapse(all, p)) --region.alive;
+    region.stats.collapses += all.stats.collapses;
+    region.stats.rejected_topology += all.stats.rejected_topology;
+    region.stats.rejected_feature += all.stats.rejected_feature;
+    region.stats.max_feature_error = std::max(region.stats.max_feature_error, all.stats.max_feature_error);
+    if (all.queue.size() > rebuild_at) {
+      rebuild_queue(all);
+      rebuild_at = std::max<size_t>(4 * all.queue.size(), 1024);
+    }
+  }
+  regions[0].arena = std::move(all.arena);
 }
 
 // Regions: a grid of nx x ny rectangles of the image by initial position. Frozen: every vertex with
@@ -1120,8 +1121,8 @@ void Simplifier::split_regions(int nx, int ny) {
 // Whether every node that the refit after removing `removed_node` reads or moves is the worker's
 // (the same walk as refit(): five nodes each way, stopping at corners).
 bool Simplifier::owns_window(const Worker& worker, int32_t removed_node) const {
-  if (worker.region < 0) return true;
-  constexpr int kReach = 5;
+  if (worker.region == kEveryVertex) return true;
+  constexpr int kReach = kRefitReach;
   for (int direction = 0; direction < 2; ++direction) {
     int count = 0;
     for (int32_t n = direction ? nodes_[removed_node].next : nodes_[removed_node].prev; n >= 0 && n != removed_node;
@@ -1180,6 +1181,11 @@ void Simplifier::write_back() {
 }  // namespace
 
 SimplifyStats simplify(ControlMesh& mesh, int width, int height, const SimplifyOptions& options) {
+  return detail::simplify_scheduled(mesh, width, height, options, detail::SimplifySchedule::kRegionsThenGlobal);
+}
+
+SimplifyStats detail::simplify_scheduled(ControlMesh& mesh, int width, int height, const SimplifyOptions& options,
+                                         SimplifySchedule schedule) {
   if (options.target_vertices < 4) {
     throw Error(ErrorCode::kInvalidArgument, "simplify: target of " + std::to_string(options.target_vertices) +
                                                  " vertices is below the 4 image corners");
@@ -1187,7 +1193,7 @@ SimplifyStats simplify(ControlMesh& mesh, int width, int height, const SimplifyO
   if (!(options.max_feature_error > 0) || !(options.color_scale > 0)) {
     throw Error(ErrorCode::kInvalidArgument, "simplify: max_feature_error and color_scale must be positive");
   }
-  Simplifier s(mesh, width, height, options);
+  Simplifier s(mesh, width, height, options, schedule);
   return s.run();
 }
 

@@ -1,4 +1,5 @@
-// Private to the pyramid layer: the mesh state between two levels (paper §5). The finer level
+// Private to the library: the mesh state between two levels (paper §5), in the mesh layer because
+// the level building (vectorize/) and the pyramid's replay (pyramid/) both use it. The finer level
 // loses the features that the coarser one drops (each seam closes: the colors on its two sides
 // merge into their mean), then half-edge collapses remove vertices one at a time. A half-edge
 // collapse keeps the kept vertex where it is, so the coarser level's vertices are a subset of the
@@ -19,7 +20,7 @@
 #include "mesh/collapse_p.h"
 #include "subvec/mesh/vector_image.h"
 
-namespace subvec::pyramid_detail {
+namespace subvec::coarsen_detail {
 
 enum class Kind : uint8_t { kSmooth, kBorder, kTear, kCorner };
 
@@ -113,4 +114,4 @@ class Coarsener {
   int alive_count_ = 0;
 };
 
-}  // namespace subvec::pyramid_detail
+}  // namespace subvec::coarsen_detail

@@ -1,5 +1,5 @@
 // The mesh state between two levels; see coarsen_p.h.
-#include "pyramid/coarsen_p.h"
+#include "mesh/coarsen_p.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
-namespace subvec::pyramid_detail {
+namespace subvec::coarsen_detail {
 namespace {
 
 double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
@@ -277,24 +277,14 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   std::array<std::array<int32_t, 2>, 2> pairs;
   const int npairs = edge_color_pairs(u, v, pairs);
   const std::vector<int32_t> faces_of_u = vfaces_[u];
-  for (int32_t f : faces_of_u) {
-    Tri& t = tri_[f];
-    if (t[0] == v || t[1] == v || t[2] == v) {
-      face_alive_[f] = 0;
-      for (int32_t w : t)
-        if (w != u) std::erase(vfaces_[w], f);
-      continue;
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] != u) continue;
-      t[k] = v;
-      int32_t cv = npairs > 0 ? pairs[0][1] : tcol_[f][k];
-      for (int i = 0; i < npairs; ++i)
-        if (pairs[i][0] == tcol_[f][k]) cv = pairs[i][1];
-      tcol_[f][k] = cv;
-    }
-    vfaces_[v].push_back(f);
-  }
+  detail::collapse_faces(
+      faces_of_u, tri_, tcol_, u, v, pairs, npairs,
+      [&](int32_t f) {
+        face_alive_[f] = 0;
+        for (int32_t w : tri_[f])
+          if (w != u) std::erase(vfaces_[w], f);
+      },
+      [&](int32_t f) { vfaces_[v].push_back(f); });
   std::sort(vfaces_[v].begin(), vfaces_[v].end());
   vfaces_[u].clear();
   vertex_alive_[u] = 0;
@@ -352,4 +342,4 @@ ControlMesh Coarsener::result(std::vector<int32_t>& parents, std::vector<int32_t
   return out;
 }
 
-}  // namespace subvec::pyramid_detail
+}  // namespace subvec::coarsen_detail
