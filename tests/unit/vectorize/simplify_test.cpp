@@ -214,7 +214,8 @@ double seam_distance(Vec2 p, int width, int height) {
 // regions work, which changes costs nearby and, through them, the order farther out. Compared: the
 // share of output vertices, more than 48 px from a seam, at a position where the other mesh also
 // has a vertex (bit for bit); tear and border vertices keep their input positions, so a shared
-// position is a shared surviving vertex. And both meet the same budget and feature bound.
+// position is a shared surviving vertex. Measured: 241 of 381 (0.63); with the seams not frozen
+// it would be 0.95. And both meet the same budget and feature bound.
 TEST(SimplifySchedule, RegionsThenGlobalMatchOneGlobalPassAwayFromTheSeams) {
   const VectorImage image = dense_image();
   ControlMesh fast = image.levels[0], slow = image.levels[0];
@@ -235,7 +236,6 @@ TEST(SimplifySchedule, RegionsThenGlobalMatchOneGlobalPassAwayFromTheSeams) {
   ASSERT_GT(far, kTarget / 2);
   const double share = double(shared) / far;
   RecordProperty("shared_share", std::to_string(share));
-  std::printf("shared %d of %d vertices away from the seams (%.3f)\n", shared, far, share);
   EXPECT_GT(share, 0.5);
 }
 
