@@ -146,33 +146,25 @@ bool Coarsener::can_collapse(int32_t u, int32_t v, double feature_tolerance, dou
   int32_t faces[2];
   const int nf = faces_with_edge(u, v, faces);
   if (nf < 1 || nf > 2) return false;
-  switch (kind_[u]) {
-    case Kind::kCorner:
-      return false;
-    case Kind::kSmooth:
-      break;
-    case Kind::kBorder:
-      if (nf != 1 || !(sides_[u] & sides_[v]) || !(kind_[v] == Kind::kBorder || kind_[v] == Kind::kCorner)) return false;
-      break;
-    case Kind::kTear: {
-      const int slot = chain_slot(u);
-      if (slot < 0) return false;
-      const Chain& c = chains_[chain_of_[u]];
-      const int n = static_cast<int>(c.nodes.size());
-      if (c.closed && n <= 4) return false;
-      const int prev = slot > 0 ? slot - 1 : n - 1, next = slot + 1 < n ? slot + 1 : 0;
-      if (c.nodes[prev] != v && c.nodes[next] != v) return false;
-      // The chain's points from prev to next (u's among them) must stay near the new edge.
-      const Vec2 a = pos_[c.nodes[prev]], b = pos_[c.nodes[next]];
-      const int np = static_cast<int>(c.points.size());
-      for (int i = c.original[prev] + 1;; ++i) {
-        const int j = i % np;
-        if (j == c.original[next]) break;
-        if (segment_distance(c.points[j], a, b) > feature_tolerance) return false;
-      }
-      break;
+  const auto along_chain = [&] {
+    const int slot = chain_slot(u);
+    if (slot < 0) return false;
+    const Chain& c = chains_[chain_of_[u]];
+    const int n = static_cast<int>(c.nodes.size());
+    if (c.closed && n <= 4) return false;
+    const int prev = slot > 0 ? slot - 1 : n - 1, next = slot + 1 < n ? slot + 1 : 0;
+    if (c.nodes[prev] != v && c.nodes[next] != v) return false;
+    // The chain's points from prev to next (u's among them) must stay near the new edge.
+    const Vec2 a = pos_[c.nodes[prev]], b = pos_[c.nodes[next]];
+    const int np = static_cast<int>(c.points.size());
+    for (int i = c.original[prev] + 1;; ++i) {
+      const int j = i % np;
+      if (j == c.original[next]) break;
+      if (segment_distance(c.points[j], a, b) > feature_tolerance) return false;
     }
-  }
+    return true;
+  };
+  if (!detail::kinds_allow_collapse(kind_[u], kind_[v], nf, (sides_[u] & sides_[v]) != 0, along_chain)) return false;
   // Link condition: the common neighbours are exactly the faces' third vertices.
   if (!detail::link_condition(vfaces_[u], vfaces_[v], tri_, u, v, nf, marks_)) return false;
   // A dying face must not fold two sharp edges into one.

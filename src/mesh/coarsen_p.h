@@ -22,7 +22,7 @@
 
 namespace subvec::coarsen_detail {
 
-enum class Kind : uint8_t { kSmooth, kBorder, kTear, kCorner };
+using Kind = detail::VertexKind;
 
 using Rgb = std::array<double, 3>;
 

@@ -16,6 +16,30 @@
 
 namespace subvec::detail {
 
+// What a vertex is to the collapses (paper §3.2): smooth, on the image border between two
+// corners, on a tear (feature) chain, or a corner (image corner, feature end, junction).
+enum class VertexKind : uint8_t { kSmooth, kBorder, kTear, kCorner };
+
+// The paper's constraints on removing u into its neighbour v over an edge with `edge_faces` faces,
+// by their kinds (§4; §5 for the levels): a corner stays; a smooth vertex may go into any
+// neighbour; a border vertex only along its image side (`same_side`) over a border edge (one face)
+// into a border vertex or a corner; a tear vertex only where `along_chain()` allows (the caller's
+// chain: v next to u on it, and what else the caller's chain rules ask).
+template <class AlongChain>
+bool kinds_allow_collapse(VertexKind ku, VertexKind kv, int edge_faces, bool same_side, AlongChain&& along_chain) {
+  switch (ku) {
+    case VertexKind::kSmooth:
+      return true;
+    case VertexKind::kBorder:
+      return edge_faces == 1 && same_side && (kv == VertexKind::kBorder || kv == VertexKind::kCorner);
+    case VertexKind::kTear:
+      return along_chain();
+    case VertexKind::kCorner:
+      return false;
+  }
+  return false;
+}
+
 // A stamp per vertex for neighbourhood queries: taking a new stamp unmarks every vertex at once.
 struct VertexMarks {
   std::vector<uint32_t> mark;  // sized to the vertex count by the owner

@@ -57,7 +57,7 @@ using detail::Quadric2;
 using detail::reduce;
 using Quadric = detail::Quadric5;
 
-enum class Kind : uint8_t { kSmooth, kBorder, kFeature, kCorner };
+using Kind = detail::VertexKind;  // kTear: a vertex of a feature chain
 
 // Uniform cubic B-spline basis on a segment, s in [0, 1].
 std::array<double, 4> bspline(double s) {
@@ -338,7 +338,7 @@ class Simplifier {
   void rebuild_queue(Worker& w);
   void neighbours(Worker& w, int32_t v, std::vector<int32_t>& out) const;
   bool image_corner(Vec2 p) const { return (p.x == 0 || p.x == w_) && (p.y == 0 || p.y == h_); }
-  bool sharp(int32_t v) const { return kind_[v] == Kind::kFeature || kind_[v] == Kind::kCorner; }
+  bool sharp(int32_t v) const { return kind_[v] == Kind::kTear || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
   bool feature_neighbour(int32_t u, int32_t v) const;
   bool tear_edge(int32_t a, int32_t b) const;
@@ -500,7 +500,7 @@ void Simplifier::classify_vertices() {
     if (corner[v]) kind_[v] = Kind::kCorner;
     else if (creases[v] == 0 && tears[v] == 0) kind_[v] = Kind::kSmooth;
     else if (creases[v] == 2 && tears[v] == 0) kind_[v] = sides_[v] ? Kind::kBorder : Kind::kCorner;  // interior creases stay
-    else if (tears[v] == 2 && creases[v] == 0) kind_[v] = Kind::kFeature;
+    else if (tears[v] == 2 && creases[v] == 0) kind_[v] = Kind::kTear;
     else kind_[v] = Kind::kCorner;
   }
 
@@ -527,7 +527,7 @@ void Simplifier::build_chains() {
       node.prev = i > 0 ? first + static_cast<int32_t>(i) - 1 : (s.closed ? first + static_cast<int32_t>(n) - 1 : -1);
       node.next = i + 1 < n ? first + static_cast<int32_t>(i) + 1 : (s.closed ? first : -1);
       s.target.push_back(pos_[v]);
-      if (kind_[v] == Kind::kFeature) {
+      if (kind_[v] == Kind::kTear) {
         feature_[v] = static_cast<int32_t>(features_.size());
         node_of_[v] = static_cast<int32_t>(nodes_.size());
       }
@@ -538,13 +538,13 @@ void Simplifier::build_chains() {
   // Chain nodes at corners (a corner may end or join several chains), for tear edge lookups.
   corner_node_offsets_.assign(size_t(nv) + 1, 0);
   for (const Node& n : nodes_)
-    if (kind_[n.vertex] != Kind::kFeature) ++corner_node_offsets_[n.vertex + 1];
+    if (kind_[n.vertex] != Kind::kTear) ++corner_node_offsets_[n.vertex + 1];
   std::partial_sum(corner_node_offsets_.begin(), corner_node_offsets_.end(), corner_node_offsets_.begin());
   corner_nodes_.resize(corner_node_offsets_.back());
   {
     std::vector<int32_t> fill(corner_node_offsets_.begin(), corner_node_offsets_.end() - 1);
     for (int32_t i = 0; i < static_cast<int32_t>(nodes_.size()); ++i)
-      if (kind_[nodes_[i].vertex] != Kind::kFeature) corner_nodes_[fill[nodes_[i].vertex]++] = i;
+      if (kind_[nodes_[i].vertex] != Kind::kTear) corner_nodes_[fill[nodes_[i].vertex]++] = i;
   }
 }
 
@@ -638,20 +638,11 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
   } else {
     const int nfaces = faces_with_edge(u, v, faces);
     if (nfaces < 1 || nfaces > 2) return p;
-    switch (ku) {
-      case Kind::kSmooth:
-        break;
-      case Kind::kBorder:
-        if (!(kv == Kind::kBorder || kv == Kind::kCorner) || !(sides_[u] & sides_[v]) || nfaces != 1) return p;
-        break;
-      case Kind::kFeature:
-        if (!(kv == Kind::kFeature || kv == Kind::kCorner) || !feature_neighbour(u, v)) return p;
-        if (features_[feature_[u]].closed && features_[feature_[u]].size <= 4) return p;
-        break;
-      case Kind::kCorner:
-        return p;
-    }
-    if (kv == Kind::kFeature && ku != Kind::kFeature && ku != Kind::kSmooth) return p;
+    const auto along_chain = [&] {
+      const FeatureState& f = features_[feature_[u]];
+      return (kv == Kind::kTear || kv == Kind::kCorner) && feature_neighbour(u, v) && !(f.closed && f.size <= 4);
+    };
+    if (!detail::kinds_allow_collapse(ku, kv, nfaces, (sides_[u] & sides_[v]) != 0, along_chain)) return p;
 
     // The merged quadric, side by side: pairs (color of u, color of v) over the faces on the edge.
     npairs = detail::edge_color_pairs(faces, nfaces, tri_, tcol_, u, v, pairs);
@@ -775,7 +766,7 @@ bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
   for (int k = periodic ? 0 : centre - 2; k <= (periodic ? K : centre + 1); ++k) {
     if (!slot_ok(k)) continue;
     if (periodic && nfree == 4) break;
-    if (kind_[nodes_[win[wrap(k)]].vertex] == Kind::kFeature) free_slots[nfree++] = wrap(k);
+    if (kind_[nodes_[win[wrap(k)]].vertex] == Kind::kTear) free_slots[nfree++] = wrap(k);
   }
   // Segments k (between w_k and w_{k+1}) that the removal or a free node can change, and that the
   // window can evaluate (soft ends need one more node of context).
@@ -895,7 +886,7 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   const int32_t u = e.remove, v = e.keep;
   SimplifyStats& stats = worker.stats;
   // A collapse along a feature refits nodes up to five away: they must all be the worker's.
-  const int32_t removed_node = kind_[u] == Kind::kFeature ? node_of_[u] : -1;
+  const int32_t removed_node = kind_[u] == Kind::kTear ? node_of_[u] : -1;
   if (removed_node >= 0 && !owns_window(worker, removed_node)) return false;
   {
     int32_t faces[2];
