@@ -7,9 +7,9 @@
 #include <queue>
 #include <string>
 
+#include "mesh/coarsen_p.h"
 #include "mesh/polyline_p.h"
 #include "mesh/quadric_p.h"
-#include "mesh/coarsen_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
 
