@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 #include "subvec/edit/color.h"
 #include "subvec/edit/selection.h"
@@ -18,15 +19,11 @@
 namespace subvec {
 namespace {
 
+using detail::num;
+
 using Json = nlohmann::json;
 
 constexpr int kMaxDepth = 16;
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 std::string point(Vec2 p) { return "[" + num(p.x) + ", " + num(p.y) + "]"; }
 
