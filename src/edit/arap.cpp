@@ -8,6 +8,7 @@
 #include <numeric>
 #include <string>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -18,9 +19,7 @@ using Ldlt = Eigen::SimplicialLDLT<Sparse, Eigen::Lower, Eigen::AMDOrdering<int>
 using Mat2 = Eigen::Matrix2d;
 using V2 = Eigen::Vector2d;
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, "ARAP: " + message);
-}
+[[noreturn]] void invalid(const std::string& message) { detail::invalid("ARAP: " + message); }
 
 bool has(FixedAxes f, int axis) { return (static_cast<unsigned>(f) >> axis) & 1u; }
 

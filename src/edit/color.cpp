@@ -5,20 +5,14 @@
 #include <cstdio>
 #include <string>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
 namespace {
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, message);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+using detail::invalid;
+using detail::num;
 
 std::string color_name(Color c) { return "[" + num(c.r) + ", " + num(c.g) + ", " + num(c.b) + "]"; }
 

@@ -9,6 +9,8 @@
 #include <set>
 #include <string>
 
+#include "core/messages_p.h"
+#include "io/json_p.h"
 #include "subvec/core/error.h"
 #include "subvec/edit/color.h"
 #include "subvec/edit/selection.h"
@@ -18,15 +20,11 @@
 namespace subvec {
 namespace {
 
+using detail::num;
+
 using Json = nlohmann::json;
 
 constexpr int kMaxDepth = 16;
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 std::string point(Vec2 p) { return "[" + num(p.x) + ", " + num(p.y) + "]"; }
 
@@ -62,26 +60,7 @@ struct Place {
   }
 };
 
-const char* type_name(const Json& j) {
-  switch (j.type()) {
-    case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned:
-    case Json::value_t::number_float:
-      return "a number";
-    case Json::value_t::string:
-      return "a string";
-    case Json::value_t::boolean:
-      return "a boolean";
-    case Json::value_t::null:
-      return "null";
-    case Json::value_t::array:
-      return "an array";
-    case Json::value_t::object:
-      return "an object";
-    default:
-      return "an unsupported value";
-  }
-}
+const char* type_name(const Json& j) { return detail::json_type_name(j); }
 
 double number(const Json& j, const Place& at, const char* key) {
   if (!j.is_number()) at.fail(key, std::string("expected a number, got ") + type_name(j));

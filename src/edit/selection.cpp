@@ -6,23 +6,15 @@
 #include <limits>
 #include <string>
 
+#include "core/geometry_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
 
 namespace subvec {
 namespace {
 
-double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
-
-// Distance from p to segment a-b, and the nearest point.
-double segment_distance(Vec2 p, Vec2 a, Vec2 b, Vec2* nearest = nullptr) {
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  double u = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
-  u = std::clamp(u, 0.0, 1.0);
-  const Vec2 q{a.x + u * dx, a.y + u * dy};
-  if (nearest) *nearest = q;
-  return std::hypot(p.x - q.x, p.y - q.y);
-}
+using detail::cross;
+using detail::segment_distance;
 
 int corner_of(const ControlMesh& mesh, int face, int vertex) {
   const Tri& t = mesh.triangles[face];

@@ -7,22 +7,17 @@
 #include <numbers>
 #include <string>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
 namespace {
 
+using detail::invalid;
+
 constexpr size_t kCachedSets = 4;
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, message);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+std::string num(double v) { return detail::num(v, 4); }
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "core/messages_p.h"
 #include "mesh/polyline_p.h"
 #include "subvec/core/error.h"
 #include "subvec/core/image.h"
@@ -19,20 +20,14 @@
 namespace subvec {
 namespace {
 
+using detail::num;
+
 using detail::polyline_length;
 using detail::walk;
 
 constexpr int kSamplesPerSpan = 16;
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, "stylize: " + message);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+[[noreturn]] void invalid(const std::string& message) { detail::invalid("stylize: " + message); }
 
 const ControlMesh& level_mesh(const VectorImage& image, int level) {
   if (level < 0 || level >= static_cast<int>(image.levels.size())) {

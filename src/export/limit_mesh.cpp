@@ -13,21 +13,15 @@
 #include <cstdio>
 #include <string>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/validate.h"
 
 namespace subvec::detail {
 namespace {
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, message);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+using detail::invalid;
+using detail::num;
 
 constexpr int64_t kMaxTriangles = int64_t{1} << 24;
 // The tolerance may be exceeded at this fraction of the refined edges: at the few singular points

@@ -94,6 +94,73 @@ detail::Strips reversed(const detail::Strips& strips) {
   return out;
 }
 
+// A stream object's body: the dictionary `dict` (open) closed with the data's length, and the data.
+std::string stream_object(std::string dict, const std::string& data) {
+  return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data + "\nendstream";
+}
+
+// The tear hints and strokes drawn over the shadings, in image pixels.
+std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const ExportOptions& options, double s) {
+  std::string content;
+  if (options.tear_hints) {
+    for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
+      for (const double c : band.color)
+        content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
+      content += "rg";
+      for (int k = 0; k < 4; ++k) {
+        content += " " + detail::fixed(band.corners[k].x, 3) + " " +
+                   detail::fixed(band.corners[k].y, 3) + (k == 0 ? " m" : " l");
+      }
+      content += " h f\n";
+    }
+  }
+  for (const Stroke& stroke : image.strokes) {
+    if (stroke.level != options.level) continue;
+    const std::vector<Vec2> outline = detail::stroke_outline(stroke);
+    if (outline.empty()) continue;
+    const float rgb[3] = {stroke.color.r, stroke.color.g, stroke.color.b};
+    for (const float c : rgb) content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
+    content += "rg\n";
+    for (size_t i = 0; i < outline.size(); ++i) {
+      content += detail::fixed(outline[i].x, 3) + " " + detail::fixed(outline[i].y, 3) +
+                 (i == 0 ? " m\n" : " l\n");
+    }
+    content += "h f\n";
+  }
+  return content;
+}
+
+// The file: objects 1 to 5 (catalog, pages, page, contents, info), then `extra`, and the xref.
+std::string assemble(const VectorImage& image, double w, double h, double s, const std::string& resources,
+                     const std::string& content, const std::vector<std::string>& extra) {
+  std::string pdf = "%PDF-1.4\n%\xE2\xE3\xCF\xD3\n";
+  std::vector<size_t> offsets;
+  auto object = [&](const std::string& body) {
+    offsets.push_back(pdf.size());
+    pdf += std::to_string(offsets.size()) + " 0 obj\n" + body + "\nendobj\n";
+  };
+  std::string title;
+  for (const auto& [key, value] : image.metadata)
+    if (key == "title") title = value;
+  object("<< /Type /Catalog /Pages 2 0 R >>");
+  object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
+  object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
+         detail::fixed(h * s, 6) + "] /Contents 4 0 R /Resources << " + resources + " >> >>");
+  object(stream_object("<< /Filter /FlateDecode", deflate(content)));
+  object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
+  for (const std::string& body : extra) object(body);
+  const size_t xref = pdf.size();
+  pdf += "xref\n0 " + std::to_string(offsets.size() + 1) + "\n0000000000 65535 f \n";
+  for (const size_t o : offsets) {
+    char line[24];
+    std::snprintf(line, sizeof line, "%010zu 00000 n \n", o);
+    pdf += line;
+  }
+  pdf += "trailer\n<< /Size " + std::to_string(offsets.size() + 1) +
+         " /Root 1 0 R /Info 5 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
+  return pdf;
+}
+
 }  // namespace
 
 std::string to_pdf(const VectorImage& image, const ExportOptions& options, ExportReport* report) {
@@ -139,10 +206,6 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   auto add = [&](std::string body) {
     extra.push_back(std::move(body));
     return std::to_string(5 + extra.size()) + " 0 R";
-  };
-  auto stream_object = [](std::string dict, const std::string& data) {
-    return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data +
-           "\nendstream";
   };
   const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
   auto shading = [&](const std::string& data, int channel, double offset) {
@@ -210,59 +273,10 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     }
     resources = "/XObject <<" + forms + " >> /ExtGState << /GA0 << /ca 1 >> /GA1 << /ca 0.5 >> >>";
   }
-  if (options.tear_hints) {
-    for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
-      for (const double c : band.color)
-        content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
-      content += "rg";
-      for (int k = 0; k < 4; ++k) {
-        content += " " + detail::fixed(band.corners[k].x, 3) + " " +
-                   detail::fixed(band.corners[k].y, 3) + (k == 0 ? " m" : " l");
-      }
-      content += " h f\n";
-    }
-  }
-  for (const Stroke& stroke : image.strokes) {
-    if (stroke.level != options.level) continue;
-    const std::vector<Vec2> outline = detail::stroke_outline(stroke);
-    if (outline.empty()) continue;
-    const float rgb[3] = {stroke.color.r, stroke.color.g, stroke.color.b};
-    for (const float c : rgb) content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
-    content += "rg\n";
-    for (size_t i = 0; i < outline.size(); ++i) {
-      content += detail::fixed(outline[i].x, 3) + " " + detail::fixed(outline[i].y, 3) +
-                 (i == 0 ? " m\n" : " l\n");
-    }
-    content += "h f\n";
-  }
+  content += overlays(image, mesh, options, s);
   content += "Q\n";
 
-  std::string pdf = "%PDF-1.4\n%\xE2\xE3\xCF\xD3\n";
-  std::vector<size_t> offsets;
-  auto object = [&](const std::string& body) {
-    offsets.push_back(pdf.size());
-    pdf += std::to_string(offsets.size()) + " 0 obj\n" + body + "\nendobj\n";
-  };
-  std::string title;
-  for (const auto& [key, value] : image.metadata)
-    if (key == "title") title = value;
-  object("<< /Type /Catalog /Pages 2 0 R >>");
-  object("<< /Type /Pages /Kids [3 0 R] /Count 1 >>");
-  object("<< /Type /Page /Parent 2 0 R /MediaBox [0 0 " + detail::fixed(w * s, 6) + " " +
-         detail::fixed(h * s, 6) + "] /Contents 4 0 R /Resources << " + resources + " >> >>");
-  object(stream_object("<< /Filter /FlateDecode", deflate(content)));
-  object("<< /Producer (subvec)" + (title.empty() ? "" : " /Title " + pdf_string(title)) + " >>");
-  for (const std::string& body : extra) object(body);
-  const size_t xref = pdf.size();
-  pdf += "xref\n0 " + std::to_string(offsets.size() + 1) + "\n0000000000 65535 f \n";
-  for (const size_t o : offsets) {
-    char line[24];
-    std::snprintf(line, sizeof line, "%010zu 00000 n \n", o);
-    pdf += line;
-  }
-  pdf += "trailer\n<< /Size " + std::to_string(offsets.size() + 1) +
-         " /Root 1 0 R /Info 5 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
-  return pdf;
+  return assemble(image, w, h, s, resources, content, extra);
 }
 
 }  // namespace subvec

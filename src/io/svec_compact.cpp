@@ -842,131 +842,136 @@ ControlMesh quantize_positions(const ControlMesh& mesh, int width, int height,
 // ---------------------------------------------------------------------------------------------
 // Encoder.
 
-void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
-                          int color_bits, int version, ByteWriter& out,
-                          std::vector<size_t>& block_ends, std::vector<int32_t>* vertex_order) {
-  const int32_t nv = mesh.num_vertices(), virt = nv;
-  // The closed mesh: real triangles, then one virtual triangle (b, a, virtual) per border edge
-  // a -> b.
-  std::vector<Tri> closed = mesh.triangles;
+namespace {
+
+// The closed mesh: real triangles, then one virtual triangle (b, a, virtual) per border edge
+// a -> b; and each half-edge's triangle.
+struct ClosedMesh {
+  std::vector<Tri> triangles;
   std::unordered_map<uint64_t, int32_t> half_edges;
-  half_edges.reserve(closed.size() * 4);
+};
+
+ClosedMesh close_mesh(const ControlMesh& mesh, int32_t virt) {
+  ClosedMesh closed{mesh.triangles, {}};
+  closed.half_edges.reserve(closed.triangles.size() * 4);
   for (int32_t f = 0; f < static_cast<int32_t>(mesh.triangles.size()); ++f)
-    for (int k = 0; k < 3; ++k) half_edges[key(closed[f][k], closed[f][(k + 1) % 3])] = f;
+    for (int k = 0; k < 3; ++k) closed.half_edges[key(closed.triangles[f][k], closed.triangles[f][(k + 1) % 3])] = f;
   for (int32_t f = 0; f < static_cast<int32_t>(mesh.triangles.size()); ++f) {
     for (int k = 0; k < 3; ++k) {
       const int32_t a = mesh.triangles[f][k], b = mesh.triangles[f][(k + 1) % 3];
-      if (half_edges.count(key(b, a))) continue;
-      const auto g = static_cast<int32_t>(closed.size());
-      closed.push_back({b, a, virt});
-      half_edges[key(b, a)] = g;
-      half_edges[key(a, virt)] = g;
-      half_edges[key(virt, b)] = g;
+      if (closed.half_edges.count(key(b, a))) continue;
+      const auto g = static_cast<int32_t>(closed.triangles.size());
+      closed.triangles.push_back({b, a, virt});
+      closed.half_edges[key(b, a)] = g;
+      closed.half_edges[key(a, virt)] = g;
+      closed.half_edges[key(virt, b)] = g;
     }
   }
+  return closed;
+}
 
-  // Traverse, numbering vertices as they are met.
-  std::vector<int32_t> code(size_t(nv) + 1, -1);
-  Traversal tr;
+// The encoder's traversal in the original numbering: each vertex's decode number (`code`), the
+// operations with their contexts and split codes, the visited faces (u, w, x) and each vertex's
+// basis (u, w, apex) when it was met.
+struct EncoderTraversal {
+  std::vector<int32_t> code;
   std::vector<uint8_t> ops;
   std::vector<OpContext> op_contexts;
   std::vector<uint64_t> splits;
-  std::vector<char> visited(closed.size(), 0);
+  std::vector<Tri> faces;
+  std::vector<std::array<int32_t, 3>> basis;
+};
+
+// Traverses the closed mesh from its triangle 0, numbering vertices as they are met.
+EncoderTraversal traverse(const ClosedMesh& closed, int32_t nv) {
+  const int32_t virt = nv;
+  EncoderTraversal e;
+  e.code.assign(size_t(nv) + 1, -1);
+  std::vector<char> visited(closed.triangles.size(), 0);
   std::vector<int32_t> visits(size_t(nv) + 1, 0);  // visited triangles per (original) vertex
-  std::vector<std::array<int32_t, 3>> basis;  // original numbering
-  const Tri seed = closed[0];
+  const Tri seed = closed.triangles[0];
   for (int k = 0; k < 3; ++k) {
-    code[seed[k]] = k;
-    basis.push_back({-1, -1, -1});
+    e.code[seed[k]] = k;
+    e.basis.push_back({-1, -1, -1});
     visits[seed[k]] = 1;
   }
   visited[0] = 1;
-  std::vector<Tri> faces = {seed};
+  e.faces = {seed};
   Frontier front(seed[0], seed[1], seed[2]);
   for (;;) {
     const int32_t u = front.u(), w = front.w();
-    const auto it = half_edges.find(key(u, w));
-    if (it == half_edges.end() || visited[it->second])
+    const auto it = closed.half_edges.find(key(u, w));
+    if (it == closed.half_edges.end() || visited[it->second])
       fail("internal error: the compact encoder lost its way", ErrorCode::kInvalidMesh);
     const int32_t f = it->second;
     visited[f] = 1;
-    const Tri& t = closed[f];
+    const Tri& t = closed.triangles[f];
     const int32_t x = t[0] != u && t[0] != w ? t[0] : t[1] != u && t[1] != w ? t[1] : t[2];
-    faces.push_back({u, w, x});
-    op_contexts.push_back(
+    e.faces.push_back({u, w, x});
+    e.op_contexts.push_back(
         {front.size() == 3, fan_bucket(u, virt, visits), fan_bucket(w, virt, visits)});
     for (const int32_t v : {u, w, x}) ++visits[v];
     bool last = false;
-    if (code[x] < 0) {
-      code[x] = static_cast<int32_t>(basis.size());
-      basis.push_back({u, w, front.gate_apex()});
-      ops.push_back(kOpC);
+    if (e.code[x] < 0) {
+      e.code[x] = static_cast<int32_t>(e.basis.size());
+      e.basis.push_back({u, w, front.gate_apex()});
+      e.ops.push_back(kOpC);
       front.add_vertex(x);
     } else if (front.size() == 3) {
-      ops.push_back(kOpE);
+      e.ops.push_back(kOpE);
       last = !front.close_loop();
     } else if (front.after_w() == x) {
-      ops.push_back(kOpR);
+      e.ops.push_back(kOpR);
       front.close_right();
     } else if (front.before_u() == x) {
-      ops.push_back(kOpL);
+      e.ops.push_back(kOpL);
       front.close_left();
     } else {
       const int64_t pos = front.find(x);
       if (pos < 3 || pos > front.size() - 2)
         fail("internal error: the compact encoder lost its way", ErrorCode::kInvalidMesh);
-      ops.push_back(kOpS);
-      splits.push_back(split_code(pos, front.size()));
+      e.ops.push_back(kOpS);
+      e.splits.push_back(split_code(pos, front.size()));
       front.split(pos);
     }
     if (last) break;
   }
-  if (faces.size() != closed.size() || basis.size() != size_t(nv) + 1)
+  if (e.faces.size() != closed.triangles.size() || e.basis.size() != size_t(nv) + 1)
     fail("internal error: the mesh is not a disk", ErrorCode::kInvalidMesh);
+  return e;
+}
 
-  // In decode numbering.
-  tr.virtual_vertex = code[virt];
-  auto dc = [&](int32_t v) { return v < 0 ? -1 : code[v]; };
-  for (size_t f = 0; f < faces.size(); ++f) {
-    tr.faces.push_back({dc(faces[f][0]), dc(faces[f][1]), dc(faces[f][2])});
+// The traversal in decode numbering.
+Traversal decode_numbering(const EncoderTraversal& e, int32_t virt) {
+  Traversal tr;
+  tr.virtual_vertex = e.code[virt];
+  auto dc = [&](int32_t v) { return v < 0 ? -1 : e.code[v]; };
+  for (size_t f = 0; f < e.faces.size(); ++f) {
+    tr.faces.push_back({dc(e.faces[f][0]), dc(e.faces[f][1]), dc(e.faces[f][2])});
   }
-  for (const auto& b : basis) tr.vertex_basis.push_back({dc(b[0]), dc(b[1]), dc(b[2])});
-  Canonical c = make_canonical(tr, nv);
-  std::vector<int32_t> final_of(nv);
-  for (int32_t v = 0; v < nv; ++v) final_of[v] = c.final_index[code[v]];
-  if (vertex_order) *vertex_order = final_of;
-  ControlMesh& m = c.mesh;
-  m.positions.resize(nv);
-  for (int32_t v = 0; v < nv; ++v) m.positions[final_of[v]] = mesh.positions[v];
-  for (const EdgeVerts& e : mesh.creases) m.creases.push_back({final_of[e[0]], final_of[e[1]]});
-  for (const Feature& f : mesh.features) {
-    Feature g = f;
-    for (int32_t& v : g.vertices) v = final_of[v];
-    m.features.push_back(g);
-  }
+  for (const auto& b : e.basis) tr.vertex_basis.push_back({dc(b[0]), dc(b[1]), dc(b[2])});
+  return tr;
+}
 
-  Models models;
-  VarintSink varints;
-  RangeSink coded(models, nv);
-  SymbolSink& sink = version == 2 ? static_cast<SymbolSink&>(varints) : coded;
-
-  // 1-2. Connectivity (the seed is implicit; 2V - 3 operations), the virtual vertex first and
-  // each S's offset after it.
+// 1-2. Connectivity (the seed is implicit; 2V - 3 operations), the virtual vertex first and each
+// S's offset after it.
+void encode_connectivity(const EncoderTraversal& e, const Traversal& tr, SymbolSink& sink) {
   sink.virtual_vertex(uint64_t(tr.virtual_vertex));
-  {
-    size_t s = 0;
-    for (size_t i = 0; i < ops.size(); ++i) {
-      sink.op(ops[i], op_contexts[i]);
-      if (ops[i] == kOpS) sink.split(splits[s++]);
-    }
+  size_t s = 0;
+  for (size_t i = 0; i < e.ops.size(); ++i) {
+    sink.op(e.ops[i], e.op_contexts[i]);
+    if (e.ops[i] == kOpS) sink.split(e.splits[s++]);
   }
+}
 
-  // 3. Positions, in decode order.
+// 3. Positions on the grid, in decode order (returned, indexed by decode number).
+std::vector<Point> encode_positions(const ControlMesh& mesh, const EncoderTraversal& e, const Traversal& tr,
+                                    int width, int height, int position_bits, SymbolSink& sink) {
   const size_t n_decode = tr.vertex_basis.size();
   std::vector<Point> p(n_decode, Point{0, 0});
-  for (int32_t v = 0; v < nv; ++v) {
-    p[code[v]] = {to_grid(mesh.positions[v].x, position_bits),
-                  to_grid(mesh.positions[v].y, position_bits)};
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    p[e.code[v]] = {to_grid(mesh.positions[v].x, position_bits),
+                    to_grid(mesh.positions[v].y, position_bits)};
   }
   const Point max = {int64_t{width} << position_bits, int64_t{height} << position_bits};
   Point previous{0, 0};
@@ -977,10 +982,11 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
     sink.position(p[d][0] - q[0], p[d][1] - q[1]);
     previous = p[d];
   }
+  return p;
+}
 
-  // 4. Creases and features. Prediction works on final vertex numbers with positions on the grid.
-  std::vector<Point> fp(nv);
-  for (int32_t v = 0; v < nv; ++v) fp[v] = p[c.decode_index[v]];
+// 4. Creases and features of the canonical mesh m, steps ranked on its grid positions fp.
+void encode_features(const ControlMesh& m, const std::vector<Point>& fp, SymbolSink& sink) {
   const Neighbors nb = neighbors(m.triangles, m.positions.size());
   for (const EdgeVerts& e : m.creases) {
     sink.vertex(uint64_t(e[0]));
@@ -997,15 +1003,12 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
                 i == 1);
     }
   }
+}
 
-  // 5. Colors, in canonical face-varying order.
-  const MeshTopology topo = MeshTopology::build(m, width, height);
-  int num_colors = 0;
-  const std::vector<Tri> fv = face_varying_indices(m, topo, num_colors);
-  // Targets on the grid scale, in canonical order.
-  // The decoder takes grid values and residuals up to 2^48 in magnitude; colors up to 2^44 grid
-  // steps leave room for the residuals (at most 2^46) and the error diffusion. Larger colors (a
-  // hand-written 3e38, valid in the model) cannot be coded: llround would overflow.
+// The decoder takes grid values and residuals up to 2^48 in magnitude; colors up to 2^44 grid
+// steps leave room for the residuals (at most 2^46) and the error diffusion. Larger colors (a
+// hand-written 3e38, valid in the model) cannot be coded: llround would overflow.
+void check_color_range(const ControlMesh& mesh, int color_bits) {
   const double max_color = std::ldexp(1.0, 44 - color_bits);
   for (const Color& color : mesh.colors) {
     for (const float v : {color.r, color.g, color.b}) {
@@ -1019,16 +1022,21 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
       }
     }
   }
+}
+
+// Color targets on the grid scale, in the canonical face-varying order fv of m.
+std::vector<std::array<double, 3>> color_targets(const ControlMesh& mesh, const ControlMesh& m,
+                                                 const ClosedMesh& closed, const EncoderTraversal& e,
+                                                 const std::vector<Tri>& fv, int num_colors, int color_bits) {
+  const int32_t virt = mesh.num_vertices();
   std::vector<std::array<double, 3>> target(num_colors);
   std::vector<int32_t> origin(mesh.triangles.size());  // canonical triangle -> visited face
-  {
-    int32_t t = 0;
-    for (size_t f = 0; f < faces.size(); ++f)
-      if (faces[f][0] != virt && faces[f][1] != virt && faces[f][2] != virt) origin[t++] = int32_t(f);
-  }
-  for (int32_t t = 0; t < m.num_triangles(); ++t) {
-    const Tri& orig_face = faces[origin[t]];  // (u, w, x) in original vertex numbers
-    const int32_t of = half_edges.at(key(orig_face[0], orig_face[1]));
+  int32_t t = 0;
+  for (size_t f = 0; f < e.faces.size(); ++f)
+    if (e.faces[f][0] != virt && e.faces[f][1] != virt && e.faces[f][2] != virt) origin[t++] = int32_t(f);
+  for (t = 0; t < m.num_triangles(); ++t) {
+    const Tri& orig_face = e.faces[origin[t]];  // (u, w, x) in original vertex numbers
+    const int32_t of = closed.half_edges.at(key(orig_face[0], orig_face[1]));
     for (int k = 0; k < 3; ++k) {
       int j = 0;
       while (mesh.triangles[of][j] != orig_face[k]) ++j;
@@ -1038,10 +1046,14 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
                           std::ldexp(double(col.b), color_bits)};
     }
   }
-  // Values are coded in index order (the order of first use). Each one's rounding error is taken
-  // off the targets of its neighbors still to come (error diffusion), so that nearby errors
-  // cancel: the rendered color is a local average of control colors, and moves less than the
-  // values themselves.
+  return target;
+}
+
+// 5. Colors, in index order (the order of first use). Each one's rounding error is taken off the
+// targets of its neighbors still to come (error diffusion), so that nearby errors cancel: the
+// rendered color is a local average of control colors, and moves less than the values themselves.
+void encode_colors(const std::vector<Tri>& fv, int num_colors, std::vector<std::array<double, 3>> target,
+                   int color_bits, SymbolSink& sink) {
   const Neighbors cadj = neighbors(fv, size_t(num_colors));
   std::vector<Rgb> colors(num_colors), color_activity(num_colors);
   std::vector<char> known(num_colors, 0);
@@ -1071,44 +1083,84 @@ void encode_compact_level(const ControlMesh& mesh, int width, int height, int po
     known[ci] = 1;
     last = colors[ci];
   }
+}
+
+}  // namespace
+
+void encode_compact_level(const ControlMesh& mesh, int width, int height, int position_bits,
+                          int color_bits, int version, ByteWriter& out,
+                          std::vector<size_t>& block_ends, std::vector<int32_t>* vertex_order) {
+  const int32_t nv = mesh.num_vertices(), virt = nv;
+  const ClosedMesh closed = close_mesh(mesh, virt);
+  const EncoderTraversal e = traverse(closed, nv);
+  const Traversal tr = decode_numbering(e, virt);
+  Canonical c = make_canonical(tr, nv);
+  std::vector<int32_t> final_of(nv);
+  for (int32_t v = 0; v < nv; ++v) final_of[v] = c.final_index[e.code[v]];
+  if (vertex_order) *vertex_order = final_of;
+  ControlMesh& m = c.mesh;
+  m.positions.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) m.positions[final_of[v]] = mesh.positions[v];
+  for (const EdgeVerts& edge : mesh.creases) m.creases.push_back({final_of[edge[0]], final_of[edge[1]]});
+  for (const Feature& f : mesh.features) {
+    Feature g = f;
+    for (int32_t& v : g.vertices) v = final_of[v];
+    m.features.push_back(g);
+  }
+
+  Models models;
+  VarintSink varints;
+  RangeSink coded(models, nv);
+  SymbolSink& sink = version == 2 ? static_cast<SymbolSink&>(varints) : coded;
+  encode_connectivity(e, tr, sink);
+  const std::vector<Point> p = encode_positions(mesh, e, tr, width, height, position_bits, sink);
+  // Prediction works on final vertex numbers with positions on the grid.
+  std::vector<Point> fp(nv);
+  for (int32_t v = 0; v < nv; ++v) fp[v] = p[c.decode_index[v]];
+  encode_features(m, fp, sink);
+
+  const MeshTopology topo = MeshTopology::build(m, width, height);
+  int num_colors = 0;
+  const std::vector<Tri> fv = face_varying_indices(m, topo, num_colors);
+  check_color_range(mesh, color_bits);
+  encode_colors(fv, num_colors, color_targets(mesh, m, closed, e, fv, num_colors, color_bits), color_bits, sink);
   sink.finish(out, block_ends);
 }
 
 // ---------------------------------------------------------------------------------------------
 // Decoder.
 
-ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, int version) {
-  const std::string name = "level " + str(uint64_t(level)) + " ";
+namespace {
+
+// What a level declares before its symbols.
+struct LevelCounts {
+  size_t vertices = 0, colors = 0, triangles = 0, creases = 0, features = 0;
+  int position_bits = 0, color_bits = 0;
+};
+
+LevelCounts read_counts(Cursor& in, const std::string& name) {
+  LevelCounts n;
   in.set_context(name + "counts");
-  const size_t nv = in.count(name + "vertices", 0);
-  const size_t num_colors = in.count(name + "colors", 0);
-  const size_t num_triangles = in.count(name + "triangles", 0);
-  const size_t num_creases = in.count(name + "creases", 0);
-  const size_t num_features = in.count(name + "features", 0);
+  n.vertices = in.count(name + "vertices", 0);
+  n.colors = in.count(name + "colors", 0);
+  n.triangles = in.count(name + "triangles", 0);
+  n.creases = in.count(name + "creases", 0);
+  n.features = in.count(name + "features", 0);
   in.set_context(name + "precision");
-  const int position_bits = in.u8(), color_bits = static_cast<int8_t>(in.u8());
-  if (position_bits > kMaxPositionBits || color_bits < kMinColorBits ||
-      color_bits > kMaxColorBits) {
-    fail(name + "precision: position bits " + std::to_string(position_bits) + ", color bits " +
-         std::to_string(color_bits) + " (expected 0 to " + std::to_string(kMaxPositionBits) +
+  n.position_bits = in.u8(), n.color_bits = static_cast<int8_t>(in.u8());
+  if (n.position_bits > kMaxPositionBits || n.color_bits < kMinColorBits ||
+      n.color_bits > kMaxColorBits) {
+    fail(name + "precision: position bits " + std::to_string(n.position_bits) + ", color bits " +
+         std::to_string(n.color_bits) + " (expected 0 to " + std::to_string(kMaxPositionBits) +
          " and " + std::to_string(kMinColorBits) + " to " + std::to_string(kMaxColorBits) + ")");
   }
-  if (nv < 3) fail(name + "vertices: " + str(nv) + " (a level has at least 3)");
+  if (n.vertices < 3) fail(name + "vertices: " + str(n.vertices) + " (a level has at least 3)");
+  return n;
+}
 
-  Models models;
-  std::unique_ptr<SymbolSource> source;
-  if (version == 2) {
-    source = std::make_unique<VarintSource>(in, name, nv);
-  } else {
-    const std::string label = name + "stream";
-    const size_t n = in.count(label, 1, Limits::kMaxElements * 64);
-    in.set_context(label);
-    source = std::make_unique<RangeSource>(std::span<const uint8_t>(in.take(n), n), name, models, nv);
-  }
-  SymbolSource& src = *source;
+// 1-2. Connectivity: 2V - 3 operations after the seed.
+Traversal decode_connectivity(SymbolSource& src, size_t nv, const std::string& name) {
   auto corrupt = [&](const std::string& what) { fail(name + "connectivity: " + what); };
-
-  // 1-2. Connectivity: 2V - 3 operations after the seed.
   const size_t num_ops = 2 * nv - 3;
   src.begin(kConnectivity);
   src.begin(kSplits);
@@ -1159,14 +1211,12 @@ ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, i
   }
   src.end(kConnectivity);
   src.end(kSplits);
-  Canonical c = make_canonical(tr, static_cast<int>(nv));
-  ControlMesh& m = c.mesh;
-  if (size_t(m.num_triangles()) != num_triangles) {
-    corrupt(str(uint64_t(m.num_triangles())) + " triangles, but " + str(num_triangles) +
-            " are declared");
-  }
+  return tr;
+}
 
-  // 3. Positions.
+// 3. Positions on the grid, indexed by decode number.
+std::vector<Point> decode_positions(SymbolSource& src, const Traversal& tr, size_t nv, int width, int height,
+                                    int position_bits, const std::string& name) {
   src.begin(kPositions);
   std::vector<Point> p(nv + 1, Point{0, 0});
   const Point max = {int64_t{width} << position_bits, int64_t{height} << position_bits};
@@ -1184,14 +1234,13 @@ ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, i
     previous = p[d];
   }
   src.end(kPositions);
-  m.positions.resize(nv);
-  std::vector<Point> fp(nv);
-  for (size_t v = 0; v < nv; ++v) {
-    fp[v] = p[c.decode_index[v]];
-    m.positions[v] = {from_grid(fp[v][0], position_bits), from_grid(fp[v][1], position_bits)};
-  }
+  return p;
+}
 
-  // 4. Creases and features.
+// 4. Creases and features of m, steps ranked on its grid positions fp.
+void decode_features(SymbolSource& src, const LevelCounts& counts, const std::vector<Point>& fp,
+                     const std::string& name, ControlMesh& m) {
+  const size_t nv = counts.vertices;
   src.begin(kFeatures);
   src.begin(kSteps);
   const Neighbors nb = neighbors(m.triangles, m.positions.size());
@@ -1205,13 +1254,13 @@ ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, i
     if (r >= ranked.size()) fail(name + what + ": step " + str(r) + " out of range");
     return ranked[r];
   };
-  for (size_t i = 0; i < num_creases; ++i) {
+  for (size_t i = 0; i < counts.creases; ++i) {
     const std::string what = "crease " + str(i);
     const int32_t a = vertex(src.vertex(), what);
     m.creases.push_back({a, step(-1, a, true, what)});
   }
   int64_t previous_id = -1;
-  for (size_t i = 0; i < num_features; ++i) {
+  for (size_t i = 0; i < counts.features; ++i) {
     const std::string what = "feature " + str(i);
     Feature f;
     const int64_t id = previous_id + 1 + src.feature_id(what);
@@ -1230,15 +1279,19 @@ ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, i
   }
   src.end(kFeatures);
   src.end(kSteps);
+}
 
-  // 5. Colors.
+// 5. Colors: the face-varying indices from the tears, then the values in index order.
+void decode_colors(SymbolSource& src, const LevelCounts& counts, int width, int height, const std::string& name,
+                   ControlMesh& m) {
+  const int color_bits = counts.color_bits;
   src.begin(kColors);
   const MeshTopology topo = MeshTopology::build(m, width, height);
   int nc = 0;
   m.triangle_colors = face_varying_indices(m, topo, nc);
-  if (size_t(nc) != num_colors) {
+  if (size_t(nc) != counts.colors) {
     fail(name + "colors: the tears give " + str(uint64_t(nc)) + " color values, but " +
-         str(num_colors) + " are declared");
+         str(counts.colors) + " are declared");
   }
   std::vector<Rgb> colors(nc), color_activity(nc);
   const Neighbors cadj = neighbors(m.triangle_colors, size_t(nc));
@@ -1269,6 +1322,43 @@ ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, i
                    static_cast<float>(from_grid(colors[i][1], color_bits)),
                    static_cast<float>(from_grid(colors[i][2], color_bits))};
   }
+}
+
+}  // namespace
+
+ControlMesh decode_compact_level(Cursor& in, int level, int width, int height, int version) {
+  const std::string name = "level " + str(uint64_t(level)) + " ";
+  const LevelCounts counts = read_counts(in, name);
+  const size_t nv = counts.vertices;
+
+  Models models;
+  std::unique_ptr<SymbolSource> source;
+  if (version == 2) {
+    source = std::make_unique<VarintSource>(in, name, nv);
+  } else {
+    const std::string label = name + "stream";
+    const size_t n = in.count(label, 1, Limits::kMaxElements * 64);
+    in.set_context(label);
+    source = std::make_unique<RangeSource>(std::span<const uint8_t>(in.take(n), n), name, models, nv);
+  }
+  SymbolSource& src = *source;
+
+  const Traversal tr = decode_connectivity(src, nv, name);
+  Canonical c = make_canonical(tr, static_cast<int>(nv));
+  ControlMesh& m = c.mesh;
+  if (size_t(m.num_triangles()) != counts.triangles) {
+    fail(name + "connectivity: " + str(uint64_t(m.num_triangles())) + " triangles, but " +
+         str(counts.triangles) + " are declared");
+  }
+  const std::vector<Point> p = decode_positions(src, tr, nv, width, height, counts.position_bits, name);
+  m.positions.resize(nv);
+  std::vector<Point> fp(nv);
+  for (size_t v = 0; v < nv; ++v) {
+    fp[v] = p[c.decode_index[v]];
+    m.positions[v] = {from_grid(fp[v][0], counts.position_bits), from_grid(fp[v][1], counts.position_bits)};
+  }
+  decode_features(src, counts, fp, name, m);
+  decode_colors(src, counts, width, height, name, m);
   return std::move(c.mesh);
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <unordered_set>
 
+#include "io/json_p.h"
 #include "io/svec_p.h"
 #include "subvec/core/error.h"
 #include "subvec/io/svec.h"
@@ -146,27 +147,7 @@ struct Path {
   throw Error(code, svec_detail::one_line(path.str() + ": " + message));
 }
 
-const char* type_name(const Json& j) {
-  switch (j.type()) {
-    case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned:
-      return "an integer";
-    case Json::value_t::number_float:
-      return "a number with a fraction or exponent";
-    case Json::value_t::string:
-      return "a string";
-    case Json::value_t::boolean:
-      return "a boolean";
-    case Json::value_t::null:
-      return "null";
-    case Json::value_t::array:
-      return "an array";
-    case Json::value_t::object:
-      return "an object";
-    default:
-      return "an unsupported value";
-  }
-}
+const char* type_name(const Json& j) { return detail::json_type_name(j, true); }
 
 // Rejects keys outside `allowed`, naming the first unknown one.
 void check_keys(const Json& object, const Path& path, std::initializer_list<const char*> allowed) {

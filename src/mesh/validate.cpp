@@ -24,16 +24,13 @@
 #include <string>
 #include <unordered_set>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
 namespace {
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+using detail::num;
 
 std::string str(int64_t v) { return std::to_string(v); }
 

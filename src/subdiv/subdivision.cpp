@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <numeric>
 #include <string>
-#include <thread>
 
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
@@ -16,6 +15,7 @@
 #include <opensubdiv/far/topologyRefiner.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
+#include "core/parallel_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -233,10 +233,8 @@ std::unique_ptr<Far::TopologyRefiner> make_refiner(const ControlMesh& mesh,
   return create_refiner(mesh, topo, s);
 }
 
-int resolve_threads(int threads) {
-  if (threads > 0) return threads;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
+using detail::parallel_for;
+using detail::resolve_threads;
 
 }  // namespace
 
@@ -425,10 +423,7 @@ void apply_stencils(const SparseMatrix& s, Get get, std::span<float> out, int th
     }
   };
   const int t = std::clamp(resolve_threads(threads), 1, std::max(1, rows / 4096));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < t; ++i) pool.emplace_back(work, int(int64_t(rows) * i / t), int(int64_t(rows) * (i + 1) / t));
-  work(0, int(int64_t(rows) / t));
-  for (std::thread& th : pool) th.join();
+  parallel_for(t, t, [&](int i) { work(int(int64_t(rows) * i / t), int(int64_t(rows) * (i + 1) / t)); });
 }
 
 }  // namespace
@@ -451,22 +446,19 @@ void Subdivision::Impl::refine_colors(std::span<const Color> colors, std::span<f
   }
   if (resolve_threads(threads) > 1) {
     // Channels refine independently with the same weights in the same order, so splitting them
-    // over threads gives bit-identical results: (r, g) on a helper thread, b here.
-    std::thread rg([&] {
-      refine_and_limit<2, true>(
-          [&](int i, double* v) {
-            v[0] = colors[i].r;
-            v[1] = colors[i].g;
-          },
-          out, 3, 0);
+    // over threads gives bit-identical results: (r, g) as one job, b as the other.
+    parallel_for(2, 2, [&](int job) {
+      if (job == 0) {
+        refine_and_limit<2, true>(
+            [&](int i, double* v) {
+              v[0] = colors[i].r;
+              v[1] = colors[i].g;
+            },
+            out, 3, 0);
+      } else {
+        refine_and_limit<1, true>([&](int i, double* v) { v[0] = colors[i].b; }, out, 3, 2);
+      }
     });
-    try {
-      refine_and_limit<1, true>([&](int i, double* v) { v[0] = colors[i].b; }, out, 3, 2);
-    } catch (...) {
-      rg.join();
-      throw;
-    }
-    rg.join();
     return;
   }
   refine_and_limit<3, true>(
@@ -525,19 +517,13 @@ void Subdivision::evaluate_with(std::span<const Vec2> positions, std::span<const
     }
   };
   // Positions and colors are independent passes over the same topology: run them side by side.
-  if (resolve_threads(threads) > 1) {
-    std::thread color_thread(evaluate_colors_here);
-    try {
+  parallel_for(2, threads, [&](int job) {
+    if (job == 0) {
       evaluate_positions_here();
-    } catch (...) {
-      color_thread.join();
-      throw;
+    } else {
+      evaluate_colors_here();
     }
-    color_thread.join();
-  } else {
-    evaluate_positions_here();
-    evaluate_colors_here();
-  }
+  });
 }
 
 void Subdivision::evaluate(std::span<const Vec2> positions, std::span<const Color> colors,
@@ -623,14 +609,10 @@ std::vector<StencilRows> compose_parts(const Masks& masks, const StencilRows& in
                                        int num_control, bool sorted) {
   const int parts = rows.size() < 65536 ? 1 : resolve_threads(0);
   std::vector<StencilRows> part(parts);
-  std::vector<std::thread> pool;
-  auto run = [&](int i) {
+  parallel_for(parts, parts, [&](int i) {
     const size_t begin = rows.size() * i / parts, end = rows.size() * (i + 1) / parts;
     part[i] = compose_rows(masks, in, rows.subspan(begin, end - begin), num_control, sorted);
-  };
-  for (int i = 1; i < parts; ++i) pool.emplace_back(run, i);
-  run(0);
-  for (std::thread& t : pool) t.join();
+  });
   return part;
 }
 

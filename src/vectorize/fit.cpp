@@ -10,30 +10,38 @@
 // Then `l1_iterations` reweighted solves (each pixel row weighted by 1 / its absolute residual,
 // floored) move the fit toward least absolute deviations, the error we report. Before those,
 // `relocate_iterations` damped Gauss-Newton steps may move the smooth control vertices against the
-// same pixel residual (docs/vectorize.md, "Vertex relocation").
+// same pixel residual (relocate.cpp; docs/vectorize.md, "Vertex relocation").
+//
+// The stages of fit_colors(), in order: the targets (set_pixel_targets: locate the pixels, mark the
+// band along the tears, fill its targets from their own side; or set_refined_vertex_targets), the
+// least-squares solve (solve_colors), the optional relocation, the L1 reweighting (reweighted_fit)
+// and the residual (measure_residual).
 #include "subvec/vectorize/fit.h"
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
 #include <string>
 
 #include <Eigen/SparseCholesky>
 
+#include "core/geometry_p.h"
 #include "core/parallel_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/subdiv/subdivision.h"
+#include "vectorize/fit_p.h"
+#include "vectorize/relocate_p.h"
 
 namespace subvec {
+namespace fit_detail {
 namespace {
+
+using detail::cross;
 
 struct Segment {
   float ax, ay, bx, by;
 };
-
-double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
 
 // Whether segments pq and ab intersect (touching counts).
 bool segments_cross(double px, double py, double qx, double qy, const Segment& s) {
@@ -42,13 +50,6 @@ bool segments_cross(double px, double py, double qx, double qy, const Segment& s
   const double d3 = cross(s.bx - s.ax, s.by - s.ay, px - s.ax, py - s.ay);
   const double d4 = cross(s.bx - s.ax, s.by - s.ay, qx - s.ax, qy - s.ay);
   return ((d1 <= 0 && d2 >= 0) || (d1 >= 0 && d2 <= 0)) && ((d3 <= 0 && d4 >= 0) || (d3 >= 0 && d4 <= 0));
-}
-
-double point_segment_distance(double px, double py, const Segment& s) {
-  const double dx = s.bx - s.ax, dy = s.by - s.ay, len2 = dx * dx + dy * dy;
-  double t = len2 > 0 ? ((px - s.ax) * dx + (py - s.ay) * dy) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(px - (s.ax + t * dx), py - (s.ay + t * dy));
 }
 
 // Tear segments bucketed on a coarse grid for neighbourhood queries.
@@ -83,13 +84,6 @@ class SegmentGrid {
   std::vector<Segment> segments_;
   int cell_, cols_, rows_;
   std::vector<std::vector<int32_t>> buckets_;
-};
-
-// Sparse rows, CSR.
-struct Rows {
-  std::vector<int32_t> offsets{0}, columns;
-  std::vector<double> values;
-  int num_rows() const { return static_cast<int>(offsets.size()) - 1; }
 };
 
 // Accumulates sparse rows through a dense array over the columns.
@@ -184,42 +178,11 @@ Rows multiply(const Rows& a, const SparseMatrix& s, int columns, int threads) {
   });
 }
 
-// The transpose of s (rows x columns) as rows.
-Rows transpose(const SparseMatrix& s) {
-  Rows out;
-  out.offsets.assign(size_t(s.cols()) + 1, 0);
-  for (int r = 0; r < s.rows(); ++r)
-    for (SparseMatrix::InnerIterator it(s, r); it; ++it) ++out.offsets[it.col() + 1];
-  std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
-  out.columns.resize(out.offsets.back());
-  out.values.resize(out.offsets.back());
-  std::vector<int32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
-  for (int r = 0; r < s.rows(); ++r) {
-    for (SparseMatrix::InnerIterator it(s, r); it; ++it) {
-      const int32_t k = fill[it.col()]++;
-      out.columns[k] = r;
-      out.values[k] = it.value();
-    }
-  }
-  return out;
-}
-
 std::array<double, 3> pixel(const Image8& image, int x, int y) {
   const uint8_t* p = image.row(y) + size_t(x) * image.channels;
   return {double(p[0]), double(p[1]), double(p[2])};
 }
 
-
-// Where a pixel centre lies: a refined triangle and barycentric weights (1 - b1 - b2, b1, b2).
-struct Location {
-  int32_t triangle = -1;
-  float b1 = 0, b2 = 0;
-};
-
-// Channel k of the prediction at a located pixel: the refined triangle's values interpolated.
-double predict(const Location& loc, const Tri& v, const Eigen::MatrixX3d& values, int k) {
-  return (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
-}
 
 // The lower triangle of the normal matrix S' M S, with M given as rows over the rows of S and st
 // the transpose of S: row i of the result is column i of the lower triangle, from the diagonal
@@ -254,6 +217,328 @@ Rhs solve_lower(const Rows& lower, const Rhs& rhs, const char* what) {
   return Rhs(solver.solve(rhs));
 }
 
+// The tear segments of the limit mesh, for the band and for same-side tests.
+SegmentGrid tear_grid(const FitSystem& system) {
+  const std::vector<float>& limit = system.limit;
+  std::vector<Segment> segments;
+  for (const EdgeVerts& e : system.refined.tear_edges) {
+    segments.push_back({limit[2 * e[0]], limit[2 * e[0] + 1], limit[2 * e[1]], limit[2 * e[1] + 1]});
+  }
+  return SegmentGrid(std::move(segments), system.width, system.height, 4);
+}
+
+// The band along the tears: pixels whose centre lies closer than `band` to a tear segment.
+std::vector<uint8_t> tear_band(const SegmentGrid& grid, int width, int height, double band) {
+  std::vector<uint8_t> in_band(size_t(width) * height, 0);
+  for (size_t i = 0; i < grid.size(); ++i) {
+    const Segment& sg = grid[static_cast<int32_t>(i)];
+    detail::for_pixels_near_segment(sg.ax, sg.ay, sg.bx, sg.by, band, width, height,
+                                    [&](int x, int y) { in_band[size_t(y) * width + x] = 1; });
+  }
+  return in_band;
+}
+
+// Hole filling (the paper's): each located band pixel's target is the inverse-square-distance
+// average of the non-band pixels within fill_radius on its own side of the tears (no tear segment
+// between them). In parallel, image rows apart.
+struct FilledTargets {
+  std::vector<std::array<double, 3>> color;
+  std::vector<uint8_t> ok;  // 0: nothing on this side nearby, the pixel is left out
+};
+
+FilledTargets fill_band(const FitSystem& system, const Image8& image, const SegmentGrid& grid,
+                        const std::vector<uint8_t>& band, const ColorFitOptions& options) {
+  const int width = system.width, height = system.height;
+  const int r = static_cast<int>(std::ceil(options.fill_radius));
+  FilledTargets filled{std::vector<std::array<double, 3>>(size_t(width) * height),
+                       std::vector<uint8_t>(size_t(width) * height, 0)};
+  const int parts = std::min(detail::resolve_threads(options.threads), height);
+  detail::parallel_for(parts, parts, [&](int part) {
+    std::vector<int32_t> nearby;
+    for (int y = height * part / parts; y < height * (part + 1) / parts; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (system.located[size_t(y) * width + x].triangle < 0 || !band[size_t(y) * width + x]) continue;
+        const double cx = x + 0.5, cy = y + 0.5;
+        grid.query(cx - r, cy - r, cx + r, cy + r, nearby);
+        std::array<double, 3> sum{0, 0, 0};
+        double wsum = 0;
+        for (int qy = std::max(0, y - r); qy <= std::min(height - 1, y + r); ++qy) {
+          for (int qx = std::max(0, x - r); qx <= std::min(width - 1, x + r); ++qx) {
+            if (band[size_t(qy) * width + qx]) continue;
+            const double d2 = double(qx - x) * (qx - x) + double(qy - y) * (qy - y);
+            if (d2 > options.fill_radius * options.fill_radius) continue;
+            bool blocked = false;
+            for (int32_t i : nearby) {
+              if (segments_cross(cx, cy, qx + 0.5, qy + 0.5, grid[i])) {
+                blocked = true;
+                break;
+              }
+            }
+            if (blocked) continue;
+            const auto q = pixel(image, qx, qy);
+            for (int k = 0; k < 3; ++k) sum[k] += q[k] / d2;
+            wsum += 1 / d2;
+          }
+        }
+        if (wsum == 0) continue;
+        for (int k = 0; k < 3; ++k) filled.color[size_t(y) * width + x][k] = sum[k] / wsum;
+        filled.ok[size_t(y) * width + x] = 1;
+      }
+    }
+  });
+  return filled;
+}
+
+}  // namespace
+
+// The transpose of s (rows x columns) as rows.
+Rows transpose(const SparseMatrix& s) {
+  Rows out;
+  out.offsets.assign(size_t(s.cols()) + 1, 0);
+  for (int r = 0; r < s.rows(); ++r)
+    for (SparseMatrix::InnerIterator it(s, r); it; ++it) ++out.offsets[it.col() + 1];
+  std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
+  out.columns.resize(out.offsets.back());
+  out.values.resize(out.offsets.back());
+  std::vector<int32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (int r = 0; r < s.rows(); ++r) {
+    for (SparseMatrix::InnerIterator it(s, r); it; ++it) {
+      const int32_t k = fill[it.col()]++;
+      out.columns[k] = r;
+      out.values[k] = it.value();
+    }
+  }
+  return out;
+}
+
+FitSystem::FitSystem(const ControlMesh& mesh, const MeshTopology& topology, int width_, int height_, int depth)
+    : width(width_), height(height_), sub(mesh, topology, depth), refined(sub.topology()), s(sub.color_stencils()),
+      m(static_cast<int>(s.rows())), c(static_cast<int>(s.cols())), st(transpose(s)),
+      limit(size_t(sub.num_vertices()) * 2), btt(m, {0, 0, 0}) {
+  sub.evaluate_positions_once(mesh.positions, limit);
+}
+
+int locate_pixels(FitSystem& system) {
+  const int width = system.width, height = system.height;
+  const RefinedMesh& refined = system.refined;
+  const std::vector<float>& limit = system.limit;
+  int folded = 0;
+  system.located.assign(size_t(width) * height, Location{});
+  for (int t = 0; t < refined.num_triangles(); ++t) {
+    const Tri& tri = refined.triangles[t];
+    const double x0 = limit[2 * tri[0]], y0 = limit[2 * tri[0] + 1];
+    const double x1 = limit[2 * tri[1]], y1 = limit[2 * tri[1] + 1];
+    const double x2 = limit[2 * tri[2]], y2 = limit[2 * tri[2] + 1];
+    const double area = cross(x1 - x0, y1 - y0, x2 - x0, y2 - y0);
+    if (area <= 0) {
+      ++folded;
+      continue;
+    }
+    const int px0 = std::max(0, int(std::ceil(std::min({x0, x1, x2}) - 0.5)));
+    const int px1 = std::min(width - 1, int(std::floor(std::max({x0, x1, x2}) - 0.5)));
+    const int py0 = std::max(0, int(std::ceil(std::min({y0, y1, y2}) - 0.5)));
+    const int py1 = std::min(height - 1, int(std::floor(std::max({y0, y1, y2}) - 0.5)));
+    constexpr double kEps = -1e-9;
+    for (int py = py0; py <= py1; ++py) {
+      for (int px = px0; px <= px1; ++px) {
+        Location& loc = system.located[size_t(py) * width + px];
+        if (loc.triangle >= 0) continue;
+        const double x = px + 0.5, y = py + 0.5;
+        const double b1 = cross(x - x0, y - y0, x2 - x0, y2 - y0) / area;
+        const double b2 = cross(x1 - x0, y1 - y0, x - x0, y - y0) / area;
+        if (b1 < kEps || b2 < kEps || 1 - b1 - b2 < kEps) continue;
+        loc = {t, static_cast<float>(b1), static_cast<float>(b2)};
+      }
+    }
+  }
+  for (const PixelRow& row : system.rows) folded += system.located[row.pixel].triangle < 0;
+  return folded;
+}
+
+void accumulate_pixels(FitSystem& system, const std::vector<double>& weights) {
+  const RefinedMesh& refined = system.refined;
+  system.blocks.assign(refined.num_triangles(), {0, 0, 0, 0, 0, 0});
+  system.btt.assign(system.m, {0, 0, 0});
+  for (size_t r = 0; r < system.rows.size(); ++r) {
+    const Location& loc = system.located[system.rows[r].pixel];
+    const double wr = weights.empty() ? 1.0 : weights[r];
+    const Tri& values = refined.triangle_colors[loc.triangle];
+    const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
+    std::array<double, 6>& g = system.blocks[loc.triangle];
+    g[0] += wr * w[0] * w[0], g[1] += wr * w[0] * w[1], g[2] += wr * w[0] * w[2];
+    g[3] += wr * w[1] * w[1], g[4] += wr * w[1] * w[2], g[5] += wr * w[2] * w[2];
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) system.btt[values[i]][k] += wr * w[i] * system.rows[r].target[k];
+  }
+}
+
+void set_pixel_targets(FitSystem& system, const Image8& image, const ColorFitOptions& options,
+                       ColorFitStats& stats) {
+  const int width = system.width, height = system.height;
+  locate_pixels(system);
+  const SegmentGrid grid = tear_grid(system);
+  const std::vector<uint8_t> band = tear_band(grid, width, height, options.band);
+  const FilledTargets filled = fill_band(system, image, grid, band, options);
+  // Targets: the pixel, or for band pixels the hole-filled color; the rows in pixel order.
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t i = size_t(y) * width + x;
+      if (system.located[i].triangle < 0) continue;
+      std::array<double, 3> target = pixel(image, x, y);
+      if (band[i]) {
+        if (!filled.ok[i]) continue;
+        target = filled.color[i];
+        ++stats.filled;
+      }
+      system.rows.push_back({static_cast<int32_t>(i), {float(target[0]), float(target[1]), float(target[2])}});
+    }
+  }
+  stats.rows = static_cast<int>(system.rows.size());
+  accumulate_pixels(system, {});
+}
+
+void set_refined_vertex_targets(FitSystem& system, const Image8& image, ColorFitStats& stats) {
+  // One row per refined color value, its target sampled at its limit position (values on a tear
+  // sample slightly inside their own side).
+  const RefinedMesh& refined = system.refined;
+  const std::vector<float>& limit = system.limit;
+  const int m = system.m;
+  std::vector<double> sx(m, 0), sy(m, 0), cnt(m, 0);
+  std::vector<int32_t> vertex_of(m, -1);
+  for (int t = 0; t < refined.num_triangles(); ++t) {
+    const Tri& tri = refined.triangles[t];
+    const double cx = (limit[2 * tri[0]] + limit[2 * tri[1]] + limit[2 * tri[2]]) / 3;
+    const double cy = (limit[2 * tri[0] + 1] + limit[2 * tri[1] + 1] + limit[2 * tri[2] + 1]) / 3;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t value = refined.triangle_colors[t][k];
+      vertex_of[value] = tri[k];
+      sx[value] += cx, sy[value] += cy, cnt[value] += 1;
+    }
+  }
+  system.diagonal.assign(m, 0.0);
+  std::vector<int> values_at_vertex(system.sub.num_vertices(), 0);
+  for (int v = 0; v < m; ++v)
+    if (vertex_of[v] >= 0) ++values_at_vertex[vertex_of[v]];
+  for (int v = 0; v < m; ++v) {
+    if (vertex_of[v] < 0) continue;
+    double x = limit[2 * vertex_of[v]], y = limit[2 * vertex_of[v] + 1];
+    if (values_at_vertex[vertex_of[v]] > 1) {
+      const double dx = sx[v] / cnt[v] - x, dy = sy[v] / cnt[v] - y, len = std::hypot(dx, dy);
+      if (len > 0) x += 0.75 * dx / len, y += 0.75 * dy / len;
+    }
+    const auto target = sample_bilinear(image, x, y);
+    system.diagonal[v] += 1;
+    for (int k = 0; k < 3; ++k) system.btt[v][k] += target[k];
+    ++stats.rows;
+  }
+}
+
+Eigen::MatrixX3d solve_colors(const FitSystem& system, const std::vector<Color>& start, double regularization,
+                              int threads) {
+  const int c = system.c;
+  const Rows& st = system.st;
+  Rows lower = lower_normal(gram_rows(system.refined, system.m, system.blocks, system.diagonal, threads), system.s,
+                            st, threads);
+  Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
+  for (int i = 0; i < c; ++i) {
+    for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e)
+      for (int k = 0; k < 3; ++k) rhs(i, k) += st.values[e] * system.btt[st.columns[e]][k];
+  }
+  // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches. Each
+  // column's first entry is its diagonal.
+  double trace = 0;
+  for (int i = 0; i < c; ++i) trace += lower.values[lower.offsets[i]];
+  const double scale = trace / std::max(1, c);
+  const double lambda = regularization * std::max(scale, 1e-12);
+  for (int i = 0; i < c; ++i) {
+    lower.values[lower.offsets[i]] += lambda;
+    rhs(i, 0) += lambda * start[i].r;
+    rhs(i, 1) += lambda * start[i].g;
+    rhs(i, 2) += lambda * start[i].b;
+  }
+  return Eigen::MatrixX3d(solve_lower(lower, rhs, "color fit"));
+}
+
+double squared_error(const FitSystem& system, const Eigen::MatrixX3d& values) {
+  double sum = 0;
+  for (const PixelRow& row : system.rows) {
+    const Location& loc = system.located[row.pixel];
+    for (int k = 0; k < 3; ++k) {
+      const double e = predict(loc, system.refined.triangle_colors[loc.triangle], values, k) - row.target[k];
+      sum += e * e;
+    }
+  }
+  return sum;
+}
+
+}  // namespace fit_detail
+
+namespace {
+
+using fit_detail::FitSystem;
+
+void check_inputs(int width, int height, const Image8& image, const ColorFitOptions& options) {
+  if (image.width != width || image.height != height) {
+    throw Error(ErrorCode::kInvalidArgument, "fit_colors: image is " + std::to_string(image.width) + "x" +
+                                                 std::to_string(image.height) + ", the mesh domain " +
+                                                 std::to_string(width) + "x" + std::to_string(height));
+  }
+  if (options.l1_iterations < 0 || !(options.l1_floor > 0)) {
+    throw Error(ErrorCode::kInvalidArgument, "fit_colors: l1_iterations must be >= 0 and l1_floor positive");
+  }
+  if (options.relocate_iterations < 0 || !(options.relocate_damping > 0) || !(options.relocate_max_step > 0) ||
+      options.relocate_cg_iterations < 1 || options.relocate_refit_every < 1) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "fit_colors: relocate_iterations must be >= 0, relocate_damping and relocate_max_step positive, "
+                "relocate_cg_iterations and relocate_refit_every at least 1");
+  }
+}
+
+// One iteratively reweighted least-squares step toward the least absolute deviations fit: each
+// pixel row weighted by 1 / max(its mean absolute residual under x, l1_floor), then solved again.
+Eigen::MatrixX3d reweighted_fit(FitSystem& system, const Eigen::MatrixX3d& x, const std::vector<Color>& start,
+                                const ColorFitOptions& options) {
+  const Eigen::MatrixX3d values = system.s * x;
+  const std::vector<fit_detail::PixelRow>& rows = system.rows;
+  std::vector<double> weights(rows.size());
+  const int parts = std::max(1, std::min(detail::resolve_threads(options.threads), 8));
+  detail::parallel_for(parts, parts, [&](int part) {
+    const size_t end = rows.size() * size_t(part + 1) / size_t(parts);
+    for (size_t r = rows.size() * size_t(part) / size_t(parts); r < end; ++r) {
+      const fit_detail::Location& loc = system.located[rows[r].pixel];
+      const Tri& v = system.refined.triangle_colors[loc.triangle];
+      double residual = 0;
+      for (int k = 0; k < 3; ++k) residual += std::abs(fit_detail::predict(loc, v, values, k) - rows[r].target[k]);
+      weights[r] = 1 / std::max(residual / 3, options.l1_floor);
+    }
+  });
+  fit_detail::accumulate_pixels(system, weights);
+  return fit_detail::solve_colors(system, start, options.regularization, options.threads);
+}
+
+// Residual over the located pixels (the paper's error, before 8-bit rounding) and the 8-bit MAE.
+void measure_residual(const FitSystem& system, const Image8& image, const Eigen::MatrixX3d& x, ColorFitStats& stats) {
+  const Eigen::MatrixX3d values = system.s * x;
+  double sum = 0, abs_sum = 0;
+  long n = 0;
+  for (int y = 0; y < system.height; ++y) {
+    for (int px = 0; px < system.width; ++px) {
+      const fit_detail::Location& loc = system.located[size_t(y) * system.width + px];
+      if (loc.triangle < 0) continue;
+      const Tri& v = system.refined.triangle_colors[loc.triangle];
+      const auto target = fit_detail::pixel(image, px, y);
+      for (int k = 0; k < 3; ++k) {
+        const double pred = fit_detail::predict(loc, v, values, k);
+        sum += (pred - target[k]) * (pred - target[k]);
+        abs_sum += std::abs(std::clamp(std::round(pred), 0.0, 255.0) - target[k]);
+      }
+      n += 3;
+    }
+  }
+  stats.rms = n ? std::sqrt(sum / double(n)) : 0;
+  stats.mae = n ? abs_sum / double(n) : 0;
+}
+
 }  // namespace
 
 int default_fit_depth(const ControlMesh& mesh) {
@@ -274,473 +559,30 @@ int default_fit_depth(const ControlMesh& mesh) {
 
 ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8& image,
                          const ColorFitOptions& options) {
-  if (image.width != width || image.height != height) {
-    throw Error(ErrorCode::kInvalidArgument, "fit_colors: image is " + std::to_string(image.width) + "x" +
-                                                 std::to_string(image.height) + ", the mesh domain " +
-                                                 std::to_string(width) + "x" + std::to_string(height));
-  }
-  if (options.l1_iterations < 0 || !(options.l1_floor > 0)) {
-    throw Error(ErrorCode::kInvalidArgument, "fit_colors: l1_iterations must be >= 0 and l1_floor positive");
-  }
-  if (options.relocate_iterations < 0 || !(options.relocate_damping > 0) || !(options.relocate_max_step > 0) ||
-      options.relocate_cg_iterations < 1 || options.relocate_refit_every < 1) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "fit_colors: relocate_iterations must be >= 0, relocate_damping and relocate_max_step positive, "
-                "relocate_cg_iterations and relocate_refit_every at least 1");
-  }
+  check_inputs(width, height, image, options);
   const MeshTopology topo = MeshTopology::build(mesh, width, height);
-  const int depth = options.depth >= 0 ? options.depth : default_fit_depth(mesh);
-  const Subdivision sub(mesh, topo, depth);
-  const RefinedMesh& refined = sub.topology();
-  const int num_refined = sub.num_vertices();
-  std::vector<float> limit(size_t(num_refined) * 2);
-  sub.evaluate_positions_once(mesh.positions, limit);
-  const SparseMatrix& s = sub.color_stencils();
-  const int m = static_cast<int>(s.rows()), c = static_cast<int>(s.cols());
-
-  // Tear segments of the limit mesh, for the band and for same-side tests.
-  std::vector<Segment> segments;
-  for (const EdgeVerts& e : refined.tear_edges) {
-    segments.push_back({limit[2 * e[0]], limit[2 * e[0] + 1], limit[2 * e[1]], limit[2 * e[1] + 1]});
-  }
-  const SegmentGrid grid(std::move(segments), width, height, 4);
-
-  // Accumulate B'B (on refined values: per refined triangle, or on the diagonal) and B't.
-  std::vector<std::array<double, 6>> blocks;
-  std::vector<double> diagonal;
-  std::vector<std::array<double, 3>> btt(m, {0, 0, 0});
+  FitSystem system(mesh, topo, width, height, options.depth >= 0 ? options.depth : default_fit_depth(mesh));
+  const bool pixels = options.target == ColorFitTarget::kPixels;
   ColorFitStats stats;
-
-  std::vector<Location> located;
-  // The fitted pixels (image index, target), and the Gram blocks and B't of their rows, each
-  // weighted (all 1 without weights).
-  struct PixelRow {
-    int32_t pixel;
-    std::array<float, 3> target;
-  };
-  std::vector<PixelRow> rows;
-  // Locates every pixel centre in a refined triangle of the limit mesh (first one wins on shared
-  // edges). Returns the number of folded refined triangles, plus the number of pixels with a row
-  // that no triangle holds.
-  auto locate_pixels = [&]() {
-    int folded = 0;
-    located.assign(size_t(width) * height, Location{});
-    for (int t = 0; t < refined.num_triangles(); ++t) {
-      const Tri& tri = refined.triangles[t];
-      const double x0 = limit[2 * tri[0]], y0 = limit[2 * tri[0] + 1];
-      const double x1 = limit[2 * tri[1]], y1 = limit[2 * tri[1] + 1];
-      const double x2 = limit[2 * tri[2]], y2 = limit[2 * tri[2] + 1];
-      const double area = cross(x1 - x0, y1 - y0, x2 - x0, y2 - y0);
-      if (area <= 0) {
-        ++folded;
-        continue;
-      }
-      const int px0 = std::max(0, int(std::ceil(std::min({x0, x1, x2}) - 0.5)));
-      const int px1 = std::min(width - 1, int(std::floor(std::max({x0, x1, x2}) - 0.5)));
-      const int py0 = std::max(0, int(std::ceil(std::min({y0, y1, y2}) - 0.5)));
-      const int py1 = std::min(height - 1, int(std::floor(std::max({y0, y1, y2}) - 0.5)));
-      constexpr double kEps = -1e-9;
-      for (int py = py0; py <= py1; ++py) {
-        for (int px = px0; px <= px1; ++px) {
-          Location& loc = located[size_t(py) * width + px];
-          if (loc.triangle >= 0) continue;
-          const double x = px + 0.5, y = py + 0.5;
-          const double b1 = cross(x - x0, y - y0, x2 - x0, y2 - y0) / area;
-          const double b2 = cross(x1 - x0, y1 - y0, x - x0, y - y0) / area;
-          if (b1 < kEps || b2 < kEps || 1 - b1 - b2 < kEps) continue;
-          loc = {t, static_cast<float>(b1), static_cast<float>(b2)};
-        }
-      }
-    }
-    for (const PixelRow& row : rows) folded += located[row.pixel].triangle < 0;
-    return folded;
-  };
-  auto accumulate_pixels = [&](const std::vector<double>& weights) {
-    blocks.assign(refined.num_triangles(), {0, 0, 0, 0, 0, 0});
-    btt.assign(m, {0, 0, 0});
-    for (size_t r = 0; r < rows.size(); ++r) {
-      const Location& loc = located[rows[r].pixel];
-      const double wr = weights.empty() ? 1.0 : weights[r];
-      const Tri& values = refined.triangle_colors[loc.triangle];
-      const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
-      std::array<double, 6>& g = blocks[loc.triangle];
-      g[0] += wr * w[0] * w[0], g[1] += wr * w[0] * w[1], g[2] += wr * w[0] * w[2];
-      g[3] += wr * w[1] * w[1], g[4] += wr * w[1] * w[2], g[5] += wr * w[2] * w[2];
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) btt[values[i]][k] += wr * w[i] * rows[r].target[k];
-    }
-  };
-  if (options.target == ColorFitTarget::kPixels) {
-    locate_pixels();
-    // The band along tears: those pixels get targets filled from their own side.
-    std::vector<uint8_t> band(size_t(width) * height, 0);
-    for (size_t i = 0; i < grid.size(); ++i) {
-      const Segment& sg = grid[static_cast<int32_t>(i)];
-      const int x0 = std::max(0, int(std::floor(std::min(sg.ax, sg.bx) - options.band - 0.5)));
-      const int x1 = std::min(width - 1, int(std::ceil(std::max(sg.ax, sg.bx) + options.band - 0.5)));
-      const int y0 = std::max(0, int(std::floor(std::min(sg.ay, sg.by) - options.band - 0.5)));
-      const int y1 = std::min(height - 1, int(std::ceil(std::max(sg.ay, sg.by) + options.band - 0.5)));
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x)
-          if (point_segment_distance(x + 0.5, y + 0.5, sg) < options.band) band[size_t(y) * width + x] = 1;
-    }
-    // Targets: the pixel, or for band pixels the hole-filled color (in parallel, image rows apart),
-    // then the rows in pixel order.
-    const int r = static_cast<int>(std::ceil(options.fill_radius));
-    std::vector<std::array<double, 3>> filled(size_t(width) * height);
-    std::vector<uint8_t> filled_ok(size_t(width) * height, 0);
-    const int parts = std::min(detail::resolve_threads(options.threads), height);
-    detail::parallel_for(parts, parts, [&](int part) {
-      std::vector<int32_t> nearby;
-      for (int y = height * part / parts; y < height * (part + 1) / parts; ++y) {
-        for (int x = 0; x < width; ++x) {
-          if (located[size_t(y) * width + x].triangle < 0 || !band[size_t(y) * width + x]) continue;
-          // Hole filling: inverse-square-distance average of non-band pixels on the same side.
-          const double cx = x + 0.5, cy = y + 0.5;
-          grid.query(cx - r, cy - r, cx + r, cy + r, nearby);
-          std::array<double, 3> sum{0, 0, 0};
-          double wsum = 0;
-          for (int qy = std::max(0, y - r); qy <= std::min(height - 1, y + r); ++qy) {
-            for (int qx = std::max(0, x - r); qx <= std::min(width - 1, x + r); ++qx) {
-              if (band[size_t(qy) * width + qx]) continue;
-              const double d2 = double(qx - x) * (qx - x) + double(qy - y) * (qy - y);
-              if (d2 > options.fill_radius * options.fill_radius) continue;
-              bool blocked = false;
-              for (int32_t i : nearby) {
-                if (segments_cross(cx, cy, qx + 0.5, qy + 0.5, grid[i])) {
-                  blocked = true;
-                  break;
-                }
-              }
-              if (blocked) continue;
-              const auto q = pixel(image, qx, qy);
-              for (int k = 0; k < 3; ++k) sum[k] += q[k] / d2;
-              wsum += 1 / d2;
-            }
-          }
-          if (wsum == 0) continue;  // nothing on this side nearby: leave the pixel out
-          for (int k = 0; k < 3; ++k) filled[size_t(y) * width + x][k] = sum[k] / wsum;
-          filled_ok[size_t(y) * width + x] = 1;
-        }
-      }
-    });
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const size_t i = size_t(y) * width + x;
-        if (located[i].triangle < 0) continue;
-        std::array<double, 3> target = pixel(image, x, y);
-        if (band[i]) {
-          if (!filled_ok[i]) continue;
-          target = filled[i];
-          ++stats.filled;
-        }
-        rows.push_back({static_cast<int32_t>(i), {float(target[0]), float(target[1]), float(target[2])}});
-      }
-    }
-    stats.rows = static_cast<int>(rows.size());
-    accumulate_pixels({});
+  if (pixels) {
+    fit_detail::set_pixel_targets(system, image, options, stats);
   } else {
-    // The paper's fit: one row per refined color value, its target sampled at its limit position
-    // (values on a tear sample slightly inside their own side).
-    std::vector<double> sx(m, 0), sy(m, 0), cnt(m, 0);
-    std::vector<int32_t> vertex_of(m, -1);
-    for (int t = 0; t < refined.num_triangles(); ++t) {
-      const Tri& tri = refined.triangles[t];
-      const double cx = (limit[2 * tri[0]] + limit[2 * tri[1]] + limit[2 * tri[2]]) / 3;
-      const double cy = (limit[2 * tri[0] + 1] + limit[2 * tri[1] + 1] + limit[2 * tri[2] + 1]) / 3;
-      for (int k = 0; k < 3; ++k) {
-        const int32_t value = refined.triangle_colors[t][k];
-        vertex_of[value] = tri[k];
-        sx[value] += cx, sy[value] += cy, cnt[value] += 1;
-      }
-    }
-    diagonal.assign(m, 0.0);
-    std::vector<int> values_at_vertex(num_refined, 0);
-    for (int v = 0; v < m; ++v)
-      if (vertex_of[v] >= 0) ++values_at_vertex[vertex_of[v]];
-    for (int v = 0; v < m; ++v) {
-      if (vertex_of[v] < 0) continue;
-      double x = limit[2 * vertex_of[v]], y = limit[2 * vertex_of[v] + 1];
-      if (values_at_vertex[vertex_of[v]] > 1) {
-        const double dx = sx[v] / cnt[v] - x, dy = sy[v] / cnt[v] - y, len = std::hypot(dx, dy);
-        if (len > 0) x += 0.75 * dx / len, y += 0.75 * dy / len;
-      }
-      const auto target = sample_bilinear(image, x, y);
-      diagonal[v] += 1;
-      for (int k = 0; k < 3; ++k) btt[v][k] += target[k];
-      ++stats.rows;
-    }
+    fit_detail::set_refined_vertex_targets(system, image, stats);
   }
-
   const std::vector<Color> start = mesh.colors;
-  const Rows st = transpose(s);
-  auto solve = [&]() {
-    Rows lower = lower_normal(gram_rows(refined, m, blocks, diagonal, options.threads), s, st, options.threads);
-    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(c, 3);
-    for (int i = 0; i < c; ++i) {
-      for (int32_t e = st.offsets[i]; e < st.offsets[i + 1]; ++e)
-        for (int k = 0; k < 3; ++k) rhs(i, k) += st.values[e] * btt[st.columns[e]][k];
-    }
-    // Tikhonov pull toward the current colors, scaled to the system, for colors no row reaches. Each
-    // column's first entry is its diagonal.
-    double trace = 0;
-    for (int i = 0; i < c; ++i) trace += lower.values[lower.offsets[i]];
-    const double scale = trace / std::max(1, c);
-    const double lambda = options.regularization * std::max(scale, 1e-12);
-    for (int i = 0; i < c; ++i) {
-      lower.values[lower.offsets[i]] += lambda;
-      rhs(i, 0) += lambda * start[i].r;
-      rhs(i, 1) += lambda * start[i].g;
-      rhs(i, 2) += lambda * start[i].b;
-    }
-    return Eigen::MatrixX3d(solve_lower(lower, rhs, "color fit"));
-  };
-  Eigen::MatrixX3d x = solve();
-  if (options.relocate_iterations > 0 && options.target == ColorFitTarget::kPixels) {
-    // Beyond the paper: the smooth control vertices move where the pixel residual asks, by damped
-    // Gauss-Newton steps on the squared error with the colors held, each kept only when it lowers
-    // the error; then the colors are refitted. The color field is carried by the surface: moving
-    // refined vertex j by e changes the prediction at a fixed pixel by -w_j g.e (w_j its barycentric
-    // weight, g the color gradient of the refined triangle), and refined vertex j moves by
-    // sum_v P_jv e_v (P the position stencils). Tear, crease, border and corner vertices stay, so the
-    // feature curves and the image border do not move. The normal equations P'HP are applied
-    // matrix-free in a few preconditioned conjugate-gradient iterations.
-    const SparseMatrix& p = sub.position_stencils();
-    const Rows pt = transpose(p);
-    const int n = num_refined, nv = mesh.num_vertices(), nt = refined.num_triangles();
-    std::vector<uint8_t> movable(nv, 0);
-    for (int v = 0; v < nv; ++v) movable[v] = topo.vertex_tags[v] == VertexTag::kSmooth;
-    auto folded_triangles = [&]() {
-      int folded = 0;
-      for (const Tri& tv : refined.triangles) {
-        folded += !(cross(limit[2 * tv[1]] - limit[2 * tv[0]], limit[2 * tv[1] + 1] - limit[2 * tv[0] + 1],
-                          limit[2 * tv[2]] - limit[2 * tv[0]], limit[2 * tv[2] + 1] - limit[2 * tv[0] + 1]) > 0);
-      }
-      return folded;
-    };
-    auto squared_error = [&](const Eigen::MatrixX3d& values) {
-      double sum = 0;
-      for (const PixelRow& row : rows) {
-        const Location& loc = located[row.pixel];
-        for (int k = 0; k < 3; ++k) {
-          const double e = predict(loc, refined.triangle_colors[loc.triangle], values, k) - row.target[k];
-          sum += e * e;
-        }
-      }
-      return sum;
-    };
-    static constexpr int kPacked[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
-    std::vector<std::array<double, 6>> gram(nt), gradient(nt);
-    std::vector<std::array<double, 3>> tensor(nt), precondition(nv);
-    std::vector<double> rhs_refined(size_t(2) * n), u(size_t(2) * n), hu(size_t(2) * n);
-    // out = (P'HP + damping * diag) d over the movable vertices.
-    double damping = options.relocate_damping;
-    auto apply = [&](const std::vector<double>& d, std::vector<double>& out) {
-      for (int j = 0; j < n; ++j) {
-        double ux = 0, uy = 0;
-        for (SparseMatrix::InnerIterator it(p, j); it; ++it) ux += it.value() * d[2 * it.col()], uy += it.value() * d[2 * it.col() + 1];
-        u[2 * j] = ux, u[2 * j + 1] = uy;
-      }
-      std::fill(hu.begin(), hu.end(), 0.0);
-      for (int t = 0; t < nt; ++t) {
-        const Tri& tv = refined.triangles[t];
-        const std::array<double, 3>& tt = tensor[t];
-        for (int k = 0; k < 3; ++k) {
-          double sx = 0, sy = 0;
-          for (int l = 0; l < 3; ++l) {
-            const double g = gram[t][kPacked[k][l]];
-            sx += g * u[2 * tv[l]], sy += g * u[2 * tv[l] + 1];
-          }
-          hu[2 * tv[k]] += tt[0] * sx + tt[1] * sy, hu[2 * tv[k] + 1] += tt[1] * sx + tt[2] * sy;
-        }
-      }
-      for (int v = 0; v < nv; ++v) {
-        double ox = 0, oy = 0;
-        if (movable[v]) {
-          for (int32_t e = pt.offsets[v]; e < pt.offsets[v + 1]; ++e)
-            ox += pt.values[e] * hu[2 * pt.columns[e]], oy += pt.values[e] * hu[2 * pt.columns[e] + 1];
-          const std::array<double, 3>& pc = precondition[v];
-          ox += damping * (pc[0] * d[2 * v] + pc[1] * d[2 * v + 1]), oy += damping * (pc[1] * d[2 * v] + pc[2] * d[2 * v + 1]);
-        }
-        out[2 * v] = ox, out[2 * v + 1] = oy;
-      }
-    };
-    Eigen::MatrixX3d values = s * x;
-    double error = squared_error(values);
-    const int folded = folded_triangles();
-    for (int it = 0; it < options.relocate_iterations; ++it) {
-      // Color gradients and their structure tensors per refined triangle.
-      for (int t = 0; t < nt; ++t) {
-        const Tri& tv = refined.triangles[t];
-        const Tri& tc = refined.triangle_colors[t];
-        const double e1x = limit[2 * tv[1]] - limit[2 * tv[0]], e1y = limit[2 * tv[1] + 1] - limit[2 * tv[0] + 1];
-        const double e2x = limit[2 * tv[2]] - limit[2 * tv[0]], e2y = limit[2 * tv[2] + 1] - limit[2 * tv[0] + 1];
-        const double det = e1x * e2y - e1y * e2x;
-        gradient[t] = {0, 0, 0, 0, 0, 0}, tensor[t] = {0, 0, 0}, gram[t] = {0, 0, 0, 0, 0, 0};
-        if (!(det > 0)) continue;
-        for (int k = 0; k < 3; ++k) {
-          const double d1 = values(tc[1], k) - values(tc[0], k), d2 = values(tc[2], k) - values(tc[0], k);
-          const double gx = (d1 * e2y - e1y * d2) / det, gy = (e1x * d2 - d1 * e2x) / det;
-          gradient[t][2 * k] = gx, gradient[t][2 * k + 1] = gy;
-          tensor[t][0] += gx * gx, tensor[t][1] += gx * gy, tensor[t][2] += gy * gy;
-        }
-      }
-      // Barycentric Gram blocks and the gradient of half the squared error on refined coordinates.
-      std::fill(rhs_refined.begin(), rhs_refined.end(), 0.0);
-      for (const PixelRow& row : rows) {
-        const Location& loc = located[row.pixel];
-        const Tri& tv = refined.triangles[loc.triangle];
-        const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
-        std::array<double, 6>& g = gram[loc.triangle];
-        g[0] += w[0] * w[0], g[1] += w[0] * w[1], g[2] += w[0] * w[2];
-        g[3] += w[1] * w[1], g[4] += w[1] * w[2], g[5] += w[2] * w[2];
-        double rx = 0, ry = 0;
-        for (int k = 0; k < 3; ++k) {
-          const double e = predict(loc, refined.triangle_colors[loc.triangle], values, k) - row.target[k];
-          rx += e * gradient[loc.triangle][2 * k], ry += e * gradient[loc.triangle][2 * k + 1];
-        }
-        for (int i = 0; i < 3; ++i) rhs_refined[2 * tv[i]] += w[i] * rx, rhs_refined[2 * tv[i] + 1] += w[i] * ry;
-      }
-      // Right-hand side and a block-Jacobi preconditioner (the diagonal terms of P'HP) per vertex.
-      std::vector<double> r(size_t(2) * nv, 0.0);
-      std::vector<std::array<double, 3>> hjj(n, {0, 0, 0});
-      for (int t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k)
-          for (int c3 = 0; c3 < 3; ++c3) hjj[refined.triangles[t][k]][c3] += gram[t][kPacked[k][k]] * tensor[t][c3];
-      for (int v = 0; v < nv; ++v) {
-        precondition[v] = {0, 0, 0};
-        if (!movable[v]) continue;
-        for (int32_t e = pt.offsets[v]; e < pt.offsets[v + 1]; ++e) {
-          const int32_t j = pt.columns[e];
-          const double w2 = pt.values[e] * pt.values[e];
-          r[2 * v] += pt.values[e] * rhs_refined[2 * j], r[2 * v + 1] += pt.values[e] * rhs_refined[2 * j + 1];
-          for (int c3 = 0; c3 < 3; ++c3) precondition[v][c3] += w2 * hjj[j][c3];
-        }
-        precondition[v][0] += 1e-9, precondition[v][2] += 1e-9;
-      }
-      auto preconditioned = [&](const std::vector<double>& in, std::vector<double>& out) {
-        for (int v = 0; v < nv; ++v) {
-          const std::array<double, 3>& pc = precondition[v];
-          const double scale = 1 + damping, a = scale * pc[0], b2 = scale * pc[1], d = scale * pc[2];
-          const double det = a * d - b2 * b2;
-          if (!movable[v] || !(det > 0)) {
-            out[2 * v] = out[2 * v + 1] = 0;
-            continue;
-          }
-          out[2 * v] = (d * in[2 * v] - b2 * in[2 * v + 1]) / det;
-          out[2 * v + 1] = (a * in[2 * v + 1] - b2 * in[2 * v]) / det;
-        }
-      };
-      // Conjugate gradients from 0.
-      std::vector<double> step(size_t(2) * nv, 0.0), z(size_t(2) * nv), dir(size_t(2) * nv), ad(size_t(2) * nv);
-      preconditioned(r, z);
-      dir = z;
-      double rz = std::inner_product(r.begin(), r.end(), z.begin(), 0.0);
-      for (int cg = 0; cg < options.relocate_cg_iterations && rz > 0; ++cg) {
-        apply(dir, ad);
-        const double dad = std::inner_product(dir.begin(), dir.end(), ad.begin(), 0.0);
-        if (!(dad > 0)) break;
-        const double alpha = rz / dad;
-        for (size_t i = 0; i < step.size(); ++i) step[i] += alpha * dir[i], r[i] -= alpha * ad[i];
-        preconditioned(r, z);
-        const double rz_next = std::inner_product(r.begin(), r.end(), z.begin(), 0.0);
-        for (size_t i = 0; i < dir.size(); ++i) dir[i] = z[i] + rz_next / rz * dir[i];
-        rz = rz_next;
-      }
-      // Move, at most max_step px a vertex; a vertex of a triangle that would flip or thin stays.
-      const std::vector<Vec2> before = mesh.positions;
-      std::vector<uint8_t> held(nv, 0);
-      for (int round = 0; round < 8; ++round) {
-        for (int v = 0; v < nv; ++v) {
-          if (!movable[v] || held[v]) {
-            mesh.positions[v] = before[v];
-            continue;
-          }
-          double dx = step[2 * v], dy = step[2 * v + 1];
-          const double len = std::hypot(dx, dy);
-          if (len > options.relocate_max_step) dx *= options.relocate_max_step / len, dy *= options.relocate_max_step / len;
-          mesh.positions[v] = {before[v].x + dx, before[v].y + dy};
-        }
-        bool bad = false;
-        for (const Tri& t : mesh.triangles) {
-          const Vec2 a = mesh.positions[t[0]], b = mesh.positions[t[1]], q = mesh.positions[t[2]];
-          if (cross(b.x - a.x, b.y - a.y, q.x - a.x, q.y - a.y) > 2e-3) continue;
-          bad = true;
-          for (int32_t v : t) held[v] = 1;
-        }
-        if (!bad) break;
-        if (round == 7) mesh.positions = before;
-      }
-      const std::vector<float> limit_before = limit;
-      const std::vector<Location> located_before = located;
-      for (int j = 0; j < n; ++j) {
-        double lx = 0, ly = 0;
-        for (SparseMatrix::InnerIterator e(p, j); e; ++e) lx += e.value() * mesh.positions[e.col()].x, ly += e.value() * mesh.positions[e.col()].y;
-        limit[2 * j] = static_cast<float>(lx), limit[2 * j + 1] = static_cast<float>(ly);
-      }
-      const double moved_error = locate_pixels() <= folded ? squared_error(values) : std::numeric_limits<double>::infinity();
-      if (moved_error < error) {
-        error = moved_error, damping = std::max(damping / 2, 1e-3);
-        ++stats.relocations;
-      } else {
-        mesh.positions = before, limit = limit_before, located = located_before;
-        damping *= 4;
-      }
-      if ((it + 1) % options.relocate_refit_every == 0 || it + 1 == options.relocate_iterations) {
-        accumulate_pixels({});
-        x = solve();
-        values = s * x;
-        error = squared_error(values);
-      }
-    }
+  Eigen::MatrixX3d x = fit_detail::solve_colors(system, start, options.regularization, options.threads);
+  if (options.relocate_iterations > 0 && pixels) {
+    stats.relocations = fit_detail::relocate_vertices(mesh, topo, system, start, options, x);
   }
   // Iteratively reweighted least squares toward the least absolute deviations fit: the error we
   // report (and the one the eye forgives least on flat areas) is the mean absolute one, and the L1
   // fit lets outliers (texture, specular dots, pixels at misplaced edges) pull the colors less.
   // One reweighting gets most of the gain (docs/vectorize.md).
-  for (int it = 0; it < options.l1_iterations && options.target == ColorFitTarget::kPixels; ++it) {
-    const Eigen::MatrixX3d values = s * x;
-    std::vector<double> weights(rows.size());
-    const int parts = std::max(1, std::min(detail::resolve_threads(options.threads), 8));
-    detail::parallel_for(parts, parts, [&](int part) {
-      const size_t end = rows.size() * size_t(part + 1) / size_t(parts);
-      for (size_t r = rows.size() * size_t(part) / size_t(parts); r < end; ++r) {
-        const Location& loc = located[rows[r].pixel];
-        const Tri& v = refined.triangle_colors[loc.triangle];
-        double residual = 0;
-        for (int k = 0; k < 3; ++k) residual += std::abs(predict(loc, v, values, k) - rows[r].target[k]);
-        weights[r] = 1 / std::max(residual / 3, options.l1_floor);
-      }
-    });
-    accumulate_pixels(weights);
-    x = solve();
-  }
-  for (int i = 0; i < c; ++i) {
+  for (int it = 0; it < options.l1_iterations && pixels; ++it) x = reweighted_fit(system, x, start, options);
+  for (int i = 0; i < system.c; ++i) {
     mesh.colors[i] = {static_cast<float>(x(i, 0)), static_cast<float>(x(i, 1)), static_cast<float>(x(i, 2))};
   }
-
-  // Residual over the fitted pixels (the paper's error, before 8-bit rounding).
-  if (options.target == ColorFitTarget::kPixels) {
-    const Eigen::MatrixX3d values = s * x;
-    double sum = 0, abs_sum = 0;
-    long n = 0;
-    for (int y = 0; y < height; ++y) {
-      for (int px = 0; px < width; ++px) {
-        const Location& loc = located[size_t(y) * width + px];
-        if (loc.triangle < 0) continue;
-        const Tri& v = refined.triangle_colors[loc.triangle];
-        const auto target = pixel(image, px, y);
-        for (int k = 0; k < 3; ++k) {
-          const double pred = predict(loc, v, values, k);
-          sum += (pred - target[k]) * (pred - target[k]);
-          abs_sum += std::abs(std::clamp(std::round(pred), 0.0, 255.0) - target[k]);
-        }
-        n += 3;
-      }
-    }
-    stats.rms = n ? std::sqrt(sum / double(n)) : 0;
-    stats.mae = n ? abs_sum / double(n) : 0;
-  }
+  if (pixels) measure_residual(system, image, x, stats);
   return stats;
 }
 

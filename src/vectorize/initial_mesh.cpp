@@ -12,6 +12,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include "core/geometry_p.h"
 #include "mesh/disjoint_sets_p.h"
 #include "subvec/core/error.h"
 
@@ -29,59 +30,23 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_
 using CdtPlus = CGAL::Constrained_triangulation_plus_2<Cdt>;
 using Point = Kernel::Point_2;
 
-double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
-}  // namespace
-
-ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
-                               const InitialMeshOptions& options) {
-  const int w = image.width, h = image.height;
-  if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
-
-  // Grid points closer than min_grid_distance to a feature would make slivers: drop them.
-  std::vector<uint8_t> dropped(size_t(w) * h, 0);
-  const double r = options.min_grid_distance;
+// Pixels whose centre lies closer than r to a feature's polyline.
+std::vector<uint8_t> near_features(const std::vector<DetectedFeature>& features, int w, int h, double r) {
+  std::vector<uint8_t> mask(size_t(w) * h, 0);
   for (const DetectedFeature& f : features) {
     for (size_t i = 0; i + 1 < f.points.size(); ++i) {
       const Vec2 a = f.points[i], b = f.points[i + 1];
-      const int x0 = std::max(0, int(std::floor(std::min(a.x, b.x) - r - 0.5)));
-      const int x1 = std::min(w - 1, int(std::ceil(std::max(a.x, b.x) + r - 0.5)));
-      const int y0 = std::max(0, int(std::floor(std::min(a.y, b.y) - r - 0.5)));
-      const int y1 = std::min(h - 1, int(std::ceil(std::max(a.y, b.y) + r - 0.5)));
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x)
-          if (segment_distance({x + 0.5, y + 0.5}, a, b) < r) dropped[size_t(y) * w + x] = 1;
+      detail::for_pixels_near_segment(a.x, a.y, b.x, b.y, r, w, h,
+                                      [&](int x, int y) { mask[size_t(y) * w + x] = 1; });
     }
   }
+  return mask;
+}
 
-  if (options.grid_step < 0 || options.grid_step > 2) {
-    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1 or 2");
-  }
-  const int step = std::max(1, options.grid_step);
-  // Pixels near a feature keep the fine grid when the grid is coarse elsewhere.
-  std::vector<uint8_t> fine;
-  if (step == 2) {
-    fine.assign(size_t(w) * h, 0);
-    const double band = std::max(options.fine_band, r);
-    for (const DetectedFeature& f : features) {
-      for (size_t i = 0; i + 1 < f.points.size(); ++i) {
-        const Vec2 a = f.points[i], b = f.points[i + 1];
-        const int x0 = std::max(0, int(std::floor(std::min(a.x, b.x) - band - 0.5)));
-        const int x1 = std::min(w - 1, int(std::ceil(std::max(a.x, b.x) + band - 0.5)));
-        const int y0 = std::max(0, int(std::floor(std::min(a.y, b.y) - band - 0.5)));
-        const int y1 = std::min(h - 1, int(std::ceil(std::max(a.y, b.y) + band - 0.5)));
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x)
-            if (segment_distance({x + 0.5, y + 0.5}, a, b) < band) fine[size_t(y) * w + x] = 1;
-      }
-    }
-  }
-
+// The points to triangulate: pixel centres not `dropped` (step 1), or one point per 2x2 block away
+// from the `fine` pixels (step 2); then the border: corners and one vertex per pixel along each side.
+std::vector<Point> grid_points(int w, int h, int step, const std::vector<uint8_t>& dropped,
+                               const std::vector<uint8_t>& fine) {
   std::vector<Point> points;
   points.reserve(size_t(w) * h + 2 * size_t(w + h) + 4);
   if (step == 1) {
@@ -104,13 +69,15 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
       }
     }
   }
-  // The border: corners and one vertex per pixel along each side.
   points.emplace_back(0, 0), points.emplace_back(w, 0), points.emplace_back(w, h), points.emplace_back(0, h);
   for (int x = 0; x < w; ++x) points.emplace_back(x + 0.5, 0), points.emplace_back(x + 0.5, h);
   for (int y = 0; y < h; ++y) points.emplace_back(0, y + 0.5), points.emplace_back(w, y + 0.5);
+  return points;
+}
 
-  CdtPlus cdt;
-  cdt.insert(points.begin(), points.end());
+// Each feature, clamped to the domain, as a constraint of the triangulation.
+std::vector<CdtPlus::Constraint_id> insert_features(CdtPlus& cdt, const std::vector<DetectedFeature>& features,
+                                                    int w, int h) {
   std::vector<CdtPlus::Constraint_id> ids;
   for (const DetectedFeature& f : features) {
     std::vector<Point> poly;
@@ -122,7 +89,11 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     if (poly.size() < 2) continue;
     ids.push_back(cdt.insert_constraint(poly.begin(), poly.end(), f.closed()));
   }
+  return ids;
+}
 
+// Positions and triangles, numbering the triangulation's vertices and faces (their info()).
+ControlMesh mesh_of(CdtPlus& cdt) {
   ControlMesh mesh;
   int32_t next = 0;
   for (auto v : cdt.finite_vertex_handles()) {
@@ -134,12 +105,15 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     f->info() = next++;
     mesh.triangles.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()});
   }
+  return mesh;
+}
 
-  // Face-varying colors: the corners of a vertex share one color value unless a tear (a
-  // constrained interior edge) separates them; values numbered in order of first use, as
-  // face_varying_indices() (topology.h) numbers them. Only vertices on a constraint can have
-  // several: around each of those, a union of the corners across every unconstrained edge, read
-  // off the triangulation's adjacency.
+// Face-varying colors: the corners of a vertex share one color value unless a tear (a
+// constrained interior edge) separates them; values numbered in order of first use, as
+// face_varying_indices() (topology.h) numbers them. Only vertices on a constraint can have
+// several: around each of those, a union of the corners across every unconstrained edge, read
+// off the triangulation's adjacency. Sets mesh.triangle_colors; returns the number of values.
+int number_colors(const CdtPlus& cdt, const std::vector<CdtPlus::Constraint_id>& ids, ControlMesh& mesh) {
   const int nf = mesh.num_triangles();
   std::vector<uint8_t> on_constraint(mesh.num_vertices(), 0);
   detail::DisjointSets corners(size_t(nf) * 3);
@@ -160,18 +134,20 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   }
   int num_colors = 0;
   mesh.triangle_colors.resize(nf);
-  {
-    std::vector<int32_t> index(size_t(nf) * 3, -1), vertex_color(mesh.num_vertices(), -1);
-    for (int32_t c = 0; c < 3 * nf; ++c) {
-      const int32_t v = mesh.triangles[c / 3][c % 3];
-      int32_t& id = on_constraint[v] ? index[corners.find(c)] : vertex_color[v];
-      if (id < 0) id = num_colors++;
-      mesh.triangle_colors[c / 3][c % 3] = id;
-    }
+  std::vector<int32_t> index(size_t(nf) * 3, -1), vertex_color(mesh.num_vertices(), -1);
+  for (int32_t c = 0; c < 3 * nf; ++c) {
+    const int32_t v = mesh.triangles[c / 3][c % 3];
+    int32_t& id = on_constraint[v] ? index[corners.find(c)] : vertex_color[v];
+    if (id < 0) id = num_colors++;
+    mesh.triangle_colors[c / 3][c % 3] = id;
   }
+  return num_colors;
+}
 
-  // Features: each constraint's vertex sequence (including any intersection vertices CGAL added),
-  // split where an edge is already claimed by an earlier feature or lies on the border.
+// Features: each constraint's vertex sequence (including any intersection vertices CGAL added),
+// split where an edge is already claimed by an earlier feature or lies on the border.
+void add_features(const CdtPlus& cdt, const std::vector<CdtPlus::Constraint_id>& ids, int w, int h,
+                  ControlMesh& mesh) {
   std::set<std::pair<int32_t, int32_t>> claimed;
   auto on_border = [&](int32_t a, int32_t b) {
     const Vec2 p = mesh.positions[a], q = mesh.positions[b];
@@ -204,8 +180,10 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     }
     flush();
   }
+}
 
-  // Each color value sampled at its vertex, or on its side of the tears.
+// Each color value sampled at its vertex, or on its side of the tears.
+void sample_colors(const Image8& image, int num_colors, double side_offset, ControlMesh& mesh) {
   std::vector<Vec2> toward(num_colors, Vec2{0, 0});
   std::vector<int32_t> owner(num_colors, -1);
   std::vector<int> sectors(mesh.num_vertices(), 0);
@@ -238,11 +216,38 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
     Vec2 p = mesh.positions[v];
     if (sectors[v] > 1) {  // a vertex on a tear: sample inside this side
       const double len = std::hypot(toward[ci].x, toward[ci].y);
-      if (len > 0) p.x += options.side_offset * toward[ci].x / len, p.y += options.side_offset * toward[ci].y / len;
+      if (len > 0) p.x += side_offset * toward[ci].x / len, p.y += side_offset * toward[ci].y / len;
     }
     const auto rgb = sample_bilinear(image, p.x, p.y);
     mesh.colors[ci] = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
   }
+}
+
+}  // namespace
+
+ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
+                               const InitialMeshOptions& options) {
+  const int w = image.width, h = image.height;
+  if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
+  if (options.grid_step < 0 || options.grid_step > 2) {
+    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1 or 2");
+  }
+  const int step = std::max(1, options.grid_step);
+  // Grid points closer than min_grid_distance to a feature would make slivers: drop them. Pixels
+  // near a feature keep the fine grid when the grid is coarse elsewhere.
+  const double r = options.min_grid_distance;
+  const std::vector<uint8_t> dropped = near_features(features, w, h, r);
+  const std::vector<uint8_t> fine =
+      step == 2 ? near_features(features, w, h, std::max(options.fine_band, r)) : std::vector<uint8_t>{};
+
+  const std::vector<Point> points = grid_points(w, h, step, dropped, fine);
+  CdtPlus cdt;
+  cdt.insert(points.begin(), points.end());
+  const std::vector<CdtPlus::Constraint_id> ids = insert_features(cdt, features, w, h);
+  ControlMesh mesh = mesh_of(cdt);
+  const int num_colors = number_colors(cdt, ids, mesh);
+  add_features(cdt, ids, w, h, mesh);
+  sample_colors(image, num_colors, options.side_offset, mesh);
   return mesh;
 }
 

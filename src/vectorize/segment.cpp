@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "core/geometry_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -83,13 +84,6 @@ std::vector<Vec2> resample(const std::vector<Vec2>& p, double spacing) {
   return out;
 }
 
-double point_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  const double t =
-      len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy);
-}
-
 double orient(Vec2 a, Vec2 b, Vec2 c) {
   return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
 }
@@ -99,8 +93,8 @@ double segment_distance(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
                o4 = orient(c, d, b);
   if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
     return 0;
-  return std::min({point_segment_distance(a, c, d), point_segment_distance(b, c, d),
-                   point_segment_distance(c, a, b), point_segment_distance(d, a, b)});
+  return std::min({detail::segment_distance(a, c, d), detail::segment_distance(b, c, d),
+                   detail::segment_distance(c, a, b), detail::segment_distance(d, a, b)});
 }
 
 // The boundary's segments, bucketed on a coarse grid for distance queries.

@@ -67,13 +67,19 @@ TEST(Arap, TheSameTargetsGiveTheSameResult) {
   std::vector<FixedAxes> fixed(n, FixedAxes::kNone);
   fixed[0] = fixed[n - 1] = fixed[15] = FixedAxes::kXY;
   const ArapDeformer arap(m.mesh.positions, m.mesh.triangles, fixed);
-  std::vector<Vec2> a = m.mesh.positions, b = a, out_a(n), out_b(n), again(n);
+  std::vector<Vec2> a = m.mesh.positions, b = a, out_a(n), out_b(n), again(n), again_b(n);
   a[15].x += 2;
   b[15].y -= 3;
   arap.solve(a, out_a);
   arap.solve(b, out_b);
   arap.solve(a, again);
+  arap.solve(b, again_b);
   EXPECT_EQ(out_a, again);
+  EXPECT_EQ(out_b, again_b);
+  // The two targets differ, and so do the results (each holds its own handle).
+  EXPECT_NE(out_a, out_b);
+  EXPECT_EQ(out_a[15], a[15]);
+  EXPECT_EQ(out_b[15], b[15]);
 }
 
 TEST(Arap, ConstraintsThatDoNotPinTheMeshAreRefused) {

@@ -99,19 +99,34 @@ TEST(Stylize, LongerFeaturesGetWiderStrokes) {
   const VectorImage& img = image();
   const std::vector<double> length = feature_saliency(img, 0, 0.0);
   const std::vector<Stroke> strokes = stylize(img, o);
-  // Strokes come in feature order; match them to features by their first point.
+  // Strokes come in feature order; match them to features by their first point. Every stroke
+  // must match one, and the widths of matched features must follow their lengths.
+  ASSERT_FALSE(strokes.empty());
   std::vector<float> width(img.levels[0].features.size(), 0);
+  std::vector<char> matched(width.size(), 0);
+  size_t matched_strokes = 0;
   for (const Stroke& s : strokes) {
+    bool found = false;
     for (size_t f = 0; f < width.size(); ++f) {
-      for (int32_t v : img.levels[0].features[f].vertices)
-        if (img.levels[0].positions[v] == s.points.front()) width[f] = s.width;
+      for (int32_t v : img.levels[0].features[f].vertices) {
+        if (img.levels[0].positions[v] == s.points.front()) {
+          width[f] = s.width;
+          matched[f] = 1;
+          found = true;
+        }
+      }
     }
+    matched_strokes += found;
   }
+  EXPECT_EQ(matched_strokes, strokes.size());
+  int compared = 0;
   for (size_t a = 0; a < width.size(); ++a)
     for (size_t b = 0; b < width.size(); ++b)
-      if (length[a] > length[b]) {
-        EXPECT_GE(width[a], width[b]);
+      if (matched[a] && matched[b] && length[a] > length[b]) {
+        EXPECT_GE(width[a], width[b]) << "features " << a << " and " << b;
+        ++compared;
       }
+  EXPECT_GT(compared, 0);
 }
 
 TEST(Stylize, TheChoiceBelowTheThresholdIsDeterministicForASeed) {
