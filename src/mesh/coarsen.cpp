@@ -5,21 +5,12 @@
 #include <cmath>
 #include <string>
 
+#include "core/geometry_p.h"
 #include "mesh/collapse_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
 namespace subvec::coarsen_detail {
-namespace {
-
-double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
-}  // namespace
 
 Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::vector<int32_t>& kept_ids)
     : width_(width), height_(height) {
@@ -160,7 +151,7 @@ bool Coarsener::can_collapse(int32_t u, int32_t v, double feature_tolerance, dou
     for (int i = c.original[prev] + 1;; ++i) {
       const int j = i % np;
       if (j == c.original[next]) break;
-      if (segment_distance(c.points[j], a, b) > feature_tolerance) return false;
+      if (detail::segment_distance(c.points[j], a, b) > feature_tolerance) return false;
     }
     return true;
   };
