@@ -1,28 +1,42 @@
 #!/usr/bin/env python3
-"""Writes the files of the bad-input corpus, tests/bad-input/files/*.
+"""Writes both corpora of bad inputs: the command line's, tests/bad-input/files/*, and the
+library's, tests/data/bad/*.
 
-Run: python3 tests/bad-input/make_files.py (needs cjpeg and cwebp, from the Debian packages
-libjpeg-turbo-progs and webp, for the two valid images the JPEG and WebP cases start from; the
-written files are committed, so the tests need neither). cases.txt says what the command line must
-answer for each file; README.md describes the format.
+Run: python3 tests/bad-input/make_files.py [--library]
 
-Every file is small (under 10 kB): decompression bombs declare absurd sizes in their headers
-rather than holding the pixels.
+- tests/bad-input/files/: what a stranger may hand `subvec`. cases.txt says what the command line
+  must answer for each file (tests/unit/cli/bad_input_test.cpp); README.md describes the format.
+  Needs cjpeg and cwebp (Debian packages libjpeg-turbo-progs and webp) for the two valid images
+  the JPEG and WebP cases start from, zstd, and build/bin/subvec (or $SUBVEC) for the binary
+  .svec cases. Every file is small (under 10 kB): decompression bombs declare absurd sizes in
+  their headers rather than holding the pixels.
+- tests/data/bad/: each file breaks exactly one rule of docs/format.md;
+  tests/unit/io/bad_files_test.cpp lists, for every file, the error code and the words its message
+  must contain, and cases.txt runs each through the command line too. Standard library only (the
+  binary files hold their payload in stored, uncompressed zstd blocks); `--library` writes only
+  these. Most start from the 4 x 4 worked example of docs/format.md (corners 0-3, center 4).
+
+The written files are committed, so the tests need none of the tools. Some files are also seeds of
+the fuzzers (fuzz/corpus/*/, the command line's with a "bad-input-" prefix).
 """
+import copy
 import json
+import math
 import os
 import struct
 import subprocess
+import sys
 import tempfile
 import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "files")
+LIBRARY = os.path.join(HERE, "..", "data", "bad")
 
 
-def write(name, data):
+def write(name, data, folder=OUT):
     mode = "wb" if isinstance(data, bytes) else "w"
-    with open(os.path.join(OUT, name), mode) as out:
+    with open(os.path.join(folder, name), mode) as out:
         out.write(data)
 
 
@@ -232,6 +246,7 @@ def other_files():
 
 # ---- vector images -------------------------------------------------------------------------------
 
+# The 4 x 4 worked example of docs/format.md, which both corpora start from.
 SQUARE = {
     "format": "subvec", "version": 1, "width": 4, "height": 4,
     "levels": [{
@@ -406,7 +421,172 @@ def v3_stream_files(good):
     write("svec-v3-stream-cut.svec", wrap(cut))
 
 
+# ---- the library's corpus, tests/data/bad ------------------------------------------------------------
+
+def text_of(image):
+    """One line per top-level key and per level key: small and readable."""
+    lines = []
+    for key, value in image.items():
+        if key == "levels":
+            levels = []
+            for level in value:
+                inner = ",\n".join(f"    {json.dumps(k)}: {json.dumps(v)}" for k, v in level.items())
+                levels.append("  {\n" + inner + "\n  }")
+            lines.append('"levels": [\n' + ",\n".join(levels) + "\n]")
+        else:
+            lines.append(f"{json.dumps(key)}: {json.dumps(value)}")
+    return "{\n" + ",\n".join(lines) + "\n}\n"
+
+
+def square_image(**level_changes):
+    image = copy.deepcopy(SQUARE)
+    image["levels"][0].update(level_changes)
+    return image
+
+
+def write_library(name, data):
+    write(name, data, LIBRARY)
+
+
+def library_json_files():
+    files = {}
+    # Indices out of range.
+    files["index-triangle"] = square_image(triangles=[[0, 1, 4], [1, 2, 9], [2, 3, 4], [3, 0, 4]])
+    files["index-triangle-colors"] = square_image(triangle_colors=[[0, 1, 4], [1, 2, 4], [2, 3, 7], [3, 0, 4]])
+    files["index-feature"] = square_image(features=[{"id": 3, "vertices": [4, 12]}])
+    # Non-covering: triangle (1, 2, 4) removed, leaving a hole at the right.
+    files["gap"] = square_image(triangles=[[0, 1, 4], [2, 3, 4], [3, 0, 4]])
+    # Self-overlapping: a fan around the center that winds twice around it, over a second copy of
+    # the four corners (vertices 5-8): every triangle is positive, every border edge on the border.
+    files["overlap"] = square_image(
+        vertices=[[2, 2], [0, 0], [4, 0], [4, 4], [0, 4], [0, 0], [4, 0], [4, 4], [0, 4]],
+        colors=[[0, 0, 0]] * 9,
+        triangles=[[1, 2, 0], [2, 3, 0], [3, 4, 0], [4, 5, 0], [5, 6, 0], [6, 7, 0], [7, 8, 0], [8, 1, 0]])
+    # Two complete copies of the mesh on top of each other.
+    files["double-cover"] = square_image(
+        vertices=SQUARE["levels"][0]["vertices"] * 2, colors=SQUARE["levels"][0]["colors"] * 2,
+        triangles=SQUARE["levels"][0]["triangles"] + [[a + 5, b + 5, c + 5] for a, b, c in
+                                                      SQUARE["levels"][0]["triangles"]])
+    # Flipped: vertex 5 splits triangle (0, 1, 4) but sits below the center, folding its fan over.
+    files["flipped"] = square_image(
+        vertices=SQUARE["levels"][0]["vertices"] + [[2, 3]],
+        colors=SQUARE["levels"][0]["colors"] + [[0, 0, 0]],
+        triangles=[[0, 1, 5], [1, 4, 5], [4, 0, 5], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    files["inconsistent-orientation"] = square_image(triangles=[[0, 1, 4], [1, 4, 2], [2, 3, 4], [3, 0, 4]])
+    files["outside"] = square_image(vertices=[[0, 0], [4, 0], [4, 4], [0, 4], [2, 4.5]])
+    files["unused-vertex"] = square_image(vertices=SQUARE["levels"][0]["vertices"] + [[1, 1]],
+                                    colors=SQUARE["levels"][0]["colors"] + [[0, 0, 0]])
+    # Features that are not chains of interior mesh edges.
+    files["not-a-chain"] = square_image(features=[{"id": 0, "vertices": [1, 3]}])
+    files["feature-on-border"] = square_image(features=[{"id": 0, "vertices": [0, 1]}])
+    # A color jump across edge (0, 4), which is not a tear.
+    files["color-jump-without-tear"] = square_image(
+        colors=SQUARE["levels"][0]["colors"] + [[0, 255, 0]],
+        triangle_colors=[[5, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    # Structure.
+    bad_key = square_image()
+    bad_key["levels"][0]["triangle_color"] = bad_key["levels"][0].pop("triangles")
+    files["unknown-key"] = bad_key
+    files["wrong-type"] = dict(SQUARE, width="4")
+    files["absurd-size"] = dict(SQUARE, width=100000000, height=100000000)
+    files["wrong-version"] = dict(SQUARE, version=3)
+    for name, image in files.items():
+        write_library(name + ".svec.json", text_of(image))
+
+    square_text = text_of(SQUARE)
+    write_library("nan.svec.json", square_text.replace("[2, 2]", "[NaN, 2]"))
+    write_library("huge-number.svec.json", square_text.replace("[2, 2]", "[2, 1e400]"))
+    write_library("duplicate-key.svec.json", square_text.replace('"height": 4', '"height": 4,\n"height": 5'))
+    write_library("truncated.svec.json", square_text[:len(square_text) // 2])
+
+
+# Binary files.
+
+def raw_zstd_frame(data):
+    """A zstd frame (RFC 8878) with the content size and one stored block per 128 KiB."""
+    out = bytearray(b"\x28\xb5\x2f\xfd\xe0") + struct.pack("<Q", len(data))
+    pos = 0
+    while True:
+        n = min(len(data) - pos, 1 << 17)
+        last = pos + n == len(data)
+        out += struct.pack("<I", (n << 3) | int(last))[:3] + data[pos:pos + n]
+        pos += n
+        if last:
+            return bytes(out)
+
+
+def svec(payload, version=1, flags=0, payload_size=None, frame=None):
+    frame = raw_zstd_frame(payload) if frame is None else frame
+    size = len(payload) if payload_size is None else payload_size
+    return b"SUBVEC\x00\x1a" + struct.pack("<IIQQ", version, flags, size, len(frame)) + frame
+
+
+def square_payload(x1=4.0, tri_vertex=4):
+    p = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 5, 4, 0, 0)
+    for x, y in [(0, 0), (x1, 0), (4, 4), (0, 4), (2, 2)]:
+        p += struct.pack("<dd", x, y)
+    for rgb in [(255, 0, 0), (255, 0, 0), (0, 0, 255), (0, 0, 255), (127.5, 0, 127.5)]:
+        p += struct.pack("<fff", *rgb)
+    triangles = [(0, 1, 4), (1, 2, 4), (2, 3, tri_vertex), (3, 0, 4)]
+    for a, b, c in triangles:
+        p += struct.pack("<iii", a, b, c)
+    for a, b, c in [(0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)]:
+        p += struct.pack("<iii", a, b, c)
+    return p + struct.pack("<II", 0, 0)
+
+
+def library_binary_files():
+    good = svec(square_payload())
+    write_library("wrong-magic.svec", b"SUBVEX" + good[6:])
+    write_library("wrong-version.svec", svec(square_payload(), version=7))
+    write_library("unknown-flags.svec", svec(square_payload(), flags=1))
+    write_library("truncated-header.svec", good[:20])
+    write_library("truncated.svec", good[:len(good) - 30])
+    write_library("truncated-zstd.svec", svec(square_payload(), frame=raw_zstd_frame(square_payload())[:-30]))
+    write_library("absurd-payload-size.svec", svec(square_payload(), payload_size=1 << 50))
+    absurd_count = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 5, 0xFFFFFFF0, 0, 0)
+    write_library("absurd-count.svec", svec(absurd_count + bytes(64)))
+    write_library("truncated-payload.svec", svec(square_payload()[:-40]))
+    write_library("trailing-payload-bytes.svec", svec(square_payload() + b"\x00\x00"))
+    write_library("trailing-file-bytes.svec", good + b"\x00")
+    write_library("nan-position.svec", svec(square_payload(x1=math.nan)))
+    write_library("index-out-of-range.svec", svec(square_payload(tri_vertex=-7)))
+
+
+# The compact (version 2) payload of the square, as laid out in docs/format.md ("Worked example,
+# version 2"), in pieces so that one field at a time can be broken.
+COMPACT_HEAD = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 5, 4, 0, 0)
+COMPACT_SECTIONS = [bytes([0x32, 0x3C, 0x03]), bytes([0x03]),
+                    bytes.fromhex("0000 2000 0f10 0010 0000"), b"", b"",
+                    bytes.fromhex("7f8002 000100 007f8001 00bf01be01 007f8001")]
+
+
+def compact_payload(head=COMPACT_HEAD, precision=b"\x02\xff", sections=COMPACT_SECTIONS):
+    body = b"".join(struct.pack("<I", len(s)) + s for s in sections)
+    return head + precision + body + struct.pack("<II", 0, 0)
+
+
+def library_compact_files():
+    sections = list(COMPACT_SECTIONS)
+    sections[0] = bytes([0x7F, 0x3C, 0x03])  # 127: not three operations in base 5
+    write_library("compact-bad-operations.svec", svec(compact_payload(sections=sections), version=2))
+    write_library("compact-bad-precision.svec", svec(compact_payload(precision=b"\x0d\xff"), version=2))
+    head = struct.pack("<iiI", 4, 4, 1) + struct.pack("<5I", 5, 6, 4, 0, 0)  # 6 colors declared
+    write_library("compact-color-count.svec", svec(compact_payload(head=head), version=2))
+    sections = list(COMPACT_SECTIONS)
+    sections[2] = sections[2] + b"\x00"
+    write_library("compact-trailing-section-bytes.svec", svec(compact_payload(sections=sections), version=2))
+
+
 def main():
+    library_only = sys.argv[1:] == ["--library"]
+    if sys.argv[1:] and not library_only:
+        sys.exit("usage: make_files.py [--library]")
+    library_json_files()
+    library_binary_files()
+    library_compact_files()
+    if library_only:
+        return
     os.makedirs(OUT, exist_ok=True)
     for name in os.listdir(OUT):
         if not name.startswith("svec-v2-"):

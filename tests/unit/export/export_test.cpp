@@ -25,6 +25,7 @@
 #include "subvec/mesh/validate.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
 #include "support/synthetic.h"
 
 namespace subvec {
@@ -276,7 +277,7 @@ TEST_F(ExportViewers, PopplerDrawsThePdfLikeTheRenderer) {
 TEST_F(ExportViewers, PopplerDrawsThePopplerTargetPdfOfThePhotographs) {
   if (!have("pdftoppm")) GTEST_SKIP() << "pdftoppm (poppler-utils) is not installed; scripts/setup installs it";
   const fs::path images = fs::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
-  if (!fs::exists(images)) GTEST_SKIP() << "no " << images << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(images)) GTEST_SKIP() << *why;
   std::vector<double> maes;
   for (const auto& entry : fs::directory_iterator(images)) {
     if (entry.path().extension() != ".png") continue;

@@ -1,4 +1,4 @@
-// The bad-file corpus tests/data/bad (written by make_bad_files.py there): every file must be
+// The bad-file corpus tests/data/bad (written by tests/bad-input/make_files.py): every file must be
 // rejected by read_svec with the listed error code and a one-line message naming the problem.
 #include <gtest/gtest.h>
 

@@ -18,6 +18,7 @@
 #include "subvec/io/svec.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
 #include "support/synthetic.h"
 #include "support/test_meshes.h"
 #include "unit/io/svec_test_util.h"
@@ -243,7 +244,7 @@ TEST(SvecCompact, DefaultGridsKeepThePicture) {
 TEST(SvecCompact, SharedPhotographWithinBudget) {
   const std::filesystem::path path =
       std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "chelsea.png";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
   const Image8 photo = read_image(path);
   const VectorImage image = vectorize(photo, {});
   const std::vector<uint8_t> bytes = to_svec_binary(image);

@@ -10,6 +10,7 @@
 #include "subvec/io/image_io.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
+#include "support/shared_photos.h"
 
 namespace subvec {
 namespace {
@@ -158,7 +159,7 @@ TEST(Levels, BadOptions) {
 // error rises with the level.
 TEST(Levels, SharedPhotographs) {
   const auto dir = test::shared_images();
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no " << dir << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(dir)) GTEST_SKIP() << *why;
   int count = 0;
   for (const char* name : {"astronaut", "chelsea", "rocket", "fruits", "butterfly", "home", "squirrel", "apple"}) {
     const auto path = dir / (std::string(name) + ".png");

@@ -14,6 +14,7 @@
 #include "subvec/mesh/validate.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
+#include "support/shared_photos.h"
 
 namespace subvec {
 namespace {
@@ -186,7 +187,7 @@ TEST(Pyramid, ContrastAcrossRetainedFeaturesSurvivesSmoothing) {
 // level, as above) rising with eta from 0 through 2.
 TEST(Pyramid, SharedPhotographs) {
   const auto dir = test::shared_images();
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no " << dir << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(dir)) GTEST_SKIP() << *why;
   int count = 0;
   for (const char* name : {"apple", "astronaut", "butterfly", "chelsea", "fruits", "home", "rocket", "squirrel"}) {
     const auto path = dir / (std::string(name) + ".png");

@@ -17,6 +17,7 @@
 #include "subvec/io/image_io.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
 
 namespace subvec {
 namespace {
@@ -345,8 +346,7 @@ TEST(Segment, VectorizeEndsTheBoundaryOnTheImageBorder) {
 TEST(Segment, SharedPhotograph) {
   const std::filesystem::path path =
       std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "apple.png";
-  if (!std::filesystem::exists(path))
-    GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
   const Image8 img = read_image(path);
   VectorizeOptions options;
   options.ratio = 0.01;

@@ -14,6 +14,7 @@
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
 
 namespace subvec {
 namespace {
@@ -84,7 +85,7 @@ TEST(InitialMesh, IsValidAndFollowsTheFeatures) {
 // topology implies, also where features meet and cross (many do on the astronaut).
 TEST(InitialMesh, ColorValuesAreTheTopologysOnAPhotograph) {
   const auto path = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "astronaut.png";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
   const Image8 img = read_image(path);
   const ControlMesh mesh = build_initial_mesh(img, detect_features(img));
   const MeshTopology topo = validate_level(mesh, img.width, img.height);
@@ -400,7 +401,7 @@ TEST(Vectorize, RejectsBadOptions) {
 TEST(Vectorize, CoarseGridMatchesThePixelGridOnAnUpscaledPhotograph) {
   const std::filesystem::path path =
       std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "astronaut.png";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
   const Image8 photo = read_image(path);
   constexpr int kSize = 512, kScale = 2;
   Image8 img(kSize, kSize, 3);
@@ -433,7 +434,7 @@ TEST(Vectorize, CoarseGridMatchesThePixelGridOnAnUpscaledPhotograph) {
 // adaptive Delaunay mesh with linearly interpolated least-squares colors; docs/quality.md).
 TEST(Vectorize, SharedPhotographs) {
   const std::filesystem::path dir = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no " << dir << ": shared photographs not present";
+  if (const auto why = test::skip_shared_photos(dir)) GTEST_SKIP() << *why;
   const std::pair<const char*, double> baseline[] = {{"astronaut", 10.1}, {"chelsea", 7.3}, {"rocket", 4.9},
                                                      {"fruits", 7.8},     {"butterfly", 20.3}, {"home", 9.1},
                                                      {"squirrel", 9.7},   {"apple", 5.2}};
