@@ -187,10 +187,22 @@ TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   const std::string s = editor.new_session();
   const ViewMesh whole = editor.view(s, {0, 3});
   ViewRequest zoomed{0, 3, 0, 0, 20, 20};
-  const ViewMesh part = editor.view(s, zoomed);
+  // The session's whole view covers the window at that depth: nothing to send again.
+  const ViewMesh same = editor.view(s, zoomed);
+  EXPECT_TRUE(same.unchanged);
+  EXPECT_EQ(same.id, whole.id);
+  EXPECT_TRUE(same.triangles.empty());
+  const ViewMesh part = editor.view(editor.new_session(), zoomed);
   EXPECT_FALSE(whole.partial);
+  EXPECT_FALSE(whole.unchanged);
   EXPECT_TRUE(part.partial);
   EXPECT_LT(part.triangles.size(), whole.triangles.size() / 2);
+  // Without a depth, the renderer's rule for the scale: 8x deeper is 3 levels more.
+  ViewRequest fit{0, -1, 0, 0, 0, 0, 1, 2.5};
+  const ViewMesh at1 = editor.view(editor.new_session(), fit);
+  fit.scale = 8;
+  const ViewMesh at8 = editor.view(editor.new_session(), fit);
+  EXPECT_EQ(at8.depth, std::min(at1.depth + 3, 8));
   EXPECT_EQ(status_of([&] { editor.view(s, {0, 9}); }), kBadRequest);
   EXPECT_EQ(status_of([&] { editor.view(s, {5, 2}); }), kBadRequest);
 }
