@@ -177,7 +177,7 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
     subvec::render_size(options, image.width, image.height);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::kLimit) throw;
-    throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit in all)");
+    throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
   options.level = a.level;
   const std::string overlay = lower(a.overlay);

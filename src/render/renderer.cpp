@@ -246,10 +246,10 @@ RenderSize render_size(const RenderOptions& options, int image_width, int image_
   if (!(width <= Limits::kMaxDimension && height <= Limits::kMaxDimension &&
         width * height <= double(options.max_pixels))) {
     throw Error(ErrorCode::kLimit, "output size " + detail::pixels(width) + "x" +
-                                       detail::pixels(height) + " is too large (at most " +
+                                       detail::pixels(height) + " is too large: at most " +
                                        std::to_string(Limits::kMaxDimension) +
                                        " pixels a side and " + std::to_string(options.max_pixels) +
-                                       " pixels in all)");
+                                       " pixels in all");
   }
   r.width = static_cast<int>(width);
   r.height = static_cast<int>(height);

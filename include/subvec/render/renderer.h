@@ -70,7 +70,7 @@ struct RenderSize {
 // Resolves and checks the size of a render of an image of image_width x image_height pixels:
 // Error(kInvalidArgument) for a negative size, a scale that is not a positive number (or a scale
 // beside a width or height), an empty or non-finite window or a bad max_pixels; Error(kLimit)
-// ("output size W x H is too large ...") for an output over Limits::kMaxDimension a side or
+// ("output size WxH is too large: ...") for an output over Limits::kMaxDimension a side or
 // options.max_pixels in all.
 RenderSize render_size(const RenderOptions& options, int image_width, int image_height);
 

@@ -259,8 +259,8 @@ TEST(RenderSize, ScaleWidthHeightAndOneLimit) {
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kLimit);
     EXPECT_STREQ(e.what(),
-                 "output size 640x480 is too large (at most 65536 pixels a side and 307199 pixels "
-                 "in all)");
+                 "output size 640x480 is too large: at most 65536 pixels a side and 307199 pixels "
+                 "in all");
   }
   big.max_pixels = 640 * 480;
   EXPECT_EQ(code(big), ErrorCode::kIo);
