@@ -197,12 +197,12 @@ TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   EXPECT_FALSE(whole.unchanged);
   EXPECT_TRUE(part.partial);
   EXPECT_LT(part.triangles.size(), whole.triangles.size() / 2);
-  // Without a depth, the renderer's rule for the scale: 8x deeper is 3 levels more.
+  // Without a depth, the renderer's rule for the scale: 4x larger is 2 levels deeper.
   ViewRequest fit{0, -1, 0, 0, 0, 0, 1, 2.5};
   const ViewMesh at1 = editor.view(editor.new_session(), fit);
-  fit.scale = 8;
-  const ViewMesh at8 = editor.view(editor.new_session(), fit);
-  EXPECT_EQ(at8.depth, std::min(at1.depth + 3, 8));
+  fit.scale = 4;
+  const ViewMesh at4 = editor.view(editor.new_session(), fit);
+  EXPECT_EQ(at4.depth, at1.depth + 2);
   EXPECT_EQ(status_of([&] { editor.view(s, {0, 9}); }), kBadRequest);
   EXPECT_EQ(status_of([&] { editor.view(s, {5, 2}); }), kBadRequest);
 }
