@@ -214,7 +214,8 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
   options.max_pixels = subvec::kMaxRenderPixels;  // nothing is rasterized: the size is the scale
   auto v = std::make_unique<View>();
   try {
-    if (session.view && session.view->version == version_ && !session.view->preview &&
+    if (session.view && request.have == session.view->mesh.id &&
+        session.view->version == version_ && !session.view->preview &&
         session.view->limit.covers(subvec::view_faces(image_, options))) {
       // The view the page holds already has every face this one needs at its depth.
       const ViewMesh& held = session.view->mesh;

@@ -68,6 +68,7 @@ struct ViewRequest {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   double scale = 1;              // canvas pixels per image pixel
   double max_edge_pixels = 2.5;  // the depth rule's target (RenderOptions::max_edge_pixels)
+  int64_t have = 0;              // the view the page holds (ViewMesh::id; 0: none)
 };
 
 // The refined mesh a session draws, unwelded for WebGL.
@@ -76,8 +77,9 @@ struct ViewMesh {
   int level = 0;
   int depth = 0;
   bool partial = false;             // only the faces near the window were refined
-  // The session's view already covers the request (same level, depth and document version, and
-  // every face it needs): nothing to send, the arrays are empty and `id` is the held view's.
+  // The view the page holds (ViewRequest::have) is the session's and covers the request (same
+  // level, depth and document version, and every face it needs): nothing to send, the arrays are
+  // empty and `id` is the held view's.
   bool unchanged = false;
   std::vector<float> positions;     // #G x 2, image pixels
   std::vector<uint8_t> colors;      // #G x 4, RGBA8 (alpha 255)

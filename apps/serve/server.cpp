@@ -470,6 +470,7 @@ void EditorServer::Impl::routes() {
     v.depth = small_int(j, "depth", -1);
     v.scale = number(j, "scale", 1.0);
     v.max_edge_pixels = number(j, "max_edge_pixels", 2.5);
+    v.have = integer(j, "have", 0);
     if (j.contains("window") && !j["window"].is_null()) {
       const json& w = j["window"];
       if (!w.is_array() || w.size() != 4 ||

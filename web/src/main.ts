@@ -181,9 +181,10 @@ function loadView(): Promise<void> {
       const want = wantedView();
       const frame = await postFrame('/api/view', {
         session: state.session, level: state.level, window: want.window, scale: want.zoom,
-        max_edge_pixels: quality.edge,
+        max_edge_pixels: quality.edge, have: state.view.id,
       });
-      if (!frame.header.unchanged || frame.header.view !== state.view.id) {
+      // "unchanged": the view held (`have`) already covers this one; nothing was sent.
+      if (!frame.header.unchanged) {
         renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
       }
       state.view = {

@@ -187,11 +187,14 @@ TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   const std::string s = editor.new_session();
   const ViewMesh whole = editor.view(s, {0, 3});
   ViewRequest zoomed{0, 3, 0, 0, 20, 20};
-  // The session's whole view covers the window at that depth: nothing to send again.
+  // The page holds the whole view, which covers the window at that depth: nothing to send again.
+  zoomed.have = whole.id;
   const ViewMesh same = editor.view(s, zoomed);
   EXPECT_TRUE(same.unchanged);
   EXPECT_EQ(same.id, whole.id);
   EXPECT_TRUE(same.triangles.empty());
+  zoomed.have = 0;  // a page that holds no view gets one
+  EXPECT_FALSE(editor.view(s, zoomed).unchanged);
   const ViewMesh part = editor.view(editor.new_session(), zoomed);
   EXPECT_FALSE(whole.partial);
   EXPECT_FALSE(whole.unchanged);
