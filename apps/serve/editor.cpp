@@ -229,9 +229,13 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
     }
     v->limit = subvec::view_mesh(image_, options);
   } catch (const Error& e) {
-    throw RequestError(e.code() == ErrorCode::kLimit ? kUnprocessable : kBadRequest, e.what());
+    const ErrorCode code = e.code();
+    throw RequestError(code == ErrorCode::kInvalidArgument ? kBadRequest
+                       : code == ErrorCode::kLimit         ? kUnprocessable
+                                                           : 500,
+                       e.what());
   }
-  const subvec::RefinedMesh& refined = v->limit.refined;
+  subvec::RefinedMesh& refined = v->limit.refined;
   const int nr = refined.num_vertices();
 
   // Unweld: GL vertex = (refined vertex, color value). The first color seen at a vertex takes
@@ -281,6 +285,13 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
     for (int c = 0; c < 3; ++c) v->mesh.colors[4 * g + c] = to_byte(refined.colors[3 * rc + c]);
     v->mesh.colors[4 * g + 3] = 255;
   }
+  // Deltas need only the limit values; the topology lives on in the subdivision and the GL arrays.
+  refined.triangles = {};
+  refined.triangle_colors = {};
+  refined.triangle_parent = {};
+  refined.crease_edges = {};
+  refined.border_edges = {};
+  refined.tear_edges = {};
   v->mesh.id = next_view_++;
   v->mesh.level = request.level;
   v->mesh.depth = v->limit.faces.depth;
