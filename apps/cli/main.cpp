@@ -53,9 +53,6 @@ namespace fs = std::filesystem;
 using subvec::Error;
 using subvec::ErrorCode;
 
-// Output images over this many pixels are refused (about 1 GiB of RGBA).
-constexpr int64_t kMaxOutputPixels = int64_t{1} << 28;
-
 std::string in_quotes(const fs::path& p) { return "'" + p.string() + "'"; }
 
 std::string lower(std::string s) {
@@ -114,10 +111,7 @@ struct RenderArgs {
   double tolerance = 0.25;  // .pdf and .svg only
   std::string pdf_target = "any";  // .pdf only: any or poppler (checked by CLI11)
   bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
-  // Output pixels refused by default: a file of a few hundred bytes may declare a 65536 x 4096
-  // image, whose render at 1x would take half a minute and gigabytes. 2^26 (8192 x 8192) renders
-  // in seconds with about 400 MB.
-  int64_t max_pixels = int64_t{1} << 26;
+  int64_t max_pixels = subvec::RenderOptions{}.max_pixels;  // the library's default
 };
 
 // Output formats by extension: .png rasterizes; .pdf and .svg export the limit mesh
@@ -168,46 +162,23 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
     return;
   }
 
+  // Output size (subvec::render_size): explicit width (height keeps the window's aspect), or the
+  // window's size times the scale (1 by default).
   subvec::RenderOptions options;
-  subvec::Window window{0, 0, double(image.width), double(image.height)};
   if (!a.window.empty()) {
+    subvec::Window window;
     parse_window(a.window, window);  // already validated by CLI11
     options.window = window;
   }
-  // Output size: explicit width (height keeps the window's aspect), or the window's size times
-  // the scale (1 by default).
-  const double ww = window.x1 - window.x0, wh = window.y1 - window.y0;
-  double out_w, out_h;
-  if (width_given) {
-    out_w = a.width;
-    out_h = std::max(1.0, std::round(a.width * wh / ww));
-  } else {
-    const double s = scale_given ? a.scale : 1.0;
-    out_w = std::max(1.0, std::round(ww * s));
-    out_h = std::max(1.0, std::round(wh * s));
+  if (width_given) options.width = a.width;
+  if (scale_given) options.scale = a.scale;
+  options.max_pixels = a.max_pixels;
+  try {
+    subvec::render_size(options, image.width, image.height);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kLimit) throw;
+    throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
-  const double max_side = subvec::Limits::kMaxDimension;
-  if (!(out_w <= max_side && out_h <= max_side && out_w * out_h <= double(kMaxOutputPixels))) {
-    const auto pixels = [](double v) {
-      std::ostringstream o;
-      if (v < 1e15) o << std::fixed << std::setprecision(0);
-      o << v;
-      return o.str();
-    };
-    std::ostringstream msg;
-    msg << "output size " << pixels(out_w) << "x" << pixels(out_h) << " is too large (at most "
-        << subvec::Limits::kMaxDimension << " pixels a side and " << kMaxOutputPixels
-        << " pixels in all)";
-    throw Error(ErrorCode::kLimit, msg.str());
-  }
-  if (out_w * out_h > double(a.max_pixels)) {
-    throw Error(ErrorCode::kLimit, "output size " + std::to_string(int64_t(out_w)) + "x" +
-                                       std::to_string(int64_t(out_h)) + " is over the limit of " +
-                                       std::to_string(a.max_pixels) +
-                                       " pixels (--max-pixels raises the limit)");
-  }
-  options.width = static_cast<int>(out_w);
-  options.height = static_cast<int>(out_h);
   options.level = a.level;
   const std::string overlay = lower(a.overlay);
   options.overlay = overlay == "mesh"       ? subvec::Overlay::kMesh
@@ -582,7 +553,7 @@ int run(int argc, char** argv) {
   render
       ->add_option("--max-pixels", ra.max_pixels,
                    ".png: refuse larger outputs (default 67108864 = 8192 x 8192; at most 2^28)")
-      ->check(CLI::Range(int64_t{1}, kMaxOutputPixels));
+      ->check(CLI::Range(int64_t{1}, subvec::kMaxRenderPixels));
   render->add_option("--threads", ra.threads, "Worker threads; 0 (default) uses all cores")
       ->check(CLI::Range(0, 1024));
   render

@@ -13,6 +13,7 @@
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/pyramid/pyramid.h"
+#include "subvec/render/renderer.h"
 
 namespace subvec_serve {
 
@@ -24,10 +25,11 @@ using subvec::MeshTopology;
 
 struct Editor::View {
   ViewMesh mesh;
-  std::unique_ptr<subvec::Subdivision> subdivision;
+  subvec::ViewMesh limit;  // the library's view mesh: faces, depth, subdivision, limit values
   std::vector<int32_t> gl_vertex, gl_color;  // #G: refined vertex and color value of each GL vertex
-  std::vector<float> refined_positions, refined_colors;  // scratch
   int num_control_vertices = 0;
+  int64_t version = 0;     // the document version it shows
+  bool preview = false;    // it holds a drag preview's positions, not the document's
 };
 
 struct Editor::Session {
@@ -193,61 +195,48 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_level_locked(request.level);
-  if (request.depth < 0 || request.depth > 8) {
+  if (request.depth < -1 || request.depth > 8) {
     throw RequestError(kBadRequest, "depth " + std::to_string(request.depth) +
-                                        " is out of range (0 to 8)");
+                                        " is out of range (-1 to 8; -1: from the scale)");
   }
   const ControlMesh& mesh = image_.levels[request.level];
-  const MeshTopology topology =
-      MeshTopology::build(mesh, image_.width, image_.height);
 
-  // Faces whose limit surface may touch the window: the limit over a face lies in the convex
-  // hull of its one-ring, so test the bounding box of the vertices of every face around it.
-  std::vector<int32_t> faces;
-  const bool windowed = request.x1 > request.x0 && request.y1 > request.y0 &&
-                        (request.x0 > 0 || request.y0 > 0 || request.x1 < image_.width ||
-                         request.y1 < image_.height);
-  if (windowed) {
-    const int nv = mesh.num_vertices();
-    std::vector<std::array<double, 4>> vbox(nv, {std::numeric_limits<double>::max(),
-                                                 std::numeric_limits<double>::max(),
-                                                 std::numeric_limits<double>::lowest(),
-                                                 std::numeric_limits<double>::lowest()});
-    // Box of each vertex's star (its incident faces' vertices).
-    for (const subvec::Tri& t : mesh.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        auto& b = vbox[t[k]];
-        for (int j = 0; j < 3; ++j) {
-          const Vec2 p = mesh.positions[t[j]];
-          b = {std::min(b[0], p.x), std::min(b[1], p.y), std::max(b[2], p.x), std::max(b[3], p.y)};
-        }
-      }
-    }
-    for (int f = 0; f < mesh.num_triangles(); ++f) {
-      std::array<double, 4> b = vbox[mesh.triangles[f][0]];
-      for (int k = 1; k < 3; ++k) {
-        const auto& o = vbox[mesh.triangles[f][k]];
-        b = {std::min(b[0], o[0]), std::min(b[1], o[1]), std::max(b[2], o[2]), std::max(b[3], o[3])};
-      }
-      if (b[2] >= request.x0 && b[0] <= request.x1 && b[3] >= request.y0 && b[1] <= request.y1) {
-        faces.push_back(f);
-      }
-    }
-    if (faces.empty()) faces.push_back(0);  // nothing visible: one face keeps the view valid
-    if (static_cast<int>(faces.size()) == mesh.num_triangles()) faces.clear();
+  // The renderer's view of the window at the page's scale (render/renderer.h): its visible faces
+  // and its depth rule, or the depth the request names.
+  subvec::RenderOptions options;
+  options.level = request.level;
+  if (request.x1 > request.x0 && request.y1 > request.y0) {
+    options.window = subvec::Window{request.x0, request.y0, request.x1, request.y1};
   }
-  int depth = request.depth;
-  const int64_t base = faces.empty() ? mesh.num_triangles() : static_cast<int64_t>(faces.size());
-  while (depth > 0 && (base << (2 * depth)) > kMaxViewTriangles) --depth;
-
+  options.scale = request.scale;
+  options.depth = request.depth;
+  options.max_edge_pixels = request.max_edge_pixels;
+  options.max_pixels = subvec::kMaxRenderPixels;  // nothing is rasterized: the size is the scale
   auto v = std::make_unique<View>();
   try {
-    v->subdivision = std::make_unique<subvec::Subdivision>(mesh, topology, depth, faces);
+    if (session.view && request.have == session.view->mesh.id &&
+        session.view->version == version_ && !session.view->preview &&
+        session.view->limit.covers(subvec::view_faces(image_, options))) {
+      // The view the page holds already has every face this one needs at its depth.
+      const ViewMesh& held = session.view->mesh;
+      ViewMesh same;
+      same.id = held.id;
+      same.level = held.level;
+      same.depth = held.depth;
+      same.partial = held.partial;
+      same.unchanged = true;
+      return same;
+    }
+    v->limit = subvec::view_mesh(image_, options);
   } catch (const Error& e) {
-    refuse_edit(e);
+    const ErrorCode code = e.code();
+    throw RequestError(code == ErrorCode::kInvalidArgument ? kBadRequest
+                       : code == ErrorCode::kLimit         ? kUnprocessable
+                                                           : 500,
+                       e.what());
   }
-  const subvec::RefinedMesh& refined = v->subdivision->topology();
-  const int nr = v->subdivision->num_vertices();
+  subvec::RefinedMesh& refined = v->limit.refined;
+  const int nr = refined.num_vertices();
 
   // Unweld: GL vertex = (refined vertex, color value). The first color seen at a vertex takes
   // the vertex's slot; the other sides of a tear get extra GL vertices.
@@ -287,24 +276,28 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
 
   // Limit values, gathered per GL vertex.
   const size_t ng = v->gl_vertex.size();
-  v->refined_positions.resize(size_t(nr) * 2);
-  v->refined_colors.resize(size_t(v->subdivision->num_colors()) * 3);
-  v->subdivision->evaluate_positions(mesh.positions, v->refined_positions);
-  v->subdivision->evaluate_colors(mesh.colors, v->refined_colors);
   v->mesh.positions.resize(ng * 2);
   v->mesh.colors.resize(ng * 4);
   for (size_t g = 0; g < ng; ++g) {
     const size_t rv = static_cast<size_t>(v->gl_vertex[g]), rc = static_cast<size_t>(v->gl_color[g]);
-    v->mesh.positions[2 * g] = v->refined_positions[2 * rv];
-    v->mesh.positions[2 * g + 1] = v->refined_positions[2 * rv + 1];
-    for (int c = 0; c < 3; ++c) v->mesh.colors[4 * g + c] = to_byte(v->refined_colors[3 * rc + c]);
+    v->mesh.positions[2 * g] = refined.positions[2 * rv];
+    v->mesh.positions[2 * g + 1] = refined.positions[2 * rv + 1];
+    for (int c = 0; c < 3; ++c) v->mesh.colors[4 * g + c] = to_byte(refined.colors[3 * rc + c]);
     v->mesh.colors[4 * g + 3] = 255;
   }
+  // Deltas need only the limit values; the topology lives on in the subdivision and the GL arrays.
+  refined.triangles = {};
+  refined.triangle_colors = {};
+  refined.triangle_parent = {};
+  refined.crease_edges = {};
+  refined.border_edges = {};
+  refined.tear_edges = {};
   v->mesh.id = next_view_++;
   v->mesh.level = request.level;
-  v->mesh.depth = depth;
-  v->mesh.partial = !faces.empty();
+  v->mesh.depth = v->limit.faces.depth;
+  v->mesh.partial = !v->limit.faces.all_faces;
   v->num_control_vertices = mesh.num_vertices();
+  v->version = version_;
   session.view = std::move(v);
   return session.view->mesh;
 }
@@ -320,12 +313,17 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
   const ControlMesh& mesh = image_.levels[v.mesh.level];
   const std::vector<Vec2>& positions = preview ? *preview : mesh.positions;
   delta.view_id = v.mesh.id;
-  v.subdivision->evaluate_positions(positions, v.refined_positions);
-  if (colors) v.subdivision->evaluate_colors(mesh.colors, v.refined_colors);
+  v.version = version_;
+  v.preview = preview != nullptr;
+  subvec::RefinedMesh& refined = v.limit.refined;
+  if (v.limit.subdivision) {
+    v.limit.subdivision->evaluate_positions(positions, refined.positions);
+    if (colors) v.limit.subdivision->evaluate_colors(mesh.colors, refined.colors);
+  }
   const size_t ng = v.gl_vertex.size();
   for (size_t g = 0; g < ng; ++g) {
     const size_t rv = static_cast<size_t>(v.gl_vertex[g]);
-    const float x = v.refined_positions[2 * rv], y = v.refined_positions[2 * rv + 1];
+    const float x = refined.positions[2 * rv], y = refined.positions[2 * rv + 1];
     if (x != v.mesh.positions[2 * g] || y != v.mesh.positions[2 * g + 1]) {
       v.mesh.positions[2 * g] = x;
       v.mesh.positions[2 * g + 1] = y;
@@ -335,7 +333,7 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
     const size_t rc = static_cast<size_t>(v.gl_color[g]);
     bool changed = false;
     for (int c = 0; c < 3; ++c) {
-      const uint8_t b = to_byte(v.refined_colors[3 * rc + c]);
+      const uint8_t b = to_byte(refined.colors[3 * rc + c]);
       changed |= b != v.mesh.colors[4 * g + c];
       v.mesh.colors[4 * g + c] = b;
     }

@@ -14,9 +14,10 @@
 // (drag_feature / drag_vertex / move_feature, then ShapeEditor::deform with the factorization
 // cached for the drag's handle set) and committed with apply_edit_ops when the mouse is released.
 //
-// Redraw data. A view is the control faces of one level refined `depth` times and pushed to the
-// limit (subdiv/subdivision.h), unwelded into "GL vertices" (one per refined vertex and color value
-// pair, so a tear is a seam), with RGBA8 colors and float positions in image pixels. After an edit
+// Redraw data. A view is the control faces of one level that the renderer would draw for the
+// page's window and scale, refined to the renderer's depth and pushed to the limit
+// (subvec::view_mesh, render/renderer.h), unwelded into "GL vertices" (one per refined vertex and
+// color value pair, so a tear is a seam), with RGBA8 colors and float positions in image pixels. After an edit
 // a session answers with a Delta: the GL vertices whose position or color changed (sparse when few
 // changed, dense otherwise), never the topology again.
 #pragma once
@@ -57,11 +58,17 @@ class RequestError : public std::runtime_error {
 inline constexpr int kBadRequest = 400, kNotFound = 404, kConflict = 409, kUnprocessable = 422,
                      kUnavailable = 503;
 
+// A view as the renderer plans it (render/renderer.h, view_mesh): the faces whose limit surface
+// may touch the window, refined to the renderer's depth for `scale` and `max_edge_pixels`, or to
+// `depth` when it is given.
 struct ViewRequest {
   int level = 0;
-  int depth = 2;
+  int depth = -1;  // -1: the renderer's depth rule; else 0..8
   // Image-space window the page shows (with a margin); empty (x1 <= x0): the whole image.
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  double scale = 1;              // canvas pixels per image pixel
+  double max_edge_pixels = 2.5;  // the depth rule's target (RenderOptions::max_edge_pixels)
+  int64_t have = 0;              // the view the page holds (ViewMesh::id; 0: none)
 };
 
 // The refined mesh a session draws, unwelded for WebGL.
@@ -70,6 +77,10 @@ struct ViewMesh {
   int level = 0;
   int depth = 0;
   bool partial = false;             // only the faces near the window were refined
+  // The view the page holds (ViewRequest::have) is the session's and covers the request (same
+  // level, depth and document version, and every face it needs): nothing to send, the arrays are
+  // empty and `id` is the held view's.
+  bool unchanged = false;
   std::vector<float> positions;     // #G x 2, image pixels
   std::vector<uint8_t> colors;      // #G x 4, RGBA8 (alpha 255)
   std::vector<uint32_t> triangles;  // #T x 3 GL vertex indices
@@ -150,7 +161,6 @@ class Editor {
   // Limits that keep one request bounded in time and memory.
   static constexpr int kMaxSessions = 32;
   static constexpr int kMaxUndo = 200;
-  static constexpr int64_t kMaxViewTriangles = int64_t{1} << 22;
 
   explicit Editor(VectorImage image);
   ~Editor();

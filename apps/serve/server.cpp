@@ -467,7 +467,10 @@ void EditorServer::Impl::routes() {
     const json j = body_json(req);
     ViewRequest v;
     v.level = small_int(j, "level", 0);
-    v.depth = small_int(j, "depth", 2);
+    v.depth = small_int(j, "depth", -1);
+    v.scale = number(j, "scale", 1.0);
+    v.max_edge_pixels = number(j, "max_edge_pixels", 2.5);
+    v.have = integer(j, "have", 0);
     if (j.contains("window") && !j["window"].is_null()) {
       const json& w = j["window"];
       if (!w.is_array() || w.size() != 4 ||
@@ -492,6 +495,7 @@ void EditorServer::Impl::routes() {
                                        {"level", m.level},
                                        {"depth", m.depth},
                                        {"partial", m.partial},
+                                       {"unchanged", m.unchanged},
                                        {"version", doc->version()}});
     res.set_content(body, "application/octet-stream");
   });

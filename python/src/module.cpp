@@ -211,48 +211,18 @@ subvec::Color color3(const std::array<double, 3>& c, const char* what) {
 
 // ---- VectorImage methods ---------------------------------------------------------------------
 
-// Output size and window exactly as `subvec render` computes them (apps/cli/main.cpp), so that
-// render() and the CLI's PNG agree byte for byte.
+// Fills RenderOptions as `subvec render` does; the library resolves the output size and window
+// (subvec::render_size), so render() and the CLI's PNG agree byte for byte.
 subvec::Image8 render_image(const VectorImage& image, std::optional<int> width,
                             std::optional<double> scale, std::optional<std::array<double, 4>> win,
                             int level, const std::string& overlay, bool antialias, int threads,
                             int depth) {
   check_level(image, level);
   if (width && scale) invalid("give width or scale, not both");
-  if (width && (*width < 1 || *width > subvec::Limits::kMaxDimension)) {
-    invalid("width " + std::to_string(*width) + " is out of range (1 to " +
-            std::to_string(subvec::Limits::kMaxDimension) + ")");
-  }
-  if (scale && !(std::isfinite(*scale) && *scale > 0)) invalid("scale must be a positive number");
-  if (depth < -1 || depth > 10) invalid("depth " + std::to_string(depth) + " is out of range (-1 to 10)");
   subvec::RenderOptions options;
-  subvec::Window window{0, 0, double(image.width), double(image.height)};
-  if (win) {
-    const auto& v = *win;
-    for (double x : v) {
-      if (!std::isfinite(x)) invalid("the window holds a number that is not finite");
-    }
-    if (!(v[0] < v[2]) || !(v[1] < v[3])) invalid("the window must have x0 < x1 and y0 < y1");
-    window = {v[0], v[1], v[2], v[3]};
-    options.window = window;
-  }
-  const double ww = window.x1 - window.x0, wh = window.y1 - window.y0;
-  double out_w, out_h;
-  if (width) {
-    out_w = *width;
-    out_h = std::max(1.0, std::round(*width * wh / ww));
-  } else {
-    const double s = scale.value_or(1.0);
-    out_w = std::max(1.0, std::round(ww * s));
-    out_h = std::max(1.0, std::round(wh * s));
-  }
-  const double max_side = subvec::Limits::kMaxDimension;
-  if (!(out_w <= max_side && out_h <= max_side && out_w * out_h <= double(int64_t{1} << 28))) {
-    throw Error(ErrorCode::kLimit, "output size " + std::to_string(out_w) + " x " +
-                                       std::to_string(out_h) + " is too large");
-  }
-  options.width = static_cast<int>(out_w);
-  options.height = static_cast<int>(out_h);
+  if (win) options.window = subvec::Window{(*win)[0], (*win)[1], (*win)[2], (*win)[3]};
+  if (width) options.width = *width;
+  if (scale) options.scale = *scale;  // the output limit: RenderOptions::max_pixels, as the CLI's
   options.level = level;
   if (overlay == "none") {
     options.overlay = subvec::Overlay::kNone;

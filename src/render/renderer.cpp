@@ -81,52 +81,36 @@ std::string num(double v) {
   return buf;
 }
 
-// Output size for a window of ww x wh image pixels.
-std::array<int, 2> output_size(const RenderOptions& options, double ww, double wh) {
-  if (options.width < 0 || options.height < 0) {
-    invalid("output size " + std::to_string(options.width) + " x " +
-            std::to_string(options.height) + " is negative");
-  }
-  double w = options.width, h = options.height;
-  if (w == 0 && h == 0) {
-    w = ww;
-    h = wh;
-  } else if (h == 0) {
-    h = w * wh / ww;
-  } else if (w == 0) {
-    w = h * ww / wh;
-  }
-  w = std::max(1.0, std::round(w));
-  h = std::max(1.0, std::round(h));
-  if (w > Limits::kMaxDimension || h > Limits::kMaxDimension ||
-      w * h > double(Limits::kMaxPixels)) {
-    throw Error(ErrorCode::kLimit, "output size " + num(w) + " x " + num(h) +
-                                       " is over the limit of " +
-                                       std::to_string(Limits::kMaxDimension) + " per side and " +
-                                       std::to_string(Limits::kMaxPixels) + " pixels");
-  }
-  return {static_cast<int>(w), static_cast<int>(h)};
+// A pixel count as an integer while it is one.
+std::string pixels(double v) {
+  if (v >= 1e15) return num(v);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f", v);
+  return buf;
 }
 
 }  // namespace
 
+bool covers_faces(std::span<const int32_t> have, bool have_all, std::span<const int32_t> want,
+                  bool want_all) {
+  return have_all || (!want_all && std::includes(have.begin(), have.end(), want.begin(), want.end()));
+}
+
 ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
                    std::span<const std::array<double, 4>> boxes, const RenderOptions& options) {
   ViewPlan p;
-  const Window w = options.window.value_or(Window{0, 0, double(image.width), double(image.height)});
-  if (!std::isfinite(w.x0) || !std::isfinite(w.y0) || !std::isfinite(w.x1) ||
-      !std::isfinite(w.y1) || !(w.x0 < w.x1) || !(w.y0 < w.y1)) {
-    invalid("window " + num(w.x0) + "," + num(w.y0) + "," + num(w.x1) + "," + num(w.y1) +
-            " is empty or not finite (want x0 < x1, y0 < y1)");
-  }
+  const RenderSize size = render_size(options, image.width, image.height);
   if (!(options.max_edge_pixels > 0) || !std::isfinite(options.max_edge_pixels)) {
     invalid("max_edge_pixels " + num(options.max_edge_pixels) + " is not a positive number");
   }
-  if (options.depth > 10) invalid("depth " + std::to_string(options.depth) + " is over 10");
+  if (options.depth < -1 || options.depth > 10) {
+    invalid("depth " + std::to_string(options.depth) + " is out of range (-1 to 10)");
+  }
+  const Window w = size.window;
   const double ww = w.x1 - w.x0, wh = w.y1 - w.y0;
-  const auto [width, height] = output_size(options, ww, wh);
+  const int width = size.width, height = size.height;
   p.window = w;
-  p.view = {w.x0, w.y0, width / ww, height / wh, width, height};
+  p.view = {w.x0, w.y0, size.scale_x, size.scale_y, width, height};
   constexpr double kMaxZoom = 65536;
   if (p.view.sx > kMaxZoom || p.view.sy > kMaxZoom) {
     invalid("window " + num(ww) + " x " + num(wh) + " is too small for a " + std::to_string(width) +
@@ -220,6 +204,59 @@ std::vector<OverlayLayer> feature_overlay(const RefinedMesh& refined, const View
 
 }  // namespace
 }  // namespace detail
+
+RenderSize render_size(const RenderOptions& options, int image_width, int image_height) {
+  using detail::invalid;
+  using detail::num;
+  if (options.width < 0 || options.height < 0) {
+    invalid("output size " + std::to_string(options.width) + " x " +
+            std::to_string(options.height) + " is negative");
+  }
+  if (!(options.scale > 0) || !std::isfinite(options.scale)) {
+    invalid("scale " + num(options.scale) + " is not a positive number");
+  }
+  if (options.scale != 1 && (options.width > 0 || options.height > 0)) {
+    invalid("give width or scale, not both (width " + std::to_string(options.width) +
+            ", height " + std::to_string(options.height) + ", scale " + num(options.scale) + ")");
+  }
+  if (options.max_pixels < 1 || options.max_pixels > kMaxRenderPixels) {
+    invalid("max_pixels " + std::to_string(options.max_pixels) + " is out of range (1 to " +
+            std::to_string(kMaxRenderPixels) + ")");
+  }
+  RenderSize r;
+  r.window = options.window.value_or(Window{0, 0, double(image_width), double(image_height)});
+  const Window& w = r.window;
+  if (!std::isfinite(w.x0) || !std::isfinite(w.y0) || !std::isfinite(w.x1) ||
+      !std::isfinite(w.y1) || !(w.x0 < w.x1) || !(w.y0 < w.y1)) {
+    invalid("window " + num(w.x0) + "," + num(w.y0) + "," + num(w.x1) + "," + num(w.y1) +
+            " is empty or not finite (want x0 < x1, y0 < y1)");
+  }
+  const double ww = w.x1 - w.x0, wh = w.y1 - w.y0;
+  double width = options.width, height = options.height;
+  if (width == 0 && height == 0) {
+    width = ww * options.scale;
+    height = wh * options.scale;
+  } else if (height == 0) {
+    height = width * wh / ww;
+  } else if (width == 0) {
+    width = height * ww / wh;
+  }
+  width = std::max(1.0, std::round(width));
+  height = std::max(1.0, std::round(height));
+  if (!(width <= Limits::kMaxDimension && height <= Limits::kMaxDimension &&
+        width * height <= double(options.max_pixels))) {
+    throw Error(ErrorCode::kLimit, "output size " + detail::pixels(width) + "x" +
+                                       detail::pixels(height) + " is too large: at most " +
+                                       std::to_string(Limits::kMaxDimension) +
+                                       " pixels a side and " + std::to_string(options.max_pixels) +
+                                       " pixels in all");
+  }
+  r.width = static_cast<int>(width);
+  r.height = static_cast<int>(height);
+  r.scale_x = width / ww;
+  r.scale_y = height / wh;
+  return r;
+}
 
 namespace {
 
@@ -327,10 +364,9 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
     }
     use_gpu = state.gpu != nullptr;
   }
-  const bool reuse =
-      c.subdivision && c.on_gpu == use_gpu && c.level == options.level && c.depth == plan.depth &&
-      (c.faces.empty() || (!plan.all_faces && std::includes(c.faces.begin(), c.faces.end(),
-                                                            plan.faces.begin(), plan.faces.end())));
+  const bool reuse = c.subdivision && c.on_gpu == use_gpu && c.level == options.level &&
+                     c.depth == plan.depth &&
+                     detail::covers_faces(c.faces, c.faces.empty(), plan.faces, plan.all_faces);
   if (use_gpu) {
     try {
       if (!reuse) {
@@ -412,7 +448,58 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
   detail::draw_strokes(image.strokes, options.level, plan.view, out);
 }
 
+// The plan of one view with the level's validated topology: what render() plans for `options`.
+struct LevelPlan {
+  MeshTopology topology;
+  detail::ViewPlan plan;
+};
+
+LevelPlan plan_level(const VectorImage& image, const RenderOptions& options) {
+  if (image.width < 1 || image.height < 1) {
+    throw Error(ErrorCode::kInvalidArgument, "the image has no pixels");
+  }
+  State state;
+  LevelState& ls = level_state(image, state, options.level);
+  detail::ViewPlan plan = detail::plan_view(image, image.levels[options.level], ls.boxes, options);
+  return {std::move(*ls.topology), std::move(plan)};
+}
+
+ViewFaces view_faces_of(const detail::ViewPlan& plan, int level) {
+  ViewFaces v;
+  v.level = level;
+  v.depth = plan.depth;
+  v.size = {plan.view.width, plan.view.height, plan.window, plan.view.sx, plan.view.sy};
+  v.all_faces = plan.all_faces;
+  v.faces = plan.faces;
+  return v;
+}
+
 }  // namespace
+
+ViewFaces view_faces(const VectorImage& image, const RenderOptions& options) {
+  return view_faces_of(plan_level(image, options).plan, options.level);
+}
+
+bool ViewMesh::covers(const ViewFaces& other) const {
+  return faces.level == other.level && faces.depth == other.depth &&
+         detail::covers_faces(faces.faces, faces.all_faces, other.faces, other.all_faces);
+}
+
+ViewMesh view_mesh(const VectorImage& image, const RenderOptions& options) {
+  const LevelPlan p = plan_level(image, options);
+  ViewMesh v;
+  v.faces = view_faces_of(p.plan, options.level);
+  if (p.plan.faces.empty()) return v;
+  const ControlMesh& mesh = image.levels[options.level];
+  // The renderer's partial refinement: the visible faces only, or the whole level (no face list)
+  // when every face is visible.
+  const std::span<const int32_t> faces =
+      p.plan.all_faces ? std::span<const int32_t>{} : std::span<const int32_t>(p.plan.faces);
+  v.subdivision.emplace(mesh, p.topology, p.plan.depth, faces);
+  v.subdivision->evaluate(mesh.positions, mesh.colors, v.refined,
+                          detail::resolve_threads(options.threads));
+  return v;
+}
 
 Image8 render(const VectorImage& image, const RenderOptions& options) {
   State state;

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "render/raster_p.h"
@@ -34,6 +35,11 @@ struct ViewPlan {
 // Checks the options (Error(kInvalidArgument) / kLimit) and plans the view of one level.
 ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
                    std::span<const std::array<double, 4>> boxes, const RenderOptions& options);
+
+// Whether a refinement of `have` (all faces when have_all) holds every face of `want` at the same
+// level and depth: the rule by which a refinement is reused (Renderer's cache, ViewMesh::covers).
+bool covers_faces(std::span<const int32_t> have, bool have_all, std::span<const int32_t> want,
+                  bool want_all);
 
 // The depth rule: the smallest k in 0..8 with mean_edge_pixels / 2^k <= max_edge_pixels, lowered
 // until num_faces * 4^k <= kMaxAutoTriangles.

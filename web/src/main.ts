@@ -38,7 +38,7 @@ const state = {
   version: 0,
   level: 0,
   tool: 'drag' as Tool,
-  view: { id: 0, depth: -1, partial: false, window: null as number[] | null },
+  view: { id: 0, depth: -1, partial: false, window: null as number[] | null, zoom: 0 },
   transform: { zoom: 1, panX: 0, panY: 0 } as Transform,
   overlays: { mesh: false, features: false },
   busy: 0,           // requests that change the document, in flight
@@ -133,28 +133,26 @@ function toImage([x, y]: [number, number]): [number, number] {
 
 // ---- the refined view ----------------------------------------------------------------------
 
-// Depth: refine until refined edges are at most quality.edge canvas pixels long on average (the
-// CPU renderer's rule, docs/performance.md, uses 2.5); the whole level while that stays under ~1.5 M triangles, else the visible
-// window with a margin.
-function wantedView(): { depth: number; window: number[] | null } {
-  const doc = state.doc!;
-  const level = doc.levels[state.level];
-  const edge = level.mean_edge * state.transform.zoom;
-  let depth = 0;
-  while (depth < 6 && edge / 2 ** depth > quality.edge) ++depth;
-  if (level.triangles * 4 ** depth <= 1.5e6) return { depth, window: null };
+// The view the page asks for: the visible part of the image plus a quarter on each side, at the
+// current zoom. The server plans it as the renderer does (subvec::view_mesh: the control faces
+// whose limit surface may meet the window, refined until refined edges average at most
+// quality.edge canvas pixels) and answers the depth it chose.
+function wantedView(): { zoom: number; window: number[] } {
   const t = state.transform;
   const x0 = -t.panX / t.zoom, y0 = -t.panY / t.zoom;
   const x1 = (canvas.width - t.panX) / t.zoom, y1 = (canvas.height - t.panY) / t.zoom;
   const mx = (x1 - x0) * 0.25, my = (y1 - y0) * 0.25;
-  return { depth, window: [x0 - mx, y0 - my, x1 + mx, y1 + my] };
+  return { zoom: t.zoom, window: [x0 - mx, y0 - my, x1 + mx, y1 + my] };
 }
 
-function viewCovers(want: { depth: number; window: number[] | null }): boolean {
-  if (want.depth !== state.view.depth) return false;
+// Whether the view held is the one the server would plan now: the same zoom, and the screen inside
+// its window (or every face refined). Otherwise the server is asked; it answers "unchanged" when
+// the view held already covers the new one.
+function viewCovers(want: { zoom: number; window: number[] }): boolean {
+  if (want.zoom !== state.view.zoom) return false;
   if (!state.view.partial) return true;
   const have = state.view.window;
-  if (!have || !want.window) return false;
+  if (!have) return false;
   const t = state.transform;
   const x0 = -t.panX / t.zoom, y0 = -t.panY / t.zoom;
   const x1 = (canvas.width - t.panX) / t.zoom, y1 = (canvas.height - t.panY) / t.zoom;
@@ -182,10 +180,17 @@ function loadView(): Promise<void> {
     try {
       const want = wantedView();
       const frame = await postFrame('/api/view', {
-        session: state.session, level: state.level, depth: want.depth, window: want.window,
+        session: state.session, level: state.level, window: want.window, scale: want.zoom,
+        max_edge_pixels: quality.edge, have: state.view.id,
       });
-      renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
-      state.view = { id: frame.header.view, depth: want.depth, partial: frame.header.partial, window: want.window };
+      // "unchanged": the view held (`have`) already covers this one; nothing was sent.
+      if (!frame.header.unchanged) {
+        renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
+      }
+      state.view = {
+        id: frame.header.view, depth: frame.header.depth, partial: frame.header.partial,
+        window: want.window, zoom: want.zoom,
+      };
       updateZoomLabel();
       redraw();
     } finally {

@@ -7,13 +7,16 @@
 // writer per pixel, so the output is byte-identical whatever the thread count.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
+#include "subvec/subdiv/subdivision.h"
 
 namespace subvec {
 
@@ -33,10 +36,19 @@ enum class Overlay { kNone, kMesh, kFeatures };
 // the frame is drawn on the CPU: see gpu_unavailable_reason() and Renderer::last_backend().
 enum class Backend { kCpu, kGpu };
 
+// The largest output a render may be allowed (RenderOptions::max_pixels): 2^28 pixels, 1 GiB of
+// RGBA.
+inline constexpr int64_t kMaxRenderPixels = int64_t{1} << 28;
+
 struct RenderOptions {
-  int width = 0;                 // output width; 0: the window's width in image pixels
+  int width = 0;                 // output width; 0: from the height, else the window's width x scale
   int height = 0;                // output height; 0: keep the window's aspect ratio
+  double scale = 1;              // with width and height 0: output pixels per image pixel
   std::optional<Window> window;  // default: the whole image
+  // Outputs over this many pixels are refused (Error(kLimit)): a file of a few hundred bytes may
+  // declare a 65536 x 4096 image, whose render at 1x would take half a minute and gigabytes.
+  // 2^26 (8192 x 8192) renders in seconds with about 400 MB. At most kMaxRenderPixels.
+  int64_t max_pixels = int64_t{1} << 26;
   int level = 0;                 // level of detail
   Overlay overlay = Overlay::kNone;
   bool antialias = true;         // supersample pixels crossed by tears and the border
@@ -45,6 +57,22 @@ struct RenderOptions {
   double max_edge_pixels = 2.5;  // depth rule: refine until refined edges average at most this
   Backend backend = Backend::kCpu;
 };
+
+// The output size and window of a render: the one place they are computed. Explicit width and/or
+// height (a missing one keeps the window's aspect ratio), else the window's size times `scale`;
+// each side rounded, at least 1.
+struct RenderSize {
+  int width = 0, height = 0;  // output pixels
+  Window window;              // image coordinates (the whole image by default)
+  double scale_x = 1, scale_y = 1;  // output pixels per image pixel
+};
+
+// Resolves and checks the size of a render of an image of image_width x image_height pixels:
+// Error(kInvalidArgument) for a negative size, a scale that is not a positive number (or a scale
+// beside a width or height), an empty or non-finite window or a bad max_pixels; Error(kLimit)
+// ("output size WxH is too large: ...") for an output over Limits::kMaxDimension a side or
+// options.max_pixels in all.
+RenderSize render_size(const RenderOptions& options, int image_width, int image_height);
 
 // Why Backend::kGpu would fall back to the CPU in this process: "" when an OpenGL 4.3 context can
 // be created through EGL, else a one-line reason. The first call tries once; later calls return the
@@ -56,6 +84,36 @@ std::string gpu_unavailable_reason();
 // L / 2^k <= max_edge_pixels, lowered while the refined triangles would exceed 2^24. A window
 // zoomed 2^z times refines z more levels over fewer faces: it costs about what a full view of the
 // same output size costs.
+
+// The control faces and the depth of a view of one level: the renderer's visible-face selection
+// (a face is visible when the bounding box of its one-ring meets the window) and its depth rule,
+// exactly as render() applies them for the same options.
+struct ViewFaces {
+  int level = 0;
+  int depth = 0;
+  RenderSize size;
+  bool all_faces = false;      // every control face of the level is visible
+  std::vector<int32_t> faces;  // the visible control faces, ascending (all of them when all_faces)
+};
+
+// Errors as render() (the level must pass validate_level()).
+ViewFaces view_faces(const VectorImage& image, const RenderOptions& options);
+
+// The refined limit mesh of a view, for a front end that draws it itself (apps/serve's page): the
+// faces of view_faces() refined to its depth (only those faces and the ring they need, like the
+// renderer's partial refinement), with limit positions and colors. The subdivision is kept so that
+// an edit of positions or colors can be re-evaluated without refining again.
+struct ViewMesh {
+  ViewFaces faces;
+  std::optional<Subdivision> subdivision;  // empty when no face is visible
+  RefinedMesh refined;                     // topology and limit values; empty when no face is visible
+  // Whether this refinement holds every face `other` needs at the same level and depth (the rule
+  // by which the renderer reuses the refinement of its last view).
+  bool covers(const ViewFaces& other) const;
+};
+
+// Errors as render(). `options.threads` evaluates; overlay, antialias and backend are not used.
+ViewMesh view_mesh(const VectorImage& image, const RenderOptions& options);
 
 // Draws the image as described by `options`; RGB, or RGBA when the window leaves the image.
 // Throws Error(kInvalidArgument) for a bad level, size, window or depth, Error(kLimit) for an

@@ -187,10 +187,25 @@ TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   const std::string s = editor.new_session();
   const ViewMesh whole = editor.view(s, {0, 3});
   ViewRequest zoomed{0, 3, 0, 0, 20, 20};
-  const ViewMesh part = editor.view(s, zoomed);
+  // The page holds the whole view, which covers the window at that depth: nothing to send again.
+  zoomed.have = whole.id;
+  const ViewMesh same = editor.view(s, zoomed);
+  EXPECT_TRUE(same.unchanged);
+  EXPECT_EQ(same.id, whole.id);
+  EXPECT_TRUE(same.triangles.empty());
+  zoomed.have = 0;  // a page that holds no view gets one
+  EXPECT_FALSE(editor.view(s, zoomed).unchanged);
+  const ViewMesh part = editor.view(editor.new_session(), zoomed);
   EXPECT_FALSE(whole.partial);
+  EXPECT_FALSE(whole.unchanged);
   EXPECT_TRUE(part.partial);
   EXPECT_LT(part.triangles.size(), whole.triangles.size() / 2);
+  // Without a depth, the renderer's rule for the scale: 4x larger is 2 levels deeper.
+  ViewRequest fit{0, -1, 0, 0, 0, 0, 1, 2.5};
+  const ViewMesh at1 = editor.view(editor.new_session(), fit);
+  fit.scale = 4;
+  const ViewMesh at4 = editor.view(editor.new_session(), fit);
+  EXPECT_EQ(at4.depth, at1.depth + 2);
   EXPECT_EQ(status_of([&] { editor.view(s, {0, 9}); }), kBadRequest);
   EXPECT_EQ(status_of([&] { editor.view(s, {5, 2}); }), kBadRequest);
 }
