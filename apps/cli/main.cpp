@@ -34,10 +34,12 @@
 #include "subvec/vectorize/vectorize.h"
 
 #include "batch.h"
+#include "cancel.h"
 #include "edit_commands.h"
 #include "memory.h"
+#include "messages.h"
 #include "progress.h"
-#include "pyramid_commands.h"  // levels: vectorize --levels, filter
+#include "pyramid_commands.h"  // filter
 #include "validators.h"
 #include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
@@ -52,6 +54,7 @@ namespace {
 namespace fs = std::filesystem;
 using subvec::Error;
 using subvec::ErrorCode;
+using subvec_cli::one_line;
 
 // Output images over this many pixels are refused (about 1 GiB of RGBA).
 constexpr int64_t kMaxOutputPixels = int64_t{1} << 28;
@@ -61,14 +64,6 @@ std::string in_quotes(const fs::path& p) { return "'" + p.string() + "'"; }
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
-// Messages are printed on one line whatever they contain.
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  std::replace(s.begin(), s.end(), '\r', ' ');
-  while (!s.empty() && s.back() == ' ') s.pop_back();
   return s;
 }
 
@@ -381,7 +376,11 @@ struct VectorizeArgs {
 };
 
 void run_vectorize(const VectorizeArgs& a) {
+  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);  // validated
   subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
+  // Ctrl+C stops the job at its next check (cancel.h); nothing is written.
+  const subvec_cli::CancelOnInterrupt interrupt;
+  options.cancel = interrupt.flag();
   const auto start = std::chrono::steady_clock::now();
   subvec_cli::ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
   subvec::Image8 image;
@@ -391,26 +390,19 @@ void run_vectorize(const VectorizeArgs& a) {
     if (e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
-  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
   subvec::VectorizeReport report;
-  subvec::VectorImage v = subvec::vectorize(image, options, &report);
-  // ---- levels of abstraction (pyramid_commands.h) ----
-  progress.update("levels", 0.95);
-  const auto levels_start = std::chrono::steady_clock::now();
-  const subvec::LevelReport level_report = subvec_cli::build_levels(a.params.levels, v, image);
-  const double levels_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - levels_start).count();
-  // ---- end levels ----
+  const subvec::VectorImage v = subvec::vectorize(image, options, &report);
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   subvec::RenderOptions render_options;
-  render_options.threads = a.params.threads;
+  render_options.threads = options.threads;
   const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  interrupt.check();
   progress.update("writing", 1.0);
   subvec::write_svec(a.output, v);
   progress.finish();
@@ -454,7 +446,7 @@ void run_vectorize(const VectorizeArgs& a) {
       levels.push_back({{"vertices", v.levels[l].num_vertices()},
                         {"triangles", v.levels[l].num_triangles()},
                         {"features", v.levels[l].features.size()},
-                        {"seconds", l < level_report.seconds.size() ? level_report.seconds[l] : 0.0}});
+                        {"seconds", l < report.levels.seconds.size() ? report.levels.seconds[l] : 0.0}});
     }
     j["levels"] = levels;
     // ---- end levels ----
@@ -464,7 +456,6 @@ void run_vectorize(const VectorizeArgs& a) {
     j["ssim"] = d.ssim;
     nlohmann::ordered_json stages;
     for (const auto& s : report.stages) stages[s.stage] = s.seconds;
-    if (v.levels.size() > 1) stages["levels"] = levels_seconds;
     stages["render_compare"] = compare_seconds;
     j["seconds"] = stages;
     j["total_seconds"] = total;
@@ -502,7 +493,6 @@ void run_vectorize(const VectorizeArgs& a) {
               d.mae_mean, d.psnr, d.ssim);
   std::printf("seconds  ");
   for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
-  if (v.levels.size() > 1) std::printf(" levels %.3f,", levels_seconds);  // levels
   std::printf(" render+compare %.3f, total %.3f\n", compare_seconds, total);
 }
 
@@ -662,26 +652,15 @@ int run(int argc, char** argv) {
   vectorize->add_option("input", va.input, "Raster image")->required();
   vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
       ->required();
-  subvec_cli::add_vertex_count_options(vectorize, va.params);
+  subvec_cli::add_vectorize_options(vectorize, va.params);
   vectorize
       ->add_option("--max-pixels", va.max_pixels,
                    "Refuse larger images (default 8388608, about 12 GB of memory)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
-  vectorize
-      ->add_option("--segment", va.params.segment,
-                   "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
-                   "becomes a closed tear")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            subvec::PixelRect r;
-            return subvec_cli::parse_rect(text, r);
-          },
-          "X,Y,W,H", "rect"));
-  subvec_cli::add_quality_options(vectorize, va.params);
-  vectorize->add_option("--threads", va.params.threads, "Worker threads; 0 (default) uses all cores")
-      ->check(CLI::Range(0, 1024));
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
-  subvec_cli::add_level_options(vectorize, va.params.levels);  // levels
+  // In a callback, like every command that runs a job: a range the library refuses
+  // (vectorize_options()) is then a usage error, reported as CLI11's are.
+  vectorize->callback([&va] { run_vectorize(va); });
   vectorize->footer(
       "Examples:\n"
       "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
@@ -729,8 +708,6 @@ int run(int argc, char** argv) {
     run_convert(convert_input, convert_output, convert_lossless);
   } else if (compare->parsed()) {
     run_compare(compare_ref, compare_test, compare_json);
-  } else if (vectorize->parsed()) {
-    run_vectorize(va);
   }
   return 0;
 }
@@ -743,6 +720,10 @@ int main(int argc, char** argv) {
     return run(argc, argv);
   } catch (const std::bad_alloc&) {
     std::cerr << "subvec: out of memory\n";
+  } catch (const Error& e) {
+    std::cerr << "subvec: " << one_line(e.what()) << "\n";
+    // Ctrl+C (cancel.h): the status a shell gives a command SIGINT ends.
+    if (e.code() == ErrorCode::kCancelled) return 130;
   } catch (const std::exception& e) {  // subvec::Error and everything else
     std::cerr << "subvec: " << one_line(e.what()) << "\n";
   } catch (...) {
