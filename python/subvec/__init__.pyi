@@ -129,9 +129,10 @@ class VectorImage:
     def subdivide(self, *, level: int = 0, depth: int = 3, limit: bool = True,
                   sparse: Literal["scipy", "arrays"] = "scipy") -> Refined: ...
 
-def vectorize(image: npt.ArrayLike, *, ratio: float = 0.01, vertices: int = 0, levels: int = 3,
-              refine: int = 8, relocate: int = 0, l1_iterations: int = 0, threads: int = 0) -> VectorImage:
-    """H x W x 3 uint8, or float32/float64 in [0, 1], to a vector image of the same size."""
+def vectorize(image: npt.ArrayLike, *, ratio: float = ..., vertices: int = ..., levels: int = ...,
+              refine: int = ..., relocate: int = ..., l1_iterations: int = ..., threads: int = ...) -> VectorImage:
+    """H x W x 3 uint8, or float32/float64 in [0, 1], to a vector image of the same size, with its
+    levels of abstraction. Defaults and ranges are the library's (subvec::VectorizeOptions)."""
 def load(path: _Path) -> VectorImage: ...
 def from_bytes(data: bytes) -> VectorImage: ...
 def read_image(path: _Path, *, max_pixels: int = ...) -> npt.NDArray[np.uint8]: ...
