@@ -511,6 +511,102 @@ std::string command_path(const CLI::App& app) {
   return path;
 }
 
+// info, convert and compare: run from their callbacks.
+void add_file_commands(CLI::App& app) {
+  // info
+  static std::string info_input;  // static: the callbacks run after this function returns
+  static bool info_json = false;
+  CLI::App* info =
+      app.add_subcommand("info", "Print the size and per-level statistics of a vector image");
+  info->add_option("input", info_input, "Vector image (.svec or .svec.json)")->required();
+  info->add_flag("--json", info_json, "Print a JSON object instead of text");
+  info->footer(
+      "Examples:\n"
+      "  subvec info in.svec\n"
+      "  subvec info in.svec.json --json    # {\"width\":..., \"height\":..., \"bytes\":..., "
+      "\"levels\":[...]}");
+
+  // convert
+  static std::string convert_input, convert_output;
+  static bool convert_lossless = false;
+  CLI::App* convert =
+      app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
+  convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
+  convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
+      ->required();
+  convert->add_flag("--lossless", convert_lossless,
+                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
+                    "of the compact form");
+  convert->footer(
+      "Examples:\n"
+      "  subvec convert in.svec.json -o in.svec     # compact binary\n"
+      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
+      "  subvec convert in.svec -o in.svec.json     # readable JSON");
+
+  // compare
+  static std::string compare_ref, compare_test;
+  static bool compare_json = false;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "Compare two raster images: mean absolute error per channel, PSNR and SSIM");
+  compare->add_option("reference", compare_ref, "Reference image (PNG, JPEG, WebP, TIFF, BMP)")
+      ->required();
+  compare->add_option("test", compare_test, "Image to compare, of the same size")->required();
+  compare->add_flag("--json", compare_json, "Print a JSON object instead of text");
+  compare->footer(
+      "Examples:\n"
+      "  subvec compare photo.png render.png\n"
+      "  subvec compare photo.png render.png --json   # psnr is null for identical images");
+  info->callback([] { run_info(info_input, info_json); });
+  convert->callback([] { run_convert(convert_input, convert_output, convert_lossless); });
+  compare->callback([] { run_compare(compare_ref, compare_test, compare_json); });
+}
+
+// vectorize (the job's options: vectorize_options.h).
+void add_vectorize_command(CLI::App& app) {
+  // vectorize
+  static VectorizeArgs va;  // static: the callback runs after this function returns
+  CLI::App* vectorize =
+      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
+  vectorize->add_option("input", va.input, "Raster image")->required();
+  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
+      ->required();
+  subvec_cli::add_vectorize_options(vectorize, va.params);
+  vectorize
+      ->add_option("--max-pixels", va.max_pixels,
+                   "Refuse larger images (default 8388608, about 12 GB of memory)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  vectorize->add_flag("--json", va.json, "Print the summary as JSON");
+  // In a callback, like every command that runs a job: a range the library refuses
+  // (vectorize_options()) is then a usage error, reported as CLI11's are.
+  vectorize->callback([] { run_vectorize(va); });
+  vectorize->footer(
+      "Examples:\n"
+      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
+      "vertices\n"
+      "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
+      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
+      "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
+}
+
+// A command-line mistake: one line naming it and the help to read, and CLI11's exit status.
+int usage_error(CLI::App& app, const CLI::ParseError& e) {
+  std::string message = e.what();
+  int status = e.get_exit_code();
+  if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
+    // No command: either none was given or the first word is not one.
+    const std::vector<std::string> extra = app.remaining();
+    if (extra.empty()) {
+      message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
+    } else {
+      message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
+                extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
+      status = int(CLI::ExitCodes::ExtrasError);
+    }
+  }
+  std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
+  return status;
+}
+
 int run(int argc, char** argv) {
   CLI::App app(
       "subvec: vector images built on piecewise smooth Loop subdivision surfaces.\n"
@@ -601,74 +697,8 @@ int run(int argc, char** argv) {
       "  subvec render in.svec -o out.pdf                       # vector: PDF, 1 pt per pixel\n"
       "  subvec render in.svec -o out.svg --scale 2");
 
-  // info
-  std::string info_input;
-  bool info_json = false;
-  CLI::App* info =
-      app.add_subcommand("info", "Print the size and per-level statistics of a vector image");
-  info->add_option("input", info_input, "Vector image (.svec or .svec.json)")->required();
-  info->add_flag("--json", info_json, "Print a JSON object instead of text");
-  info->footer(
-      "Examples:\n"
-      "  subvec info in.svec\n"
-      "  subvec info in.svec.json --json    # {\"width\":..., \"height\":..., \"bytes\":..., "
-      "\"levels\":[...]}");
-
-  // convert
-  std::string convert_input, convert_output;
-  bool convert_lossless = false;
-  CLI::App* convert =
-      app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
-  convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
-  convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
-      ->required();
-  convert->add_flag("--lossless", convert_lossless,
-                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
-                    "of the compact form");
-  convert->footer(
-      "Examples:\n"
-      "  subvec convert in.svec.json -o in.svec     # compact binary\n"
-      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
-      "  subvec convert in.svec -o in.svec.json     # readable JSON");
-
-  // compare
-  std::string compare_ref, compare_test;
-  bool compare_json = false;
-  CLI::App* compare = app.add_subcommand(
-      "compare", "Compare two raster images: mean absolute error per channel, PSNR and SSIM");
-  compare->add_option("reference", compare_ref, "Reference image (PNG, JPEG, WebP, TIFF, BMP)")
-      ->required();
-  compare->add_option("test", compare_test, "Image to compare, of the same size")->required();
-  compare->add_flag("--json", compare_json, "Print a JSON object instead of text");
-  compare->footer(
-      "Examples:\n"
-      "  subvec compare photo.png render.png\n"
-      "  subvec compare photo.png render.png --json   # psnr is null for identical images");
-
-  // vectorize
-  VectorizeArgs va;
-  CLI::App* vectorize =
-      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
-  vectorize->add_option("input", va.input, "Raster image")->required();
-  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
-      ->required();
-  subvec_cli::add_vectorize_options(vectorize, va.params);
-  vectorize
-      ->add_option("--max-pixels", va.max_pixels,
-                   "Refuse larger images (default 8388608, about 12 GB of memory)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
-  vectorize->add_flag("--json", va.json, "Print the summary as JSON");
-  // In a callback, like every command that runs a job: a range the library refuses
-  // (vectorize_options()) is then a usage error, reported as CLI11's are.
-  vectorize->callback([&va] { run_vectorize(va); });
-  vectorize->footer(
-      "Examples:\n"
-      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
-      "vertices\n"
-      "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
-      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
-      "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
-
+  add_file_commands(app);       // info, convert, compare
+  add_vectorize_command(app);   // vectorize
   subvec_cli::add_edit_commands(app);  // edit, stylize
   subvec_cli::add_pyramid_commands(app);  // filter
   subvec_serve::add_serve_command(app);  // serve (issue 7, apps/serve/)
@@ -683,31 +713,11 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::string message = e.what();
-    int status = e.get_exit_code();
-    if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
-      // No command: either none was given or the first word is not one.
-      const std::vector<std::string> extra = app.remaining();
-      if (extra.empty()) {
-        message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
-      } else {
-        message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
-        status = int(CLI::ExitCodes::ExtrasError);
-      }
-    }
-    std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
-    return status;
+    return usage_error(app, e);
   }
 
   if (render->parsed()) {
     run_render(ra, width_opt->count() > 0, scale_opt->count() > 0);
-  } else if (info->parsed()) {
-    run_info(info_input, info_json);
-  } else if (convert->parsed()) {
-    run_convert(convert_input, convert_output, convert_lossless);
-  } else if (compare->parsed()) {
-    run_compare(compare_ref, compare_test, compare_json);
   }
   return 0;
 }

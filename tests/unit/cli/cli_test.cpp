@@ -415,33 +415,6 @@ TEST_F(Cli, HelpAndVersion) {
 
 // ---- vectorize -------------------------------------------------------------------------------
 
-// `subvec vectorize`, `subvec batch` and `subvec serve` take the vectorize options from one
-// registration (vectorize_options.h), with the library's defaults in the help and the library's
-// ranges (subvec::validate) reported as usage errors naming the flag.
-TEST_F(Cli, VectorizeOptionsAreSharedWithServeAndBatch) {
-  for (const char* command : {"vectorize", "serve"}) {
-    const CliResult help = subvec(std::string(command) + " --help");
-    ASSERT_EQ(help.status, 0) << command;
-    for (const char* word : {"--ratio", "--vertices", "--segment", "--refine", "--relocate", "--levels",
-                             "--level-reduction", "--feature-level", "--edge-blur", "--threads",
-                             "(default 0.01)"}) {
-      EXPECT_NE(help.out.find(word), std::string::npos) << command << ": " << word;
-    }
-  }
-  const fs::path photo = dir_ / "photo.png";
-  write_test_photo(photo);
-  for (const char* command : {"vectorize", "serve", "batch"}) {
-    const std::string input = std::string(command) == "batch" ? dir_.string() : photo.string();
-    const std::string out = std::string(command) == "serve" ? "" : " -o " + q(dir_ / "out");
-    CliResult r = subvec(std::string(command) + " " + q(input) + out + " --ratio 2");
-    EXPECT_EQ(r.status, 105) << command;
-    expect_failure(r, "--ratio must be in (0, 1], got 2");
-    r = subvec(std::string(command) + " " + q(input) + out + " --levels 17");
-    EXPECT_EQ(r.status, 105) << command;
-    expect_failure(r, "--levels must be in [1, 16], got 17");
-  }
-}
-
 // A 64 x 48 picture: a disk over a gradient, written as PNG through the library.
 void write_test_photo(const fs::path& path) {
   subvec::Image8 img(64, 48, 3);
@@ -691,6 +664,33 @@ TEST_F(Cli, VectorizeStopsOnCtrlC) {
   EXPECT_NE(terminal.find("subvec: cancelled"), std::string::npos) << terminal;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(read_text(summary), "");
+}
+
+// `subvec vectorize`, `subvec batch` and `subvec serve` take the vectorize options from one
+// registration (vectorize_options.h), with the library's defaults in the help and the library's
+// ranges (subvec::validate) reported as usage errors naming the flag.
+TEST_F(Cli, VectorizeOptionsAreSharedWithServeAndBatch) {
+  for (const char* command : {"vectorize", "serve"}) {
+    const CliResult help = subvec(std::string(command) + " --help");
+    ASSERT_EQ(help.status, 0) << command;
+    for (const char* word : {"--ratio", "--vertices", "--segment", "--refine", "--relocate", "--levels",
+                             "--level-reduction", "--feature-level", "--edge-blur", "--threads",
+                             "(default 0.01)"}) {
+      EXPECT_NE(help.out.find(word), std::string::npos) << command << ": " << word;
+    }
+  }
+  const fs::path photo = dir_ / "photo.png";
+  write_test_photo(photo);
+  for (const char* command : {"vectorize", "serve", "batch"}) {
+    const std::string input = std::string(command) == "batch" ? dir_.string() : photo.string();
+    const std::string out = std::string(command) == "serve" ? "" : " -o " + q(dir_ / "out");
+    CliResult r = subvec(std::string(command) + " " + q(input) + out + " --ratio 2");
+    EXPECT_EQ(r.status, 105) << command;
+    expect_failure(r, "--ratio must be in (0, 1], got 2");
+    r = subvec(std::string(command) + " " + q(input) + out + " --levels 17");
+    EXPECT_EQ(r.status, 105) << command;
+    expect_failure(r, "--levels must be in [1, 16], got 17");
+  }
 }
 
 }  // namespace
