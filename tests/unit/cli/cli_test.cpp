@@ -662,6 +662,8 @@ TEST_F(Cli, VectorizeStopsOnCtrlC) {
       run_on_terminal({"vectorize", photo.string(), "-o", out.string()}, summary, "0", ": simplify");
   EXPECT_EQ(status, 130) << terminal;
   EXPECT_NE(terminal.find("subvec: cancelled"), std::string::npos) << terminal;
+  // The job itself stopped (VectorizeOptions::cancel): it never reached the levels, two stages on.
+  EXPECT_EQ(terminal.find(": levels"), std::string::npos) << terminal;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(read_text(summary), "");
 }
