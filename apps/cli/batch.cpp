@@ -35,10 +35,12 @@
 #include "subvec/io/file.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
-#include "subvec/vectorize/levels.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
+#include "cancel.h"
+#include "messages.h"
 #include "progress.h"
+#include "validators.h"
 #include "vectorize_options.h"
 
 namespace subvec_cli {
@@ -50,12 +52,14 @@ using subvec::ErrorCode;
 using Clock = std::chrono::steady_clock;
 
 struct BatchArgs {
-  BatchArgs() { vectorize.threads = 1; }
+  BatchArgs() { vectorize.options.threads = 1; }
   std::string input, output;
   int jobs = 0;  // 0: one per core
   // As `subvec vectorize` takes them (vectorize_options.h); batch sets the vertex count, the
   // levels and the threads per image (1 by default), and leaves the rest at their defaults.
   VectorizeParams vectorize;
+  subvec::VectorizeOptions options;  // vectorize_options(vectorize), validated before any work
+  const std::atomic<bool>* cancel = nullptr;  // Ctrl+C
   int64_t max_pixels = int64_t{1} << 23;
   bool render_png = false;
 };
@@ -75,12 +79,6 @@ struct Item {
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  std::replace(s.begin(), s.end(), '\r', ' ');
   return s;
 }
 
@@ -156,15 +154,16 @@ void process(Item& item, const BatchArgs& a) {
   if (saved && (saved->width != photo.width || saved->height != photo.height)) saved.reset();
   std::vector<uint8_t> bytes;
   if (!saved) {
-    subvec::VectorImage vectorized = subvec::vectorize(photo, vectorize_options(a.vectorize));
-    // Levels of abstraction as `subvec vectorize --levels` makes them (vectorize/levels.h).
-    build_levels(a.vectorize.levels, vectorized, photo);
+    // The document `subvec vectorize` makes with the same options, levels included.
+    subvec::VectorizeOptions options = a.options;
+    options.cancel = a.cancel;
+    const subvec::VectorImage vectorized = subvec::vectorize(photo, options);
     bytes = subvec::to_svec_binary(vectorized);
     // What the file holds (positions and colors on the .svec grids), measured and drawn below.
     saved = std::make_unique<subvec::VectorImage>(subvec::parse_svec_binary(bytes));
   }
   subvec::RenderOptions render_options;
-  render_options.threads = a.vectorize.threads;
+  render_options.threads = a.options.threads;
   const subvec::Image8 rendered = subvec::render(*saved, render_options);
   const subvec::ImageDifference d = subvec::compare(photo, rendered);
   if (!bytes.empty()) {
@@ -221,7 +220,8 @@ std::string summary_csv(const std::vector<Item>& items) {
   return out;
 }
 
-void run_batch(const BatchArgs& a) {
+void run_batch(BatchArgs& a) {
+  a.options = vectorize_options(a.vectorize);  // the library's ranges, as usage errors
   std::vector<Item> items = list_items(a);
   std::error_code ec;
   fs::create_directories(a.output, ec);
@@ -236,13 +236,19 @@ void run_batch(const BatchArgs& a) {
 
   // On a terminal: images done of all, a bar, elapsed seconds and the estimated time left.
   ProgressLine progress("batch", count, "images", {"skipped", "failed"});
+  // Ctrl+C: the images being vectorized stop, no new one starts, and what is done stays done.
+  const CancelOnInterrupt interrupt;
+  a.cancel = interrupt.flag();
   std::atomic<int> next{0};
   const auto worker = [&] {
-    for (int i = next++; i < count; i = next++) {
+    for (int i = next++; i < count && !interrupt.cancelled(); i = next++) {
       Item& item = items[size_t(i)];
       const auto item_start = Clock::now();
       try {
         process(item, a);
+      } catch (const Error& e) {
+        if (e.code() == ErrorCode::kCancelled) break;
+        item.error = one_line(e.what());
       } catch (const std::bad_alloc&) {
         item.error = "out of memory";
       } catch (const std::exception& e) {
@@ -262,6 +268,12 @@ void run_batch(const BatchArgs& a) {
   worker();
   for (std::thread& t : pool) t.join();
   progress.finish();
+  if (interrupt.cancelled()) {
+    int done = 0;
+    for (const Item& item : items) done += item.status == Status::kOk || item.status == Status::kSkipped;
+    throw Error(ErrorCode::kCancelled, "cancelled: " + std::to_string(done) + " of " + std::to_string(count) +
+                                           " images done (run again to resume)");
+  }
 
   const std::string csv = summary_csv(items);
   const fs::path csv_path = fs::path(a.output) / "summary.csv";
@@ -305,12 +317,11 @@ void add_batch_command(CLI::App& app) {
       ->required();
   batch->add_option("--jobs", ba.jobs, "Images vectorized at once; 0 (default) one per core")
       ->check(CLI::Range(0, 1024));
-  batch->add_option("--threads", ba.vectorize.threads, "Threads per image (default 1; 0: all cores)")
-      ->check(CLI::Range(0, 1024));
+  batch->add_option("--threads", ba.vectorize.options.threads, "Threads per image (default 1; 0: all cores)")
+      ->check(integer());
   add_vertex_count_options(batch, ba.vectorize);
   add_quality_options(batch, ba.vectorize);
-  batch->add_option("--levels", ba.vectorize.levels.levels, "Levels of abstraction, 1 to 16 (default 3), as vectorize")
-      ->check(CLI::Range(1, 16));
+  add_level_options(batch, ba.vectorize, /*levels_only=*/true);
   batch
       ->add_option("--max-pixels", ba.max_pixels,
                    "Refuse (fail) larger images (default 8388608, about 12 GB of memory each)")

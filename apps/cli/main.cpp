@@ -34,10 +34,12 @@
 #include "subvec/vectorize/vectorize.h"
 
 #include "batch.h"
+#include "cancel.h"
 #include "edit_commands.h"
 #include "memory.h"
+#include "messages.h"
 #include "progress.h"
-#include "pyramid_commands.h"  // levels: vectorize --levels, filter
+#include "pyramid_commands.h"  // filter
 #include "validators.h"
 #include "vectorize_options.h"
 // serve (issue 7): the browser editor, apps/serve/
@@ -52,20 +54,13 @@ namespace {
 namespace fs = std::filesystem;
 using subvec::Error;
 using subvec::ErrorCode;
+using subvec_cli::one_line;
 
 std::string in_quotes(const fs::path& p) { return "'" + p.string() + "'"; }
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
-// Messages are printed on one line whatever they contain.
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  std::replace(s.begin(), s.end(), '\r', ' ');
-  while (!s.empty() && s.back() == ' ') s.pop_back();
   return s;
 }
 
@@ -352,7 +347,11 @@ struct VectorizeArgs {
 };
 
 void run_vectorize(const VectorizeArgs& a) {
+  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);  // validated
   subvec::svec_format_for(a.output);  // rejects an unknown extension before any work
+  // Ctrl+C stops the job at its next check (cancel.h); nothing is written.
+  const subvec_cli::CancelOnInterrupt interrupt;
+  options.cancel = interrupt.flag();
   const auto start = std::chrono::steady_clock::now();
   subvec_cli::ProgressLine progress("vectorizing " + fs::path(a.input).filename().string());
   subvec::Image8 image;
@@ -362,26 +361,19 @@ void run_vectorize(const VectorizeArgs& a) {
     if (e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
   }
-  subvec::VectorizeOptions options = subvec_cli::vectorize_options(a.params);
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
   subvec::VectorizeReport report;
-  subvec::VectorImage v = subvec::vectorize(image, options, &report);
-  // ---- levels of abstraction (pyramid_commands.h) ----
-  progress.update("levels", 0.95);
-  const auto levels_start = std::chrono::steady_clock::now();
-  const subvec::LevelReport level_report = subvec_cli::build_levels(a.params.levels, v, image);
-  const double levels_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - levels_start).count();
-  // ---- end levels ----
+  const subvec::VectorImage v = subvec::vectorize(image, options, &report);
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   subvec::RenderOptions render_options;
-  render_options.threads = a.params.threads;
+  render_options.threads = options.threads;
   const subvec::ImageDifference d = subvec::compare(image, subvec::render(v, render_options));
   const double compare_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  interrupt.check();
   progress.update("writing", 1.0);
   subvec::write_svec(a.output, v);
   progress.finish();
@@ -425,7 +417,7 @@ void run_vectorize(const VectorizeArgs& a) {
       levels.push_back({{"vertices", v.levels[l].num_vertices()},
                         {"triangles", v.levels[l].num_triangles()},
                         {"features", v.levels[l].features.size()},
-                        {"seconds", l < level_report.seconds.size() ? level_report.seconds[l] : 0.0}});
+                        {"seconds", l < report.levels.seconds.size() ? report.levels.seconds[l] : 0.0}});
     }
     j["levels"] = levels;
     // ---- end levels ----
@@ -435,7 +427,6 @@ void run_vectorize(const VectorizeArgs& a) {
     j["ssim"] = d.ssim;
     nlohmann::ordered_json stages;
     for (const auto& s : report.stages) stages[s.stage] = s.seconds;
-    if (v.levels.size() > 1) stages["levels"] = levels_seconds;
     stages["render_compare"] = compare_seconds;
     j["seconds"] = stages;
     j["total_seconds"] = total;
@@ -473,7 +464,6 @@ void run_vectorize(const VectorizeArgs& a) {
               d.mae_mean, d.psnr, d.ssim);
   std::printf("seconds  ");
   for (const auto& s : report.stages) std::printf(" %s %.3f,", s.stage.c_str(), s.seconds);
-  if (v.levels.size() > 1) std::printf(" levels %.3f,", levels_seconds);  // levels
   std::printf(" render+compare %.3f, total %.3f\n", compare_seconds, total);
 }
 
@@ -490,6 +480,102 @@ std::string command_path(const CLI::App& app) {
     path += " " + at->get_name();
   }
   return path;
+}
+
+// info, convert and compare: run from their callbacks.
+void add_file_commands(CLI::App& app) {
+  // info
+  static std::string info_input;  // static: the callbacks run after this function returns
+  static bool info_json = false;
+  CLI::App* info =
+      app.add_subcommand("info", "Print the size and per-level statistics of a vector image");
+  info->add_option("input", info_input, "Vector image (.svec or .svec.json)")->required();
+  info->add_flag("--json", info_json, "Print a JSON object instead of text");
+  info->footer(
+      "Examples:\n"
+      "  subvec info in.svec\n"
+      "  subvec info in.svec.json --json    # {\"width\":..., \"height\":..., \"bytes\":..., "
+      "\"levels\":[...]}");
+
+  // convert
+  static std::string convert_input, convert_output;
+  static bool convert_lossless = false;
+  CLI::App* convert =
+      app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
+  convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
+  convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
+      ->required();
+  convert->add_flag("--lossless", convert_lossless,
+                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
+                    "of the compact form");
+  convert->footer(
+      "Examples:\n"
+      "  subvec convert in.svec.json -o in.svec     # compact binary\n"
+      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
+      "  subvec convert in.svec -o in.svec.json     # readable JSON");
+
+  // compare
+  static std::string compare_ref, compare_test;
+  static bool compare_json = false;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "Compare two raster images: mean absolute error per channel, PSNR and SSIM");
+  compare->add_option("reference", compare_ref, "Reference image (PNG, JPEG, WebP, TIFF, BMP)")
+      ->required();
+  compare->add_option("test", compare_test, "Image to compare, of the same size")->required();
+  compare->add_flag("--json", compare_json, "Print a JSON object instead of text");
+  compare->footer(
+      "Examples:\n"
+      "  subvec compare photo.png render.png\n"
+      "  subvec compare photo.png render.png --json   # psnr is null for identical images");
+  info->callback([] { run_info(info_input, info_json); });
+  convert->callback([] { run_convert(convert_input, convert_output, convert_lossless); });
+  compare->callback([] { run_compare(compare_ref, compare_test, compare_json); });
+}
+
+// vectorize (the job's options: vectorize_options.h).
+void add_vectorize_command(CLI::App& app) {
+  // vectorize
+  static VectorizeArgs va;  // static: the callback runs after this function returns
+  CLI::App* vectorize =
+      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
+  vectorize->add_option("input", va.input, "Raster image")->required();
+  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
+      ->required();
+  subvec_cli::add_vectorize_options(vectorize, va.params);
+  vectorize
+      ->add_option("--max-pixels", va.max_pixels,
+                   "Refuse larger images (default 8388608, about 12 GB of memory)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  vectorize->add_flag("--json", va.json, "Print the summary as JSON");
+  // In a callback, like every command that runs a job: a range the library refuses
+  // (vectorize_options()) is then a usage error, reported as CLI11's are.
+  vectorize->callback([] { run_vectorize(va); });
+  vectorize->footer(
+      "Examples:\n"
+      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
+      "vertices\n"
+      "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
+      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
+      "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
+}
+
+// A command-line mistake: one line naming it and the help to read, and CLI11's exit status.
+int usage_error(CLI::App& app, const CLI::ParseError& e) {
+  std::string message = e.what();
+  int status = e.get_exit_code();
+  if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
+    // No command: either none was given or the first word is not one.
+    const std::vector<std::string> extra = app.remaining();
+    if (extra.empty()) {
+      message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
+    } else {
+      message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
+                extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
+      status = int(CLI::ExitCodes::ExtrasError);
+    }
+  }
+  std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
+  return status;
 }
 
 int run(int argc, char** argv) {
@@ -582,85 +668,8 @@ int run(int argc, char** argv) {
       "  subvec render in.svec -o out.pdf                       # vector: PDF, 1 pt per pixel\n"
       "  subvec render in.svec -o out.svg --scale 2");
 
-  // info
-  std::string info_input;
-  bool info_json = false;
-  CLI::App* info =
-      app.add_subcommand("info", "Print the size and per-level statistics of a vector image");
-  info->add_option("input", info_input, "Vector image (.svec or .svec.json)")->required();
-  info->add_flag("--json", info_json, "Print a JSON object instead of text");
-  info->footer(
-      "Examples:\n"
-      "  subvec info in.svec\n"
-      "  subvec info in.svec.json --json    # {\"width\":..., \"height\":..., \"bytes\":..., "
-      "\"levels\":[...]}");
-
-  // convert
-  std::string convert_input, convert_output;
-  bool convert_lossless = false;
-  CLI::App* convert =
-      app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
-  convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
-  convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
-      ->required();
-  convert->add_flag("--lossless", convert_lossless,
-                    ".svec: keep every value and the order of vertices exactly (version 1) instead "
-                    "of the compact form");
-  convert->footer(
-      "Examples:\n"
-      "  subvec convert in.svec.json -o in.svec     # compact binary\n"
-      "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
-      "  subvec convert in.svec -o in.svec.json     # readable JSON");
-
-  // compare
-  std::string compare_ref, compare_test;
-  bool compare_json = false;
-  CLI::App* compare = app.add_subcommand(
-      "compare", "Compare two raster images: mean absolute error per channel, PSNR and SSIM");
-  compare->add_option("reference", compare_ref, "Reference image (PNG, JPEG, WebP, TIFF, BMP)")
-      ->required();
-  compare->add_option("test", compare_test, "Image to compare, of the same size")->required();
-  compare->add_flag("--json", compare_json, "Print a JSON object instead of text");
-  compare->footer(
-      "Examples:\n"
-      "  subvec compare photo.png render.png\n"
-      "  subvec compare photo.png render.png --json   # psnr is null for identical images");
-
-  // vectorize
-  VectorizeArgs va;
-  CLI::App* vectorize =
-      app.add_subcommand("vectorize", "Vectorize a photograph (PNG, JPEG, WebP, TIFF, BMP)");
-  vectorize->add_option("input", va.input, "Raster image")->required();
-  vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
-      ->required();
-  subvec_cli::add_vertex_count_options(vectorize, va.params);
-  vectorize
-      ->add_option("--max-pixels", va.max_pixels,
-                   "Refuse larger images (default 8388608, about 12 GB of memory)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
-  vectorize
-      ->add_option("--segment", va.params.segment,
-                   "GrabCut from this rectangle (image pixels X,Y,W,H); the foreground's boundary "
-                   "becomes a closed tear")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            subvec::PixelRect r;
-            return subvec_cli::parse_rect(text, r);
-          },
-          "X,Y,W,H", "rect"));
-  subvec_cli::add_quality_options(vectorize, va.params);
-  vectorize->add_option("--threads", va.params.threads, "Worker threads; 0 (default) uses all cores")
-      ->check(CLI::Range(0, 1024));
-  vectorize->add_flag("--json", va.json, "Print the summary as JSON");
-  subvec_cli::add_level_options(vectorize, va.params.levels);  // levels
-  vectorize->footer(
-      "Examples:\n"
-      "  subvec vectorize photo.png -o photo.svec                 # 1% of the pixel count as "
-      "vertices\n"
-      "  subvec vectorize photo.jpg -o photo.svec --ratio 0.03    # finer\n"
-      "  subvec vectorize photo.png -o photo.svec.json --vertices 2000 --json\n"
-      "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
-
+  add_file_commands(app);       // info, convert, compare
+  add_vectorize_command(app);   // vectorize
   subvec_cli::add_edit_commands(app);  // edit, stylize
   subvec_cli::add_pyramid_commands(app);  // filter
   subvec_serve::add_serve_command(app);  // serve (issue 7, apps/serve/)
@@ -675,33 +684,11 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::string message = e.what();
-    int status = e.get_exit_code();
-    if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
-      // No command: either none was given or the first word is not one.
-      const std::vector<std::string> extra = app.remaining();
-      if (extra.empty()) {
-        message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
-      } else {
-        message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                  extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
-        status = int(CLI::ExitCodes::ExtrasError);
-      }
-    }
-    std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
-    return status;
+    return usage_error(app, e);
   }
 
   if (render->parsed()) {
     run_render(ra, width_opt->count() > 0, scale_opt->count() > 0);
-  } else if (info->parsed()) {
-    run_info(info_input, info_json);
-  } else if (convert->parsed()) {
-    run_convert(convert_input, convert_output, convert_lossless);
-  } else if (compare->parsed()) {
-    run_compare(compare_ref, compare_test, compare_json);
-  } else if (vectorize->parsed()) {
-    run_vectorize(va);
   }
   return 0;
 }
@@ -714,6 +701,10 @@ int main(int argc, char** argv) {
     return run(argc, argv);
   } catch (const std::bad_alloc&) {
     std::cerr << "subvec: out of memory\n";
+  } catch (const Error& e) {
+    std::cerr << "subvec: " << one_line(e.what()) << "\n";
+    // Ctrl+C (cancel.h): the status a shell gives a command SIGINT ends.
+    if (e.code() == ErrorCode::kCancelled) return 130;
   } catch (const std::exception& e) {  // subvec::Error and everything else
     std::cerr << "subvec: " << one_line(e.what()) << "\n";
   } catch (...) {

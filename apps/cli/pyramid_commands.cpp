@@ -1,4 +1,5 @@
-// `subvec vectorize --levels ...` and `subvec filter` (docs/cli.md, docs/levels.md).
+// `subvec filter` (docs/cli.md, docs/levels.md); the level options of `subvec vectorize` are in
+// vectorize_options.cpp.
 #include "pyramid_commands.h"
 
 #include <cmath>
@@ -15,24 +16,6 @@ namespace {
 
 using subvec::Error;
 using subvec::ErrorCode;
-
-// "ID=L" with integers; returns an error message or "" and fills id and level.
-std::string parse_feature_level(const std::string& text, int& id, int& level) {
-  const auto eq = text.find('=');
-  const std::string expected = "expected ID=LEVEL (two integers), got '" + text + "'";
-  if (eq == std::string::npos) return expected;
-  auto integer = [](const std::string& s, int& out) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    const long v = std::strtol(s.c_str(), &end, 10);
-    if (*end != '\0' || v < -(1L << 30) || v > (1L << 30)) return false;
-    out = static_cast<int>(v);
-    return true;
-  };
-  if (!integer(text.substr(0, eq), id) || !integer(text.substr(eq + 1), level)) return expected;
-  if (level < 0) return "the level must be at least 0, got '" + text + "'";
-  return "";
-}
 
 // "a,b,c" finite numbers; returns an error message or "" and fills `out`.
 std::string parse_numbers(const std::string& text, std::vector<double>& out) {
@@ -90,46 +73,6 @@ void run_filter(const FilterArgs& a, bool eta_given) {
 }
 
 }  // namespace
-
-void add_level_options(CLI::App* vectorize, LevelArgs& args) {
-  vectorize->add_option("--levels", args.levels,
-                        "Levels of abstraction, level 0 the finest with every feature (default 3; 1: "
-                        "a single level)")
-      ->check(CLI::Range(1, 16));
-  vectorize
-      ->add_option("--saliency-weight", args.saliency_weight,
-                   "w in the saliency S = length + w * contrast that orders features (default 2)")
-      ->check(CLI::Range(0.0, 1e6));
-  vectorize
-      ->add_option("--level-reduction", args.reduction,
-                   "Share of the vertices each coarser level removes (default 0.5)")
-      ->check(CLI::Range(0.01, 0.95));
-  vectorize
-      ->add_option("--feature-level", args.feature_levels,
-                   "ID=L: feature ID stays up to level L (repeatable; ids as `subvec info --json` lists)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            int id = 0, level = 0;
-            return parse_feature_level(text, id, level);
-          },
-          "ID=L", "feature-level"));
-}
-
-subvec::LevelReport build_levels(const LevelArgs& args, subvec::VectorImage& image, const subvec::Image8& photo) {
-  // With one level this only stores each feature's saliency.
-  subvec::LevelReport report;
-  subvec::LevelOptions options;
-  options.levels = args.levels;
-  options.saliency_weight = args.saliency_weight;
-  options.reduction = args.reduction;
-  for (const std::string& text : args.feature_levels) {
-    int id = 0, level = 0;
-    parse_feature_level(text, id, level);
-    options.feature_levels.push_back({id, level});
-  }
-  subvec::build_levels(image, photo, options, &report);
-  return report;
-}
 
 void add_pyramid_commands(CLI::App& app) {
   static FilterArgs fa;

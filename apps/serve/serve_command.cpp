@@ -9,12 +9,15 @@
 #include <thread>
 
 #include "server.h"
+#include "vectorize_options.h"
 
 namespace subvec_serve {
 
 namespace {
 
-void run_serve(const ServeOptions& options) {
+void run_serve(ServeOptions& options, const subvec_cli::VectorizeParams& params) {
+  // The library's ranges, as usage errors (as `subvec vectorize` reports them).
+  options.vectorize = subvec_cli::vectorize_options(params);
   // Block the stop signals in every thread (the server's pool inherits the mask) and wait for
   // them in one thread, which stops the server: no work in a signal handler.
   sigset_t signals;
@@ -45,7 +48,8 @@ void run_serve(const ServeOptions& options) {
 }  // namespace
 
 void add_serve_command(CLI::App& app) {
-  static ServeOptions options;  // lives until the callback has run
+  static ServeOptions options;  // live until the callback has run
+  static subvec_cli::VectorizeParams params;
   CLI::App* serve = app.add_subcommand(
       "serve", "Edit a vector image (or a photograph, vectorized first) in the browser");
   serve->add_option("input", options.input, "Vector image (.svec, .svec.json) or raster image")
@@ -63,14 +67,8 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::Range(0, 65535));
   serve->add_option("--host", options.host,
                     "Address to listen on (default 127.0.0.1: this machine only)");
-  CLI::Option* ratio =
-      serve->add_option("--ratio", options.ratio,
-                        "Raster input: control vertices as a fraction of the pixel count (0.01)")
-          ->check(CLI::Range(1e-9, 1.0));
-  CLI::Option* vertices =
-      serve->add_option("--vertices", options.vertices, "Raster input: control vertex count")
-          ->check(CLI::Range(4, 1 << 26));
-  ratio->excludes(vertices);
+  // A raster input is vectorized as `subvec vectorize` does it, with the same options.
+  subvec_cli::add_vectorize_options(serve, params);
   serve->add_option("--max-pixels", options.max_pixels, "Raster input: refuse larger images")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
   serve->footer(
@@ -78,7 +76,7 @@ void add_serve_command(CLI::App& app) {
       "  subvec serve examples/01-disk.svec.json              # then open the printed URL\n"
       "  subvec serve photo.png --vertices 3000               # vectorized first, progress in the page\n"
       "  subvec serve in.svec -o edited.svec --port 0         # Save writes edited.svec; any free port");
-  serve->callback([] { run_serve(options); });
+  serve->callback([] { run_serve(options, params); });
 }
 
 }  // namespace subvec_serve

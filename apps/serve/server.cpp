@@ -238,7 +238,13 @@ struct EditorServer::Impl {
     return dot == std::string::npos || dot == 0 ? s : s.substr(0, dot);
   }
 
-  void routes();
+  void routes();  // the ones below
+  void guards();
+  void page_routes();
+  void document_routes();
+  void drag_routes();
+  void edit_routes();
+  void file_routes();
 };
 
 EditorServer::EditorServer(ServeOptions options) : impl_(std::make_unique<Impl>()) {
@@ -276,13 +282,14 @@ void EditorServer::start() {
     subvec::svec_format_for(*s.options.output);  // throws for an unknown extension
   }
   if (looks_like_raster(in)) {
-    // Decode now, so a bad file fails before the server starts; vectorize in the background.
+    // Check the options and decode now, so that bad ones or a bad file fail before the server
+    // starts; vectorize in the background, until done or until the server stops.
+    subvec::validate(s.options.vectorize);
     auto image = std::make_shared<subvec::Image8>(subvec::read_image(in, s.options.max_pixels));
     s.stage = "vectorizing";
     s.worker = std::thread([&s, image] {
-      subvec::VectorizeOptions vo;
-      vo.ratio = s.options.ratio;
-      vo.vertices = s.options.vertices;
+      subvec::VectorizeOptions vo = s.options.vectorize;
+      vo.cancel = &s.stopping;
       vo.progress = [&s](const std::string& stage, double fraction) {
         std::lock_guard lock(s.state_mutex);
         s.stage = stage;
@@ -329,6 +336,16 @@ void EditorServer::start() {
 }
 
 void EditorServer::Impl::routes() {
+  guards();
+  page_routes();
+  document_routes();
+  drag_routes();
+  edit_routes();
+  file_routes();
+}
+
+// Host and Content-Type checks before routing; errors and exceptions as JSON.
+void EditorServer::Impl::guards() {
   const bool loopback = is_loopback_host(options.host);
 
   server.set_pre_routing_handler([loopback](const httplib::Request& req, httplib::Response& res) {
@@ -380,7 +397,10 @@ void EditorServer::Impl::routes() {
           send_error(res, 500, "unknown error");
         }
       });
+}
 
+// The editor page (web/dist, embedded).
+void EditorServer::Impl::page_routes() {
   // ---- the page ----
   auto serve_asset = [](const std::string& path, httplib::Response& res) {
     const EmbeddedAsset* asset = find_asset(path);
@@ -394,7 +414,10 @@ void EditorServer::Impl::routes() {
   server.Get("/assets/(.+)", [serve_asset](const httplib::Request& req, httplib::Response& res) {
     serve_asset("assets/" + req.matches[1].str(), res);
   });
+}
 
+// The document: loading state, levels, sessions and the meshes the page draws.
+void EditorServer::Impl::document_routes() {
   // ---- state ----
   server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
     std::lock_guard lock(state_mutex);
@@ -499,7 +522,10 @@ void EditorServer::Impl::routes() {
                                        {"version", doc->version()}});
     res.set_content(body, "application/octet-stream");
   });
+}
 
+// Picking and dragging (drag and move-feature tools).
+void EditorServer::Impl::drag_routes() {
   server.Post("/api/select", [this](const httplib::Request& req, httplib::Response& res) {
     const json j = body_json(req);
     SelectRequest s;
@@ -557,7 +583,10 @@ void EditorServer::Impl::routes() {
     ready_editor()->drag_cancel(text(j, "session"));
     send_json(res, {{"ok", true}});
   });
+}
 
+// Edits that apply at once: color, stylize, undo / redo, the pyramid filter.
+void EditorServer::Impl::edit_routes() {
   server.Post("/api/color", [this](const httplib::Request& req, httplib::Response& res) {
     const json j = body_json(req);
     subvec::EditOp op;
@@ -634,7 +663,10 @@ void EditorServer::Impl::routes() {
     res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
                     "application/octet-stream");
   });
+}
 
+// Saving in place and downloads.
+void EditorServer::Impl::file_routes() {
   server.Post("/api/save", [this](const httplib::Request& req, httplib::Response& res) {
     const json j = body_json(req);
     std::shared_ptr<Editor> doc = ready_editor();

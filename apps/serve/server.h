@@ -26,8 +26,9 @@ struct ServeOptions {
   std::optional<std::filesystem::path> output;  // where "Save" writes (.svec or .svec.json)
   std::string host = "127.0.0.1";
   int port = 8080;                              // 0: any free port
-  double ratio = 0.01;                          // vectorization of a raster input
-  int vertices = 0;
+  // Vectorization of a raster input: the document `subvec vectorize` makes with the same options,
+  // levels included (its progress and cancel flag are the server's own).
+  subvec::VectorizeOptions vectorize;
   int64_t max_pixels = int64_t{1} << 23;
 };
 

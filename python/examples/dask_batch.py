@@ -105,8 +105,10 @@ def vectorize_one(in_path, out_dir, conflict, ratio, vertices, levels, render_pn
         saved = None
     data = None
     if saved is None:
-        data = subvec.vectorize(photo, ratio=ratio, vertices=vertices, levels=levels,
-                                threads=1).to_bytes()
+        # Only the options given: the defaults and their ranges are the library's.
+        given = {"ratio": ratio, "vertices": vertices, "levels": levels}
+        options = {key: value for key, value in given.items() if value is not None}
+        data = subvec.vectorize(photo, threads=1, **options).to_bytes()
         saved = subvec.from_bytes(data)  # what the file holds, measured and drawn below
     rendered = saved.render(threads=1)
     mae = subvec.compare(photo, rendered)["mae_mean"]
@@ -136,7 +138,7 @@ def summary_csv(rows):
     return out.getvalue()
 
 
-def run(client, in_dir, out_dir, ratio=0.01, vertices=0, levels=3, render_png=False,
+def run(client, in_dir, out_dir, ratio=None, vertices=None, levels=None, render_png=False,
         fail_once_dir=None,
         log=sys.stderr):
     """Vectorizes in_dir into out_dir on `client`'s cluster; returns the summary rows."""
@@ -178,16 +180,14 @@ def main(argv=None):
                        help="worker processes of a LocalCluster on this machine (default 2)")
     where.add_argument("--scheduler", help="address of a running Dask scheduler")
     size = parser.add_mutually_exclusive_group()
-    size.add_argument("--ratio", type=float, default=0.01,
-                      help="control vertices as a fraction of the pixel count (default 0.01)")
-    size.add_argument("--vertices", type=int, default=0, help="control vertex count instead")
-    parser.add_argument("--levels", type=int, default=3,
-                        help="levels of abstraction, 1 to 16 (default 3), as subvec vectorize")
+    size.add_argument("--ratio", type=float,
+                      help="control vertices as a fraction of the pixel count (default: subvec.vectorize's)")
+    size.add_argument("--vertices", type=int, help="control vertex count instead")
+    parser.add_argument("--levels", type=int,
+                        help="levels of abstraction (default: subvec.vectorize's), as subvec vectorize")
     parser.add_argument("--render-png", action="store_true", help="also write NAME.png")
     parser.add_argument("--fail-once", metavar="DIR", help=argparse.SUPPRESS)  # tests: retries
     args = parser.parse_args(argv)
-    if not 0 < args.ratio <= 1:
-        parser.error(f"--ratio: expected a number in (0, 1], got {args.ratio}")
 
     from dask.distributed import Client, LocalCluster
 

@@ -34,7 +34,6 @@
 #include "subvec/io/svec.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/vectorize/levels.h"
 #include "subvec/pyramid/pyramid.h"
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
@@ -56,7 +55,7 @@ using subvec::VectorImage;
 // ---- exceptions ------------------------------------------------------------------------------
 
 // Indexed by ErrorCode; filled once at import.
-std::array<PyObject*, 5> kErrorClasses{};
+std::array<PyObject*, 6> kErrorClasses{};
 PyObject* kBaseError = nullptr;
 
 PyObject* new_exception(py::module_& m, const char* name, py::tuple bases, const char* doc) {
@@ -87,6 +86,9 @@ void register_exceptions(py::module_& m) {
   kErrorClasses[size_t(ErrorCode::kLimit)] =
       new_exception(m, "LimitError", py::make_tuple(base, value_error),
                     "An input over a size limit (pixels, vertices, bytes).");
+  kErrorClasses[size_t(ErrorCode::kCancelled)] =
+      new_exception(m, "CancelledError", py::make_tuple(base),
+                    "A long job stopped because it was asked to (its cancel flag was set).");
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -345,16 +347,12 @@ std::vector<int32_t> index_list(const py::object& a, int limit, const char* what
   return out;
 }
 
-}  // namespace
+// ---- the module, one topic at a time --------------------------------------------------------
 
-PYBIND11_MODULE(_subvec, m) {
-  m.doc() = "subvec: vector images built on piecewise smooth Loop subdivision surfaces";
-  m.attr("__version__") = SUBVEC_VERSION;
-  register_exceptions(m);
+using PyVectorImage = py::class_<VectorImage>;
 
-  py::class_<VectorImage> vi(m, "VectorImage",
-                             "A subdivision vector image: a control mesh per level of detail over "
-                             "a width x height image, with strokes and metadata.");
+// Properties, copies, rendering, serialization and the raw arrays of one level.
+void def_vector_image(PyVectorImage& vi) {
   vi.def_property_readonly("width", [](const VectorImage& v) { return v.width; })
       .def_property_readonly("height", [](const VectorImage& v) { return v.height; })
       .def_property_readonly("num_levels", [](const VectorImage& v) { return v.levels.size(); })
@@ -423,9 +421,12 @@ PYBIND11_MODULE(_subvec, m) {
           [](VectorImage& v, const py::object& a, int level) {
             set_channel<float>(v, level, a, &colors_of, 3, "colors");
           },
-          "colors"_a, py::kw_only(), "level"_a = 0)
-      // Edits (edit/ops.h): image coordinates, in pixels.
-      .def(
+          "colors"_a, py::kw_only(), "level"_a = 0);
+}
+
+// Edits (edit/ops.h): image coordinates, in pixels.
+void def_edits(PyVectorImage& vi) {
+  vi.def(
           "edit",
           [](VectorImage& v, const py::object& ops) {
             const std::string text = py::isinstance<py::str>(ops)
@@ -496,9 +497,12 @@ PYBIND11_MODULE(_subvec, m) {
             return apply_op(v, op);
           },
           "at"_a, "color"_a, py::kw_only(), "mode"_a = "blend", "select"_a = "vertex",
-          "radius"_a = 0.0, "amount"_a = 0.5, "level"_a = 0)
-      // The building blocks of color edits (edit/selection.h, edit/color.h).
-      .def(
+          "radius"_a = 0.0, "amount"_a = 0.5, "level"_a = 0);
+}
+
+// The building blocks of color and shape edits (edit/selection.h, edit/color.h, edit/shape.h).
+void def_edit_parts(PyVectorImage& vi) {
+  vi.def(
           "select_colors",
           [](const VectorImage& v, std::array<double, 2> at, const std::string& select,
              double radius, int level) {
@@ -560,9 +564,13 @@ PYBIND11_MODULE(_subvec, m) {
             subvec::ShapeEditor editor(mesh, v.width, v.height);
             mesh.positions = editor.deform(h);
           },
-          "vertices"_a, "targets"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0)
-      // Stylization (edit/stylize.h): adds the strokes to the image and reports what it did.
-      .def(
+          "vertices"_a, "targets"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0);
+}
+
+// Stylization, saliency, subdivision, the pyramid's filter and pickling.
+void def_analysis(PyVectorImage& vi) {
+  // Stylization (edit/stylize.h): adds the strokes to the image and reports what it did.
+  vi.def(
           "stylize",
           [](VectorImage& v, int level, std::optional<std::array<double, 4>> roi,
              std::optional<double> threshold, uint64_t seed, double probability) {
@@ -652,45 +660,56 @@ PYBIND11_MODULE(_subvec, m) {
             return subvec::parse_svec_binary(
                 std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(s.data()), s.size()));
           }));
+}
 
+// Keyword arguments named as the Python API names them, for the library's field names in
+// subvec::validate()'s messages.
+std::string keyword_names(const std::string& message) {
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"levels.levels ", "levels "},
+      {"refine.rounds ", "refine "},
+      {"fit.relocate_iterations ", "relocate "},
+      {"fit.l1_iterations ", "l1_iterations "},
+  };
+  for (const auto& [field, keyword] : kNames) {
+    if (message.rfind(field, 0) == 0) return keyword + message.substr(std::string(field).size());
+  }
+  return message;
+}
+
+// subvec.vectorize(): the keyword arguments fill subvec::VectorizeOptions (defaults and ranges
+// are the library's), which makes the document `subvec vectorize` makes, levels included.
+void def_vectorize(py::module_& m) {
+  const subvec::VectorizeOptions d;
   m.def(
       "vectorize",
       [](const py::object& image, double ratio, int vertices, int levels, int refine, int relocate,
          int l1_iterations, int threads) {
-        if (!(std::isfinite(ratio) && ratio > 0 && ratio <= 1)) {
-          invalid("ratio must be in (0, 1], got " + std::to_string(ratio));
-        }
-        if (vertices != 0 && vertices < 4) invalid("vertices must be 0 (use ratio) or at least 4");
-        if (levels < 1 || levels > 16) {  // as `subvec vectorize --levels`
-          invalid("levels must be in 1 to 16" + std::string() +
-                  ", got " + std::to_string(levels));
-        }
-        // The ranges of `subvec vectorize --refine, --relocate, --l1-iterations`.
-        if (refine < 0 || refine > 50) invalid("refine must be in 0 to 50, got " + std::to_string(refine));
-        if (relocate < 0 || relocate > 50) invalid("relocate must be in 0 to 50, got " + std::to_string(relocate));
-        if (l1_iterations < 0 || l1_iterations > 20) {
-          invalid("l1_iterations must be in 0 to 20, got " + std::to_string(l1_iterations));
-        }
-        subvec::Image8 img = image_from_array(image);
         subvec::VectorizeOptions options;
         options.ratio = ratio;
         options.vertices = vertices;
+        options.levels.levels = levels;
         options.refine.rounds = refine;
         options.fit.relocate_iterations = relocate;
         options.fit.l1_iterations = l1_iterations;
         options.threads = threads;
+        try {
+          subvec::validate(options);
+        } catch (const Error& e) {
+          throw Error(e.code(), keyword_names(e.what()));
+        }
+        subvec::Image8 img = image_from_array(image);
         py::gil_scoped_release release;
-        VectorImage v = subvec::vectorize(img, options);
-        // As `subvec vectorize --levels` does: levels of abstraction by saliency (with one level,
-        // only each feature's saliency is stored), so both give the same file.
-        subvec::LevelOptions level_options;
-        level_options.levels = levels;
-        subvec::build_levels(v, img, level_options);
-        return v;
+        return subvec::vectorize(img, options);
       },
-      "image"_a, py::kw_only(), "ratio"_a = 0.01, "vertices"_a = 0, "levels"_a = 3,
-      "refine"_a = subvec::RefineOptions{}.rounds, "relocate"_a = 0, "l1_iterations"_a = 0, "threads"_a = 0);
+      "image"_a, py::kw_only(), "ratio"_a = d.ratio, "vertices"_a = d.vertices,
+      "levels"_a = d.levels.levels, "refine"_a = d.refine.rounds,
+      "relocate"_a = d.fit.relocate_iterations, "l1_iterations"_a = d.fit.l1_iterations,
+      "threads"_a = d.threads);
+}
 
+// Files, bytes and raster images.
+void def_io(py::module_& m) {
   m.def(
       "load",
       [](const std::filesystem::path& path) {
@@ -751,4 +770,21 @@ PYBIND11_MODULE(_subvec, m) {
                         "mae_mean"_a = d.mae_mean, "psnr"_a = d.psnr, "ssim"_a = d.ssim);
       },
       "reference"_a, "test"_a);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_subvec, m) {
+  m.doc() = "subvec: vector images built on piecewise smooth Loop subdivision surfaces";
+  m.attr("__version__") = SUBVEC_VERSION;
+  register_exceptions(m);
+  PyVectorImage vi(m, "VectorImage",
+                   "A subdivision vector image: a control mesh per level of detail over "
+                   "a width x height image, with strokes and metadata.");
+  def_vector_image(vi);
+  def_edits(vi);
+  def_edit_parts(vi);
+  def_analysis(vi);
+  def_vectorize(m);
+  def_io(m);
 }

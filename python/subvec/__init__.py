@@ -5,17 +5,18 @@ subdivision turns it into a smooth color field with sharp tears. docs/python.md 
 
     import subvec
     photo = subvec.read_image("photo.png")          # H x W x 3 uint8
-    image = subvec.vectorize(photo, ratio=0.01)      # a VectorImage
+    image = subvec.vectorize(photo)                  # a VectorImage (levels included)
     image.recolor((120, 80), (40, 90, 200), radius=15)
     pixels = image.render(width=1024)                # H' x W' x 3 uint8
     image.save("photo.svec")
 
 Errors raise subclasses of subvec.Error: InvalidArgumentError, InvalidMeshError, BadFileError,
-LimitError (all also ValueError) and FileError (also OSError).
+LimitError (all also ValueError), FileError (also OSError) and CancelledError.
 """
 
 from ._subvec import (  # noqa: F401  (the public API)
     BadFileError,
+    CancelledError,
     Error,
     FileError,
     InvalidArgumentError,
@@ -33,6 +34,7 @@ from ._subvec import (  # noqa: F401  (the public API)
 
 __all__ = [
     "BadFileError",
+    "CancelledError",
     "Error",
     "FileError",
     "InvalidArgumentError",

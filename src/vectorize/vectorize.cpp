@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <set>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -11,14 +13,84 @@
 #include "subvec/mesh/topology.h"
 
 namespace subvec {
+namespace {
+
+std::string text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+[[noreturn]] void out_of_range(const std::string& field, const std::string& rule, double value) {
+  throw Error(ErrorCode::kInvalidArgument, field + " must be " + rule + ", got " + text(value));
+}
+
+// `value` in [lo, hi] (finite); the message names `field`.
+void check_in(const std::string& field, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi)) out_of_range(field, "in [" + text(lo) + ", " + text(hi) + "]", value);
+}
+
+void check_positive(const std::string& field, double value) {
+  if (!(std::isfinite(value) && value > 0)) out_of_range(field, "a positive number", value);
+}
+
+void validate_features(const FeatureOptions& f, const std::string& at) {
+  check_in(at + "blur_sigma", f.blur_sigma, 0, 20);
+  check_in(at + "high_quantile", f.high_quantile, 0.01, 0.999);
+  check_in(at + "min_high_threshold", f.min_high_threshold, 0, 1e4);
+  check_in(at + "low_ratio", f.low_ratio, 0.01, 1);
+  check_in(at + "min_length", f.min_length, 0, 1e6);
+  check_in(at + "spur_length", f.spur_length, 0, 1e3);
+  check_in(at + "max_gap", f.max_gap, 0, 100);
+}
+
+void validate_fit(const ColorFitOptions& f, const std::string& at) {
+  check_in(at + "l1_iterations", f.l1_iterations, 0, 20);
+  check_in(at + "relocate_iterations", f.relocate_iterations, 0, 50);
+}
+
+void validate_levels(const LevelOptions& l, const std::string& at) {
+  check_in(at + "levels", l.levels, 1, 16);
+  check_in(at + "saliency_weight", l.saliency_weight, 0, 1e6);
+  check_in(at + "reduction", l.reduction, 0.01, 0.95);
+  check_positive(at + "max_feature_error", l.max_feature_error);
+  check_positive(at + "color_scale", l.color_scale);
+  validate_fit(l.fit, at + "fit.");
+}
+
+// The stages of the job and the share of the whole run time done when each starts.
+constexpr VectorizeStage kStages[] = {{"features", 0.0}, {"mesh", 0.02}, {"simplify", 0.25},
+                                      {"refine", 0.7},   {"fit", 0.8},   {"levels", 0.9}};
+constexpr VectorizeStage kSegmentStages[] = {{"segment", 0.0}, {"features", 0.08}, {"mesh", 0.1},
+                                             {"simplify", 0.3}, {"refine", 0.7},   {"fit", 0.8},
+                                             {"levels", 0.9}};
+
+}  // namespace
+
+void validate(const VectorizeOptions& o) {
+  if (!(o.ratio > 0 && o.ratio <= 1)) out_of_range("ratio", "in (0, 1]", o.ratio);
+  if (o.vertices != 0 && !(o.vertices >= 4 && o.vertices <= (1 << 26))) {
+    out_of_range("vertices", "0 (use ratio) or in [4, " + std::to_string(1 << 26) + "]", o.vertices);
+  }
+  validate_features(o.features, "features.");
+  check_in("initial_mesh.grid_step", o.initial_mesh.grid_step, 0, 2);
+  check_in("max_feature_error", o.max_feature_error, 0.05, 100);
+  check_in("refine.rounds", o.refine.rounds, 0, 50);
+  validate_fit(o.fit, "fit.");
+  validate_levels(o.levels, "levels.");
+  check_in("threads", o.threads, 0, 1024);
+}
+
+std::vector<VectorizeStage> vectorize_stages(bool segment) {
+  return segment ? std::vector<VectorizeStage>(std::begin(kSegmentStages), std::end(kSegmentStages))
+                 : std::vector<VectorizeStage>(std::begin(kStages), std::end(kStages));
+}
 
 VectorImage vectorize(const Image8& image, const VectorizeOptions& options, VectorizeReport* report) {
+  validate(options);
   if (image.width < 2 || image.height < 2) {
     throw Error(ErrorCode::kInvalidArgument, "image of " + std::to_string(image.width) + "x" +
                                                  std::to_string(image.height) + " pixels is too small to vectorize");
-  }
-  if (options.vertices <= 0 && !(options.ratio > 0 && options.ratio <= 1)) {
-    throw Error(ErrorCode::kInvalidArgument, "ratio must be in (0, 1], got " + std::to_string(options.ratio));
   }
   const double pixels = double(image.width) * image.height;
   const int target = std::max(4, options.vertices > 0 ? options.vertices
@@ -26,8 +98,13 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   VectorizeReport local;
   VectorizeReport& r = report ? *report : local;
   r = {};
-  auto progress = [&](const char* stage, double fraction) {
-    if (options.progress) options.progress(stage, fraction);
+  const std::vector<VectorizeStage> stages = vectorize_stages(options.segment.has_value());
+  // Each stage starts here: a cancelled job stops, and the progress callback hears of it.
+  auto begin = [&](const char* stage) {
+    if (options.cancel && options.cancel->load()) throw Error(ErrorCode::kCancelled, "cancelled");
+    const auto at = std::find_if(stages.begin(), stages.end(),
+                                 [&](const VectorizeStage& s) { return std::string(s.name) == stage; });
+    if (options.progress) options.progress(stage, at->start);
   };
   using Clock = std::chrono::steady_clock;
   auto t = Clock::now();
@@ -38,15 +115,15 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   };
 
   // Stage 1: features, GrabCut's region boundary (first: it checks the rectangle) and Canny.
-  // Stage 2: the dense mesh. Rough shares of the run time drive the progress.
+  // Stage 2: the dense mesh.
   std::vector<DetectedFeature> boundary;
   if (options.segment) {
-    progress("segment", 0.0);
+    begin("segment");
     r.segment_mask = segment_foreground(image, *options.segment, options.segment_options);
     boundary = region_boundary_features(r.segment_mask, options.segment_options);
     lap("segment");
   }
-  progress("features", options.segment ? 0.08 : 0.0);
+  begin("features");
   std::vector<DetectedFeature> features = detect_features(image, options.features);
   const size_t num_boundary = boundary.size();
   if (num_boundary > 0) {
@@ -56,7 +133,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
                     std::make_move_iterator(boundary.end()));
   }
   lap("features");
-  progress("mesh", options.segment ? 0.1 : 0.02);
+  begin("mesh");
   // Images from 512 x 512 up start from a 2-pixel grid away from the features (docs/vectorize.md,
   // "Large images"): about the same error for a third less time; the fit still sees every pixel.
   InitialMeshOptions mesh_options = options.initial_mesh;
@@ -86,7 +163,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   }
 
   // Stage 3: simplification.
-  progress("simplify", options.segment ? 0.3 : 0.25);
+  begin("simplify");
   SimplifyOptions simplify_options;
   simplify_options.target_vertices = target;
   simplify_options.max_feature_error = options.max_feature_error;
@@ -95,19 +172,18 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   lap("simplify");
 
   // Stage 3b: data-dependent flips and vertex moves.
-  progress("refine", 0.7);
+  begin("refine");
   RefineOptions refine_options = options.refine;
   refine_options.threads = options.threads;
   r.refine = refine_mesh(mesh, image, refine_options);
   lap("refine");
 
   // Stage 4: colors.
-  progress("fit", 0.8);
+  begin("fit");
   ColorFitOptions fit_options = options.fit;
   fit_options.threads = options.threads;
   const ColorFitStats fit = fit_colors(mesh, image.width, image.height, image, fit_options);
   lap("fit");
-  progress("done", 1.0);
 
   r.vertices = mesh.num_vertices();
   r.triangles = mesh.num_triangles();
@@ -120,6 +196,15 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   out.width = image.width;
   out.height = image.height;
   out.levels.push_back(std::move(mesh));
+
+  // Stage 5: levels of abstraction (paper §5); with one level, each feature's saliency only.
+  begin("levels");
+  LevelOptions level_options = options.levels;
+  level_options.fit.threads = options.threads;
+  build_levels(out, image, level_options, &r.levels);
+  lap("levels");
+  if (options.cancel && options.cancel->load()) throw Error(ErrorCode::kCancelled, "cancelled");
+  if (options.progress) options.progress("done", 1.0);
   return out;
 }
 

@@ -227,6 +227,7 @@ def test_exception_hierarchy():
                 subvec.LimitError):
         assert issubclass(cls, subvec.Error) and issubclass(cls, ValueError)
     assert issubclass(subvec.FileError, subvec.Error) and issubclass(subvec.FileError, OSError)
+    assert issubclass(subvec.CancelledError, subvec.Error)
     assert subvec.InvalidArgumentError.__module__ == "subvec"
 
 

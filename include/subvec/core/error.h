@@ -15,6 +15,7 @@ enum class ErrorCode {
   kBadFile,          // a file that cannot be parsed: truncated, wrong magic, bad field
   kIo,               // the operating system refused a read or a write
   kLimit,            // input over a size limit (pixels, vertices, bytes)
+  kCancelled,        // a long job stopped because its cancel flag was set (e.g. Ctrl+C)
 };
 
 class Error : public std::runtime_error {

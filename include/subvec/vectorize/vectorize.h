@@ -1,9 +1,12 @@
 // Vectorization of a photograph (paper §4): features -> dense feature-aligned mesh -> constrained
 // QEM simplification with curve refitting -> data-dependent refinement -> global least-squares color
-// fit.
+// fit -> levels of abstraction (§5). One job, one parameter struct: every front end (CLI, batch,
+// server, Python) starts from VectorizeOptions{}, fills the fields its arguments name, and calls
+// validate(), whose rules and messages are the only ones.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <functional>
 #include <optional>
 #include <string>
@@ -14,6 +17,7 @@
 #include "subvec/vectorize/features.h"
 #include "subvec/vectorize/fit.h"
 #include "subvec/vectorize/initial_mesh.h"
+#include "subvec/vectorize/levels.h"
 #include "subvec/vectorize/refine.h"
 #include "subvec/vectorize/segment.h"
 #include "subvec/vectorize/simplify.h"
@@ -32,10 +36,33 @@ struct VectorizeOptions {
   double max_feature_error = 1.0;  // pixels (simplification rolls back collapses beyond it)
   RefineOptions refine;            // data-dependent flips and vertex moves (refine.h)
   ColorFitOptions fit;
-  int threads = 0;       // <= 0: all cores; the result does not depend on it
-  // Called with a stage name and the fraction of the whole job done (0..1).
+  // Levels of abstraction built from the fitted mesh (levels.h); with levels.levels = 1 the
+  // document has one level and each feature's saliency is stored. The defaults are the document
+  // `subvec vectorize` writes. Their color refit keeps its own options (levels.fit), not `fit`.
+  LevelOptions levels;
+  int threads = 0;       // 0: all cores; the result does not depend on it
+  // Called with a stage name and the fraction of the whole job done (0..1), at the start of each
+  // stage of vectorize_stages() and with "done" and 1 at the end.
   std::function<void(const std::string& stage, double fraction)> progress;
+  // When set and true, the job stops at the next check (between stages) and throws
+  // Error(kCancelled). May be set from another thread or a signal handler.
+  const std::atomic<bool>* cancel = nullptr;
 };
+
+// Throws Error(kInvalidArgument) for the first option out of its range, in one line that starts
+// with the option's field name as written in C++ ("ratio", "levels.reduction",
+// "features.blur_sigma", "fit.l1_iterations") and then the rule and the value, e.g.
+// "ratio must be in (0, 1], got 2". Front ends may replace the leading field name by their own
+// name for it (a flag, a keyword argument). vectorize() calls it first.
+void validate(const VectorizeOptions& options);
+
+// A stage of the job and the fraction of the whole job done when it starts (rough shares of the
+// run time), in order; "segment" only with a segment rectangle.
+struct VectorizeStage {
+  const char* name;
+  double start;
+};
+std::vector<VectorizeStage> vectorize_stages(bool segment);
 
 struct StageTime {
   std::string stage;
@@ -43,11 +70,12 @@ struct StageTime {
 };
 
 struct VectorizeReport {
-  int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;
+  int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;  // of level 0
   double fit_rms = 0;
-  std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, refine, fit
+  std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, refine, fit, levels
   SimplifyStats simplify;
   RefineStats refine;
+  LevelReport levels;
   // The detected polyline each output feature follows (same order as the mesh's features).
   std::vector<std::vector<Vec2>> feature_targets;
   // With a segment rectangle: the cleaned GrabCut foreground, and the ids of the mesh features
@@ -56,8 +84,9 @@ struct VectorizeReport {
   std::vector<int32_t> segment_feature_ids;
 };
 
-// Vectorizes an RGB image into a one-level vector image of the same size. Throws
-// Error(kInvalidArgument) for options out of range.
+// Vectorizes an RGB image into a vector image of the same size with options.levels.levels
+// levels. Throws Error(kInvalidArgument) for options out of range (validate()) and
+// Error(kCancelled) when options.cancel is set.
 VectorImage vectorize(const Image8& image, const VectorizeOptions& options = {}, VectorizeReport* report = nullptr);
 
 }  // namespace subvec

@@ -572,10 +572,12 @@ TEST_F(Cli, VectorizeSegmentBadRectangles) {
 }
 
 // Runs `subvec <args...>` with stderr on a pseudo-terminal and stdout in a file; returns what the
-// terminal received and the exit status.
+// terminal received and the exit status. With `interrupt_at`, types Ctrl+C on the terminal once
+// it shows that text.
 std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args,
                                             const fs::path& stdout_file,
-                                            const char* progress_delay) {
+                                            const char* progress_delay,
+                                            const char* interrupt_at = nullptr) {
   int master = -1;
   const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
   if (pid == 0) {
@@ -591,10 +593,14 @@ std::pair<std::string, int> run_on_terminal(const std::vector<std::string>& args
   if (pid < 0) return {"forkpty failed", -1};
   std::string terminal;
   char buf[4096];
+  bool interrupted = false;
   while (true) {
     const ssize_t n = ::read(master, buf, sizeof buf);
     if (n <= 0) break;  // EIO once the child has closed the terminal
     terminal.append(buf, size_t(n));
+    if (interrupt_at && !interrupted && terminal.find(interrupt_at) != std::string::npos) {
+      interrupted = ::write(master, "\x03", 1) == 1;  // the terminal sends SIGINT
+    }
   }
   int raw = 0;
   ::waitpid(pid, &raw, 0);
@@ -634,6 +640,59 @@ TEST_F(Cli, VectorizeProgressOnlyOnATerminal) {
   const size_t message = failed.find("subvec: segment rectangle");
   ASSERT_NE(message, std::string::npos) << failed;
   EXPECT_TRUE(message == 0 || failed[message - 1] == '\r') << failed;
+}
+
+// Ctrl+C stops a vectorization at its next stage (cancel.h): one line, exit status 130, no output
+// file and no summary. Ctrl+C is typed on the terminal once the progress line shows the
+// simplification running, with several stages still to come.
+TEST_F(Cli, VectorizeStopsOnCtrlC) {
+  const fs::path photo = dir_ / "large.png", out = dir_ / "large.svec", summary = dir_ / "summary.txt";
+  subvec::Image8 img(640, 640, 3);  // a few seconds of work from the simplification on
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const bool inside = std::hypot(x % 160 - 80, y % 160 - 80) < 50;
+      uint8_t* p = img.row(y) + 3 * x;
+      p[0] = inside ? 230 : static_cast<uint8_t>(x * 255 / img.width);
+      p[1] = inside ? 40 : static_cast<uint8_t>(y * 255 / img.height);
+      p[2] = static_cast<uint8_t>((x + y) % 200);
+    }
+  }
+  subvec::write_png(photo, img);
+  const auto [terminal, status] =
+      run_on_terminal({"vectorize", photo.string(), "-o", out.string()}, summary, "0", ": simplify");
+  EXPECT_EQ(status, 130) << terminal;
+  EXPECT_NE(terminal.find("subvec: cancelled"), std::string::npos) << terminal;
+  // The job itself stopped (VectorizeOptions::cancel): it never reached the levels, two stages on.
+  EXPECT_EQ(terminal.find(": levels"), std::string::npos) << terminal;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(read_text(summary), "");
+}
+
+// `subvec vectorize`, `subvec batch` and `subvec serve` take the vectorize options from one
+// registration (vectorize_options.h), with the library's defaults in the help and the library's
+// ranges (subvec::validate) reported as usage errors naming the flag.
+TEST_F(Cli, VectorizeOptionsAreSharedWithServeAndBatch) {
+  for (const char* command : {"vectorize", "serve"}) {
+    const CliResult help = subvec(std::string(command) + " --help");
+    ASSERT_EQ(help.status, 0) << command;
+    for (const char* word : {"--ratio", "--vertices", "--segment", "--refine", "--relocate", "--levels",
+                             "--level-reduction", "--feature-level", "--edge-blur", "--threads",
+                             "(default 0.01)"}) {
+      EXPECT_NE(help.out.find(word), std::string::npos) << command << ": " << word;
+    }
+  }
+  const fs::path photo = dir_ / "photo.png";
+  write_test_photo(photo);
+  for (const char* command : {"vectorize", "serve", "batch"}) {
+    const std::string input = std::string(command) == "batch" ? dir_.string() : photo.string();
+    const std::string out = std::string(command) == "serve" ? "" : " -o " + q(dir_ / "out");
+    CliResult r = subvec(std::string(command) + " " + q(input) + out + " --ratio 2");
+    EXPECT_EQ(r.status, 105) << command;
+    expect_failure(r, "--ratio must be in (0, 1], got 2");
+    r = subvec(std::string(command) + " " + q(input) + out + " --levels 17");
+    EXPECT_EQ(r.status, 105) << command;
+    expect_failure(r, "--levels must be in [1, 16], got 17");
+  }
 }
 
 }  // namespace

@@ -246,7 +246,9 @@ TEST(SvecCompact, SharedPhotographWithinBudget) {
       std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images" / "chelsea.png";
   if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
   const Image8 photo = read_image(path);
-  const VectorImage image = vectorize(photo, {});
+  VectorizeOptions one_level;  // the budget is per vertex of one level
+  one_level.levels.levels = 1;
+  const VectorImage image = vectorize(photo, one_level);
   const std::vector<uint8_t> bytes = to_svec_binary(image);
   const double bytes_per_vertex = double(bytes.size()) / image.levels[0].num_vertices();
   const double before = compare(photo, render(image, {})).mae_mean;

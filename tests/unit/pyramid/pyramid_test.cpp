@@ -193,8 +193,7 @@ TEST(Pyramid, SharedPhotographs) {
     const auto path = dir / (std::string(name) + ".png");
     if (!std::filesystem::exists(path)) continue;
     const Image8 photo = read_image(path);
-    VectorImage image = vectorize(photo, {});
-    build_levels(image, photo, {});
+    const VectorImage image = vectorize(photo, {});  // the default levels included
     const VectorImage out = filter(image, colors(0.3));
     const Image8 before = render_level0(image), after = render_level0(out);
     for (const Feature& c : image.levels.back().features) {

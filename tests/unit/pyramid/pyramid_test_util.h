@@ -55,6 +55,7 @@ inline Image8 shapes_image(int w = 192, int h = 144) {
 inline VectorImage shapes_levels(const Image8& img, LevelOptions options = {}, LevelReport* report = nullptr) {
   VectorizeOptions v;
   v.ratio = 0.04;
+  v.levels.levels = 1;  // built below with `options`
   VectorImage image = vectorize(img, v);
   build_levels(image, img, options, report);
   return image;

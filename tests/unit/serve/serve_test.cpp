@@ -440,5 +440,57 @@ TEST(ServeHttpFilter, SavedFilterEqualsTheFilterCommand) {
   fs::remove_all(dir);
 }
 
+
+// `subvec serve photo.png` vectorizes as `subvec vectorize photo.png` does, levels included: with
+// the same options, Save writes the same bytes. (Options through the struct the CLI's flags fill,
+// vectorize_options.h; here a few set away from their defaults, as the flags would.)
+TEST(ServeHttpVectorize, SavedDocumentEqualsTheVectorizeCommand) {
+  const fs::path dir = fs::temp_directory_path() / ("subvec-serve-vectorize-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path photo = fs::path(SUBVEC_SOURCE_DIR) / "examples" / "04-rocket.png";
+  const fs::path saved = dir / "saved.svec", cli = dir / "cli.svec";
+  const std::string command = std::string("'") + SUBVEC_CLI + "' vectorize '" + photo.string() + "' -o '" +
+                              cli.string() + "' --ratio 0.02 --refine 4 --level-reduction 0.6 >/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+
+  ServeOptions options;
+  options.input = photo;
+  options.output = saved;
+  options.port = 0;
+  options.vectorize.ratio = 0.02;
+  options.vectorize.refine.rounds = 4;
+  options.vectorize.levels.reduction = 0.6;
+  EditorServer server(options);
+  server.start();
+  std::thread thread([&] { server.run(); });
+  httplib::Client client("127.0.0.1", server.port());
+  json status;
+  for (int i = 0; i < 6000; ++i) {  // until vectorized (at most a minute)
+    if (auto r = client.Get("/api/status")) {
+      status = json::parse(r->body, nullptr, false);
+      if (status["state"] != "vectorizing") break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(status["state"], "ready") << status.dump();
+  auto doc = client.Get("/api/document");
+  ASSERT_TRUE(doc);
+  EXPECT_EQ(json::parse(doc->body)["levels"].size(), static_cast<size_t>(subvec::LevelOptions{}.levels));
+  auto save = client.Post("/api/save", "{}", "application/json");
+  ASSERT_TRUE(save);
+  ASSERT_EQ(save->status, 200) << save->body;
+  server.stop();
+  thread.join();
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string a = bytes(saved), b = bytes(cli);
+  EXPECT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "saved " << a.size() << " bytes, subvec vectorize " << b.size();
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace subvec_serve

@@ -2,8 +2,12 @@
 // shared photographs (../shared/images, skipped with a message when absent).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
 #include <utility>
 
 #include "subvec/core/error.h"
@@ -174,7 +178,9 @@ std::vector<std::array<Vec2, 2>> limit_tear_segments(const ControlMesh& mesh, in
 // Checks the invariants every vectorization must keep and returns the rendered MAE.
 double check_vectorization(const Image8& img, const VectorizeOptions& options, const char* name) {
   VectorizeReport report;
-  const VectorImage v = vectorize(img, options, &report);
+  VectorizeOptions one_level = options;  // level 0 is checked here; the levels in tests/unit/pyramid
+  one_level.levels.levels = 1;
+  const VectorImage v = vectorize(img, one_level, &report);
   EXPECT_NO_THROW(validate(v)) << name;
   const ControlMesh& mesh = v.levels[0];
   // No flipped or degenerate triangle.
@@ -393,6 +399,64 @@ TEST(Vectorize, RejectsBadOptions) {
   options.ratio = -0.1;
   EXPECT_THROW(vectorize(img, options), Error);
   EXPECT_THROW(vectorize(Image8(1, 1, 3), {}), Error);
+}
+
+// validate() holds every range of the job's options, with one message naming the field (the front
+// ends replace the name by their flag or keyword, and test that).
+TEST(Vectorize, ValidateNamesTheOptionOutOfRange) {
+  EXPECT_NO_THROW(validate(VectorizeOptions{}));
+  auto message = [](const std::function<void(VectorizeOptions&)>& set) {
+    VectorizeOptions options;
+    set(options);
+    try {
+      validate(options);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.ratio = 2; }), "ratio must be in (0, 1], got 2");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.ratio = std::nan(""); }), "ratio must be in (0, 1], got nan");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.vertices = 3; }),
+            "vertices must be 0 (use ratio) or in [4, 67108864], got 3");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.features.high_quantile = 1; }),
+            "features.high_quantile must be in [0.01, 0.999], got 1");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.refine.rounds = -1; }), "refine.rounds must be in [0, 50], got -1");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.fit.relocate_iterations = 51; }),
+            "fit.relocate_iterations must be in [0, 50], got 51");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.levels.levels = 0; }), "levels.levels must be in [1, 16], got 0");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.levels.reduction = 1; }),
+            "levels.reduction must be in [0.01, 0.95], got 1");
+  EXPECT_EQ(message([](VectorizeOptions& o) { o.threads = -1; }), "threads must be in [0, 1024], got -1");
+}
+
+// The cancel flag stops the job at the next stage with a typed error; the progress callback hears
+// of every stage before it, in vectorize_stages() order, and of none after.
+TEST(Vectorize, CancelStopsAtTheNextStage) {
+  const Image8 img = disk_image(64, 64, 31.7, 32.2, 17.3);
+  std::atomic<bool> cancel{false};
+  std::vector<std::string> seen;
+  VectorizeOptions options;
+  options.cancel = &cancel;
+  options.progress = [&](const std::string& stage, double) {
+    seen.push_back(stage);
+    if (stage == "refine") cancel = true;
+  };
+  try {
+    vectorize(img, options);
+    ADD_FAILURE() << "not cancelled";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kCancelled);
+  }
+  EXPECT_EQ(seen, (std::vector<std::string>{"features", "mesh", "simplify", "refine"}));
+  // Uncancelled, every stage reports, levels included, then "done".
+  cancel = false;
+  seen.clear();
+  options.progress = [&](const std::string& stage, double) { seen.push_back(stage); };
+  const VectorImage v = vectorize(img, options);
+  EXPECT_EQ(seen, (std::vector<std::string>{"features", "mesh", "simplify", "refine", "fit", "levels", "done"}));
+  EXPECT_EQ(static_cast<int>(v.levels.size()), LevelOptions{}.levels);
 }
 
 // The coarse grid that large images start from gives the same error as the pixel grid: checked on
