@@ -679,28 +679,25 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
 }
 
 Delta Editor::undo(const std::string& session_id, int64_t version) {
-  std::lock_guard lock(mutex_);
-  Session& session = session_locked(session_id);
-  check_version_locked(version);
-  if (undo_.empty()) throw RequestError(kConflict, "nothing to undo");
-  const bool strokes_changed = undo_.back().strokes.size() != image_.strokes.size();
-  redo_.push_back(std::move(image_));
-  image_ = std::move(undo_.back());
-  undo_.pop_back();
-  ++version_;
-  session.drag.reset();
-  return delta_locked(session, nullptr, strokes_changed);
+  return step_history(session_id, version, undo_, redo_, "nothing to undo");
 }
 
 Delta Editor::redo(const std::string& session_id, int64_t version) {
+  return step_history(session_id, version, redo_, undo_, "nothing to redo");
+}
+
+// Undo takes from the undo stack and keeps the current image on the redo stack; redo the reverse.
+Delta Editor::step_history(const std::string& session_id, int64_t version,
+                           std::vector<VectorImage>& from, std::vector<VectorImage>& to,
+                           const char* empty_message) {
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
-  if (redo_.empty()) throw RequestError(kConflict, "nothing to redo");
-  const bool strokes_changed = redo_.back().strokes.size() != image_.strokes.size();
-  undo_.push_back(std::move(image_));
-  image_ = std::move(redo_.back());
-  redo_.pop_back();
+  if (from.empty()) throw RequestError(kConflict, empty_message);
+  const bool strokes_changed = from.back().strokes.size() != image_.strokes.size();
+  to.push_back(std::move(image_));
+  image_ = std::move(from.back());
+  from.pop_back();
   ++version_;
   session.drag.reset();
   return delta_locked(session, nullptr, strokes_changed);

@@ -34,6 +34,7 @@
 #include "subvec/edit/ops.h"
 #include "subvec/edit/shape.h"
 #include "subvec/mesh/vector_image.h"
+#include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
 
 namespace subvec_serve {
@@ -67,7 +68,7 @@ struct ViewRequest {
   // Image-space window the page shows (with a margin); empty (x1 <= x0): the whole image.
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   double scale = 1;              // canvas pixels per image pixel
-  double max_edge_pixels = 2.5;  // the depth rule's target (RenderOptions::max_edge_pixels)
+  double max_edge_pixels = subvec::RenderOptions{}.max_edge_pixels;  // the depth rule's target
   int64_t have = 0;              // the view the page holds (ViewMesh::id; 0: none)
 };
 
@@ -219,6 +220,8 @@ class Editor {
   void commit_locked(VectorImage image);
   Delta drag_move_locked(Session& session, Vec2 to, double rotate);
   Delta delta_locked(Session& session, const std::vector<Vec2>* preview, bool strokes_changed);
+  Delta step_history(const std::string& session, int64_t version, std::vector<VectorImage>& from,
+                     std::vector<VectorImage>& to, const char* empty_message);
 
   mutable std::mutex mutex_;
   VectorImage image_;

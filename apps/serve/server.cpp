@@ -489,11 +489,11 @@ void EditorServer::Impl::document_routes() {
   server.Post("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
     const json j = body_json(req);
     ViewRequest v;
-    v.level = small_int(j, "level", 0);
-    v.depth = small_int(j, "depth", -1);
-    v.scale = number(j, "scale", 1.0);
-    v.max_edge_pixels = number(j, "max_edge_pixels", 2.5);
-    v.have = integer(j, "have", 0);
+    v.level = small_int(j, "level", v.level);
+    v.depth = small_int(j, "depth", v.depth);
+    v.scale = number(j, "scale", v.scale);
+    v.max_edge_pixels = number(j, "max_edge_pixels", v.max_edge_pixels);
+    v.have = integer(j, "have", v.have);
     if (j.contains("window") && !j["window"].is_null()) {
       const json& w = j["window"];
       if (!w.is_array() || w.size() != 4 ||

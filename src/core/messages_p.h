@@ -2,6 +2,7 @@
 // invalid-argument error and one way to print a number in a message.
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -19,6 +20,22 @@ inline std::string num(double v, int digits = 6) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
+}
+
+// Throws "FIELD must be RULE, got VALUE" (kInvalidArgument): the one form of an option's range
+// message, for the validate() of every parameter struct.
+[[noreturn]] inline void out_of_range(const std::string& field, const std::string& rule, double value) {
+  invalid(field + " must be " + rule + ", got " + num(value));
+}
+
+// `value` in [lo, hi] (so finite); the message names `field`.
+inline void check_in(const std::string& field, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi)) out_of_range(field, "in [" + num(lo) + ", " + num(hi) + "]", value);
+}
+
+// `value` finite and > 0.
+inline void check_positive(const std::string& field, double value) {
+  if (!(std::isfinite(value) && value > 0)) out_of_range(field, "a positive number", value);
 }
 
 }  // namespace subvec::detail

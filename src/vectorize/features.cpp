@@ -11,6 +11,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 
 namespace subvec {
@@ -452,12 +453,20 @@ void smooth_polyline(std::vector<Vec2>& p, bool closed) {
 
 }  // namespace
 
+void validate(const FeatureOptions& f, const std::string& prefix) {
+  using detail::check_in;
+  check_in(prefix + "blur_sigma", f.blur_sigma, 0, 20);
+  check_in(prefix + "high_quantile", f.high_quantile, 0.01, 0.999);
+  check_in(prefix + "min_high_threshold", f.min_high_threshold, 0, 1e4);
+  check_in(prefix + "low_ratio", f.low_ratio, 0.01, 1);
+  check_in(prefix + "min_length", f.min_length, 0, 1e6);
+  check_in(prefix + "spur_length", f.spur_length, 0, 1e3);
+  check_in(prefix + "max_gap", f.max_gap, 0, 100);
+}
+
 std::vector<DetectedFeature> detect_features(const Image8& image, const FeatureOptions& options) {
   if (image.width < 2 || image.height < 2) return {};
-  if (!(options.blur_sigma >= 0) || !(options.high_quantile > 0 && options.high_quantile < 1) ||
-      !(options.low_ratio > 0 && options.low_ratio <= 1) || !(options.min_length >= 0)) {
-    throw Error(ErrorCode::kInvalidArgument, "feature options out of range");
-  }
+  validate(options);
   const int w = image.width, h = image.height;
 
   // Color gradient (Di Zenzo): the largest eigenvalue of the RGB structure tensor gives the

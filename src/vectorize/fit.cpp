@@ -26,6 +26,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/geometry_p.h"
+#include "core/messages_p.h"
 #include "core/parallel_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -477,21 +478,29 @@ namespace {
 
 using fit_detail::FitSystem;
 
+}  // namespace
+
+void validate(const ColorFitOptions& f, const std::string& prefix) {
+  using detail::check_in;
+  check_in(prefix + "depth", f.depth, -1, 8);
+  check_in(prefix + "l1_iterations", f.l1_iterations, 0, 20);
+  detail::check_positive(prefix + "l1_floor", f.l1_floor);
+  check_in(prefix + "relocate_iterations", f.relocate_iterations, 0, 50);
+  detail::check_positive(prefix + "relocate_damping", f.relocate_damping);
+  detail::check_positive(prefix + "relocate_max_step", f.relocate_max_step);
+  check_in(prefix + "relocate_cg_iterations", f.relocate_cg_iterations, 1, 1000);
+  check_in(prefix + "relocate_refit_every", f.relocate_refit_every, 1, 1000);
+}
+
+namespace {
+
 void check_inputs(int width, int height, const Image8& image, const ColorFitOptions& options) {
   if (image.width != width || image.height != height) {
     throw Error(ErrorCode::kInvalidArgument, "fit_colors: image is " + std::to_string(image.width) + "x" +
                                                  std::to_string(image.height) + ", the mesh domain " +
                                                  std::to_string(width) + "x" + std::to_string(height));
   }
-  if (options.l1_iterations < 0 || !(options.l1_floor > 0)) {
-    throw Error(ErrorCode::kInvalidArgument, "fit_colors: l1_iterations must be >= 0 and l1_floor positive");
-  }
-  if (options.relocate_iterations < 0 || !(options.relocate_damping > 0) || !(options.relocate_max_step > 0) ||
-      options.relocate_cg_iterations < 1 || options.relocate_refit_every < 1) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "fit_colors: relocate_iterations must be >= 0, relocate_damping and relocate_max_step positive, "
-                "relocate_cg_iterations and relocate_refit_every at least 1");
-  }
+  validate(options);
 }
 
 // One iteratively reweighted least-squares step toward the least absolute deviations fit: each

@@ -7,6 +7,7 @@
 #include <queue>
 #include <string>
 
+#include "core/messages_p.h"
 #include "mesh/coarsen_p.h"
 #include "mesh/polyline_p.h"
 #include "mesh/quadric_p.h"
@@ -172,11 +173,18 @@ std::vector<int> assign_feature_levels(const ControlMesh& mesh, const std::vecto
   return level;
 }
 
+void validate(const LevelOptions& l, const std::string& prefix) {
+  using detail::check_in;
+  check_in(prefix + "levels", l.levels, 1, 16);
+  check_in(prefix + "saliency_weight", l.saliency_weight, 0, 1e6);
+  check_in(prefix + "reduction", l.reduction, 0.01, 0.95);
+  detail::check_positive(prefix + "max_feature_error", l.max_feature_error);
+  detail::check_positive(prefix + "color_scale", l.color_scale);
+  validate(l.fit, prefix + "fit.");
+}
+
 void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& options, LevelReport* report) {
-  if (options.levels < 1 || options.levels > 16) invalid("levels must be in 1..16, got " + std::to_string(options.levels));
-  if (!(options.reduction > 0 && options.reduction < 1)) invalid("reduction must be in (0, 1)");
-  if (!std::isfinite(options.saliency_weight) || options.saliency_weight < 0) invalid("saliency weight must be >= 0");
-  if (!(options.max_feature_error > 0) || !(options.color_scale > 0)) invalid("max_feature_error and color_scale must be positive");
+  validate(options);
   if (image.levels.empty()) invalid("the image has no level 0");
   if (photo.width != image.width || photo.height != image.height) {
     invalid("the photograph is " + std::to_string(photo.width) + "x" + std::to_string(photo.height) +

@@ -20,6 +20,7 @@
 #include <Eigen/Dense>
 
 #include "core/parallel_p.h"
+#include "core/messages_p.h"
 #include "mesh/collapse_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -446,14 +447,20 @@ int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& o
 
 }  // namespace
 
+void validate(const RefineOptions& r, const std::string& prefix) {
+  using detail::check_in;
+  check_in(prefix + "rounds", r.rounds, 0, 50);
+  check_in(prefix + "flip_passes", r.flip_passes, 0, 100);
+  if (!(r.min_gain >= 0 && r.min_gain < 1)) detail::out_of_range(prefix + "min_gain", "in [0, 1)", r.min_gain);
+  check_in(prefix + "min_area", r.min_area, 0, 1e6);
+  check_in(prefix + "min_quality", r.min_quality, 0, 1);
+  check_in(prefix + "min_move_quality", r.min_move_quality, 0, 1);
+  detail::check_positive(prefix + "max_step", r.max_step);
+  check_in(prefix + "over_relaxation", r.over_relaxation, 1, 2);
+}
+
 RefineStats refine_mesh(ControlMesh& mesh, const Image8& image, const RefineOptions& options) {
-  if (options.rounds < 0 || options.flip_passes < 0 || !(options.min_gain >= 0 && options.min_gain < 1) ||
-      !(options.min_area >= 0) || !(options.max_step > 0) ||
-      !(options.over_relaxation >= 1 && options.over_relaxation <= 2) ||
-      !(options.min_quality >= 0 && options.min_quality <= 1) ||
-      !(options.min_move_quality >= 0 && options.min_move_quality <= 1)) {
-    throw Error(ErrorCode::kInvalidArgument, "refine_mesh: options out of range");
-  }
+  validate(options);
   RefineStats stats;
   if (options.rounds == 0) return stats;
   const int threads = detail::resolve_threads(options.threads);

@@ -9,54 +9,12 @@
 #include <string>
 #include <utility>
 
+#include "core/messages_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
 namespace subvec {
 namespace {
-
-std::string text(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-[[noreturn]] void out_of_range(const std::string& field, const std::string& rule, double value) {
-  throw Error(ErrorCode::kInvalidArgument, field + " must be " + rule + ", got " + text(value));
-}
-
-// `value` in [lo, hi] (finite); the message names `field`.
-void check_in(const std::string& field, double value, double lo, double hi) {
-  if (!(value >= lo && value <= hi)) out_of_range(field, "in [" + text(lo) + ", " + text(hi) + "]", value);
-}
-
-void check_positive(const std::string& field, double value) {
-  if (!(std::isfinite(value) && value > 0)) out_of_range(field, "a positive number", value);
-}
-
-void validate_features(const FeatureOptions& f, const std::string& at) {
-  check_in(at + "blur_sigma", f.blur_sigma, 0, 20);
-  check_in(at + "high_quantile", f.high_quantile, 0.01, 0.999);
-  check_in(at + "min_high_threshold", f.min_high_threshold, 0, 1e4);
-  check_in(at + "low_ratio", f.low_ratio, 0.01, 1);
-  check_in(at + "min_length", f.min_length, 0, 1e6);
-  check_in(at + "spur_length", f.spur_length, 0, 1e3);
-  check_in(at + "max_gap", f.max_gap, 0, 100);
-}
-
-void validate_fit(const ColorFitOptions& f, const std::string& at) {
-  check_in(at + "l1_iterations", f.l1_iterations, 0, 20);
-  check_in(at + "relocate_iterations", f.relocate_iterations, 0, 50);
-}
-
-void validate_levels(const LevelOptions& l, const std::string& at) {
-  check_in(at + "levels", l.levels, 1, 16);
-  check_in(at + "saliency_weight", l.saliency_weight, 0, 1e6);
-  check_in(at + "reduction", l.reduction, 0.01, 0.95);
-  check_positive(at + "max_feature_error", l.max_feature_error);
-  check_positive(at + "color_scale", l.color_scale);
-  validate_fit(l.fit, at + "fit.");
-}
 
 // The stages of the job and the share of the whole run time done when each starts.
 constexpr VectorizeStage kStages[] = {{"features", 0.0}, {"mesh", 0.02}, {"simplify", 0.25},
@@ -68,16 +26,17 @@ constexpr VectorizeStage kSegmentStages[] = {{"segment", 0.0}, {"features", 0.08
 }  // namespace
 
 void validate(const VectorizeOptions& o) {
-  if (!(o.ratio > 0 && o.ratio <= 1)) out_of_range("ratio", "in (0, 1]", o.ratio);
+  using detail::check_in;
+  if (!(o.ratio > 0 && o.ratio <= 1)) detail::out_of_range("ratio", "in (0, 1]", o.ratio);
   if (o.vertices != 0 && !(o.vertices >= 4 && o.vertices <= (1 << 26))) {
-    out_of_range("vertices", "0 (use ratio) or in [4, " + std::to_string(1 << 26) + "]", o.vertices);
+    detail::out_of_range("vertices", "0 (use ratio) or in [4, " + std::to_string(1 << 26) + "]", o.vertices);
   }
-  validate_features(o.features, "features.");
+  validate(o.features, "features.");
   check_in("initial_mesh.grid_step", o.initial_mesh.grid_step, 0, 2);
   check_in("max_feature_error", o.max_feature_error, 0.05, 100);
-  check_in("refine.rounds", o.refine.rounds, 0, 50);
-  validate_fit(o.fit, "fit.");
-  validate_levels(o.levels, "levels.");
+  validate(o.refine, "refine.");
+  validate(o.fit, "fit.");
+  validate(o.levels, "levels.");
   check_in("threads", o.threads, 0, 1024);
 }
 

@@ -3,6 +3,7 @@
 // subpixel accuracy (the gradient-magnitude maximum along the edge normal).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "subvec/core/image.h"
@@ -31,6 +32,10 @@ struct DetectedFeature {
   int end_node = -1;
   bool closed() const { return points.size() > 2 && points.front() == points.back(); }
 };
+
+// Throws Error(kInvalidArgument) naming the first field out of range, prefixed by `prefix`
+// ("features." from validate(VectorizeOptions)); detect_features() calls it.
+void validate(const FeatureOptions& options, const std::string& prefix = {});
 
 std::vector<DetectedFeature> detect_features(const Image8& image, const FeatureOptions& options = {});
 

@@ -9,6 +9,8 @@
 // The paper's fit at the subdivided vertices is kept as an option for comparison.
 #pragma once
 
+#include <string>
+
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
 
@@ -47,6 +49,10 @@ struct ColorFitStats {
 };
 
 // Refits mesh.colors in place against `image` (same size as the domain). Throws kInvalidArgument.
+// Throws Error(kInvalidArgument) naming the first field out of range, prefixed by `prefix`;
+// fit_colors() calls it.
+void validate(const ColorFitOptions& options, const std::string& prefix = {});
+
 ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8& image,
                          const ColorFitOptions& options = {});
 

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -61,6 +62,10 @@ std::vector<int> assign_feature_levels(const ControlMesh& mesh, const std::vecto
 // against `photo` (the raster image it was vectorized from, of the same size). Stores each
 // feature's saliency in level 0 when it has none. Deterministic. Throws Error(kInvalidArgument)
 // for options out of range.
+// Throws Error(kInvalidArgument) naming the first field out of range, prefixed by `prefix` (its
+// color refit's fields as prefix + "fit."); build_levels() calls it.
+void validate(const LevelOptions& options, const std::string& prefix = {});
+
 void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& options = {},
                   LevelReport* report = nullptr);
 

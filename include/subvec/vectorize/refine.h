@@ -16,6 +16,8 @@
 // (vertices move in color classes of the vertex graph, a class at a time).
 #pragma once
 
+#include <string>
+
 #include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
 
@@ -54,6 +56,10 @@ struct RefineStats {
 // Refines a valid single-level mesh in place (it stays valid). The colors it starts from are the
 // corner colors after simplification (quadric-optimal); smooth vertices' colors change with their
 // moves. `image` covers the mesh domain. Throws Error(kInvalidArgument) for options out of range.
+// Throws Error(kInvalidArgument) naming the first field out of range, prefixed by `prefix`;
+// refine_mesh() calls it.
+void validate(const RefineOptions& options, const std::string& prefix = {});
+
 RefineStats refine_mesh(ControlMesh& mesh, const Image8& image, const RefineOptions& options = {});
 
 }  // namespace subvec

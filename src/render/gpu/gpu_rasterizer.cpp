@@ -308,6 +308,15 @@ void check_gl(const char* what) {
   throw Error(ErrorCode::kIo, std::string("GPU: OpenGL error ") + hex(e) + " in " + what);
 }
 
+// The first line of a shader's or program's info log (glGetShaderInfoLog / glGetProgramInfoLog).
+template <class GetLog>
+std::string first_log_line(GLuint object, GetLog get_log) {
+  char log[512] = {};
+  get_log(object, sizeof log, nullptr, log);
+  const std::string text(log);
+  return text.substr(0, text.find('\n'));
+}
+
 GLuint compile(GLenum type, const std::string& source, const char* name) {
   const GLuint shader = glCreateShader(type);
   const std::string text = "#version 430 core\n" + source;
@@ -317,11 +326,8 @@ GLuint compile(GLenum type, const std::string& source, const char* name) {
   GLint ok = 0;
   glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    char log[512] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    const std::string line = first_log_line(shader, glGetShaderInfoLog);
     glDeleteShader(shader);
-    std::string line(log);
-    line = line.substr(0, line.find('\n'));
     throw Error(ErrorCode::kIo, std::string("GPU: the ") + name + " shader does not compile: " + line);
   }
   return shader;
@@ -335,11 +341,8 @@ GLuint link(std::initializer_list<GLuint> shaders, const char* name) {
   GLint ok = 0;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);
   if (!ok) {
-    char log[512] = {};
-    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    const std::string line = first_log_line(program, glGetProgramInfoLog);
     glDeleteProgram(program);
-    std::string line(log);
-    line = line.substr(0, line.find('\n'));
     throw Error(ErrorCode::kIo, std::string("GPU: the ") + name + " program does not link: " + line);
   }
   return program;
