@@ -131,7 +131,8 @@ void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bo
   }
   subvec::ExportOptions options;
   options.level = a.level;
-  options.scale = width_given ? double(a.width) / image.width : scale_given ? a.scale : 1.0;
+  if (width_given) options.width = a.width;
+  if (scale_given) options.scale = a.scale;
   options.tolerance = a.tolerance;
   options.depth = a.depth;
   options.pdf_target =

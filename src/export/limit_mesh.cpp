@@ -77,9 +77,11 @@ int export_depth(const VectorImage& image, const ExportOptions& options, ExportR
   }
   if (!(options.scale > 0) || !std::isfinite(options.scale))
     invalid("scale " + num(options.scale) + " is not a positive number");
+  if (options.width < 0) invalid("width " + std::to_string(options.width) + " is negative");
+  const double scale = export_scale(options, image.width);
   // The page, in output units: PDF viewers and SVG renderers draw nothing sensible outside these
   // bounds (the numbers of a page 1e300 units wide print with hundreds of digits).
-  const double page_width = image.width * options.scale, page_height = image.height * options.scale;
+  const double page_width = image.width * scale, page_height = image.height * scale;
   if (!(page_width <= Limits::kMaxDimension && page_height <= Limits::kMaxDimension)) {
     throw Error(ErrorCode::kLimit, "output size " + num(page_width) + "x" + num(page_height) +
                                        " is too large (at most " +
@@ -110,9 +112,9 @@ int export_depth(const VectorImage& image, const ExportOptions& options, ExportR
   } else {
     const LimitEvaluator evaluator(mesh, topology);
     for (depth = 0;; ++depth) {
-      const LinearError e = linear_error(evaluator, mesh, depth, options.tolerance / options.scale,
+      const LinearError e = linear_error(evaluator, mesh, depth, options.tolerance / scale,
                                          options.color_tolerance);
-      report.max_position_error = e.max_position * options.scale;
+      report.max_position_error = e.max_position * scale;
       report.max_color_error = e.max_color;
       report.over_tolerance = e.edges ? double(e.over) / double(e.edges) : 0;
       if (report.over_tolerance <= kAllowedOver || depth >= options.max_depth ||

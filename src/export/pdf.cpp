@@ -168,7 +168,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport& r = report ? *report : local;
   const RefinedMesh mesh =
       detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
-  const double w = image.width, h = image.height, s = options.scale;
+  const double w = image.width, h = image.height, s = export_scale(options, image.width);
 
   // The shading streams.
   // PdfTarget::kAny: one shading with RGB at the vertices. kPoppler: parameterized shadings per

@@ -74,7 +74,7 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport& r = report ? *report : local;
   const RefinedMesh mesh =
       detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
-  const double w = image.width, h = image.height, s = options.scale;
+  const double w = image.width, h = image.height, s = export_scale(options, image.width);
   // Coordinates in image pixels, to a tenth of an output pixel (crisp edges sample pixel centres).
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 10) - 1e-9)), 1, 9);
   // The grid is offset by half a step (the group below translates it back), so that no vertex
@@ -153,6 +153,10 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   }
   svg += "</svg>\n";
   return svg;
+}
+
+double export_scale(const ExportOptions& options, int image_width) {
+  return options.width > 0 ? double(options.width) / image_width : options.scale;
 }
 
 bool is_vector_export(const std::filesystem::path& path) {

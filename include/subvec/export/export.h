@@ -28,6 +28,7 @@ enum class PdfTarget { kAny, kPoppler };
 struct ExportOptions {
   int level = 0;       // level of detail
   double scale = 1;    // output units (PDF points, SVG pixels) per image pixel
+  int width = 0;       // > 0: the page's width in output units instead of `scale`
   // The triangles are refined until the piecewise-linear surface deviates from the limit surface
   // by at most `tolerance` output units in position and `color_tolerance` levels (0-255 scale) in
   // color, measured at the midpoints of the refined edges, at all but 1% of them (the error only
@@ -51,6 +52,9 @@ struct ExportReport {
   double max_color_error = 0;
   double over_tolerance = 0;
 };
+
+// Output units per image pixel: width / image_width when `width` is given, else `scale`.
+double export_scale(const ExportOptions& options, int image_width);
 
 // Throws Error(kInvalidArgument) for a bad level, scale, tolerance or depth, Error(kInvalidMesh)
 // when the level fails validation.

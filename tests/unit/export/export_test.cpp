@@ -114,6 +114,19 @@ TEST(Export, DepthFollowsTheToleranceAndTheScale) {
   EXPECT_EQ(detail::export_depth(image, options, coarse), 2);
 }
 
+// A page width is the scale that makes it: the same file, and a page of that width.
+TEST(Export, WidthSetsTheScale) {
+  const VectorImage image = example("01-disk");
+  ExportOptions by_width, by_scale;
+  by_width.width = 300;
+  by_scale.scale = 300.0 / image.width;
+  EXPECT_EQ(export_scale(by_width, image.width), by_scale.scale);
+  EXPECT_EQ(to_svg(image, by_width), to_svg(image, by_scale));
+  EXPECT_EQ(to_pdf(image, by_width), to_pdf(image, by_scale));
+  EXPECT_NE(to_svg(image, by_width).find("width=\"300\""), std::string::npos);
+  EXPECT_NE(to_svg(image, by_width), to_svg(image));
+}
+
 TEST(Export, RejectsBadOptions) {
   const VectorImage image = example("01-disk");
   auto fails = [&](ExportOptions o) { EXPECT_THROW((void)to_pdf(image, o), Error); };
@@ -121,6 +134,7 @@ TEST(Export, RejectsBadOptions) {
   fails({.scale = 0});
   fails({.tolerance = -1});
   fails({.depth = 9});
+  fails({.width = -1});
   EXPECT_THROW(write_vector_export(fs::temp_directory_path() / "x.eps", image), Error);
 }
 
