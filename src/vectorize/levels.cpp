@@ -7,6 +7,7 @@
 #include <queue>
 #include <string>
 
+#include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "mesh/coarsen_p.h"
 #include "mesh/polyline_p.h"
@@ -210,6 +211,7 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
   r.features.push_back(static_cast<int>(base.features.size()));
   r.seconds.push_back(0);
   for (int l = 1; l < options.levels; ++l) {
+    detail::check_cancel(options.cancel);
     const auto start = std::chrono::steady_clock::now();
     const ControlMesh& fine = image.levels[l - 1];
     std::vector<int32_t> kept;
@@ -224,6 +226,7 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
     std::vector<int32_t> parents, color_merged;
     ControlMesh coarse = c.result(parents, color_merged);
     ColorFitOptions fit = options.fit;
+    if (!fit.cancel) fit.cancel = options.cancel;
     fit_colors(coarse, image.width, image.height, photo, fit);
     coarse.parent_vertices = std::move(parents);
     coarse.collapses = std::move(collapses);
