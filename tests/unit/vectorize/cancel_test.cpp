@@ -122,14 +122,17 @@ TEST_F(Cancel, RefineChecksTheFlag) {
   EXPECT_TRUE(same_mesh(with_flag, without));
 }
 
-// Before the solve (with relocation and reweighting asked for too); the colors stay as they were.
+// Before the solve (at the defaults: no relocation, no reweighting), and so with relocation and
+// reweighting asked for too; the mesh stays as it was.
 TEST_F(Cancel, FitChecksTheFlag) {
   const ControlMesh start = simplified(150);
-  ControlMesh mesh = start;
   ColorFitOptions options;
+  options.cancel = &set_;
+  ControlMesh mesh = start;
+  EXPECT_TRUE(cancelled([&] { fit_colors(mesh, img_.width, img_.height, img_, options); }));
+  EXPECT_TRUE(same_mesh(mesh, start));
   options.relocate_iterations = 2;
   options.l1_iterations = 1;
-  options.cancel = &set_;
   EXPECT_TRUE(cancelled([&] { fit_colors(mesh, img_.width, img_.height, img_, options); }));
   EXPECT_TRUE(same_mesh(mesh, start));
   ControlMesh with_flag = start, without = start;
