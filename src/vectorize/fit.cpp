@@ -574,6 +574,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   FitSystem system(mesh, topo, width, height, options.depth >= 0 ? options.depth : default_fit_depth(mesh));
   const bool pixels = options.target == ColorFitTarget::kPixels;
   ColorFitStats stats;
+  detail::check_cancel(options.cancel);
   if (pixels) {
     fit_detail::set_pixel_targets(system, image, options, stats);
   } else {

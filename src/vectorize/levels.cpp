@@ -96,7 +96,9 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
   plan_all();
   std::vector<EdgeVerts> collapses;
   const double max_tolerance = tolerance * kMaxLoosening;
-  while (c.alive_vertices() > target) {
+  // The cancel flag is looked at every 4096 entries, the first one included.
+  for (int64_t popped = 0; c.alive_vertices() > target; ++popped) {
+    if (popped % 4096 == 0) detail::check_cancel(options.cancel);
     if (queue.empty()) {
       if (tolerance >= max_tolerance) break;
       tolerance *= 2;
