@@ -25,6 +25,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "core/cancel_p.h"
 #include "core/geometry_p.h"
 #include "core/messages_p.h"
 #include "core/parallel_p.h"
@@ -573,12 +574,14 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   FitSystem system(mesh, topo, width, height, options.depth >= 0 ? options.depth : default_fit_depth(mesh));
   const bool pixels = options.target == ColorFitTarget::kPixels;
   ColorFitStats stats;
+  detail::check_cancel(options.cancel);
   if (pixels) {
     fit_detail::set_pixel_targets(system, image, options, stats);
   } else {
     fit_detail::set_refined_vertex_targets(system, image, stats);
   }
   const std::vector<Color> start = mesh.colors;
+  detail::check_cancel(options.cancel);
   Eigen::MatrixX3d x = fit_detail::solve_colors(system, start, options.regularization, options.threads);
   if (options.relocate_iterations > 0 && pixels) {
     stats.relocations = fit_detail::relocate_vertices(mesh, topo, system, start, options, x);
@@ -587,7 +590,10 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   // report (and the one the eye forgives least on flat areas) is the mean absolute one, and the L1
   // fit lets outliers (texture, specular dots, pixels at misplaced edges) pull the colors less.
   // One reweighting gets most of the gain (docs/vectorize.md).
-  for (int it = 0; it < options.l1_iterations && pixels; ++it) x = reweighted_fit(system, x, start, options);
+  for (int it = 0; it < options.l1_iterations && pixels; ++it) {
+    detail::check_cancel(options.cancel);
+    x = reweighted_fit(system, x, start, options);
+  }
   for (int i = 0; i < system.c; ++i) {
     mesh.colors[i] = {static_cast<float>(x(i, 0)), static_cast<float>(x(i, 1)), static_cast<float>(x(i, 2))};
   }

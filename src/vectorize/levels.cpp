@@ -7,6 +7,7 @@
 #include <queue>
 #include <string>
 
+#include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "mesh/coarsen_p.h"
 #include "mesh/polyline_p.h"
@@ -95,7 +96,9 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
   plan_all();
   std::vector<EdgeVerts> collapses;
   const double max_tolerance = tolerance * kMaxLoosening;
-  while (c.alive_vertices() > target) {
+  // The cancel flag is looked at every 4096 entries, the first one included.
+  for (int64_t popped = 0; c.alive_vertices() > target; ++popped) {
+    if (popped % 4096 == 0) detail::check_cancel(options.cancel);
     if (queue.empty()) {
       if (tolerance >= max_tolerance) break;
       tolerance *= 2;
@@ -210,6 +213,7 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
   r.features.push_back(static_cast<int>(base.features.size()));
   r.seconds.push_back(0);
   for (int l = 1; l < options.levels; ++l) {
+    detail::check_cancel(options.cancel);
     const auto start = std::chrono::steady_clock::now();
     const ControlMesh& fine = image.levels[l - 1];
     std::vector<int32_t> kept;
@@ -224,6 +228,7 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
     std::vector<int32_t> parents, color_merged;
     ControlMesh coarse = c.result(parents, color_merged);
     ColorFitOptions fit = options.fit;
+    if (!fit.cancel) fit.cancel = options.cancel;
     fit_colors(coarse, image.width, image.height, photo, fit);
     coarse.parent_vertices = std::move(parents);
     coarse.collapses = std::move(collapses);

@@ -19,8 +19,9 @@
 
 #include <Eigen/Dense>
 
-#include "core/parallel_p.h"
+#include "core/cancel_p.h"
 #include "core/messages_p.h"
+#include "core/parallel_p.h"
 #include "mesh/collapse_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -234,6 +235,7 @@ int flip_pass(ControlMesh& mesh, const Image8& image, const RefineOptions& optio
 int flip_passes(ControlMesh& mesh, const Image8& image, const RefineOptions& options, Tracker& track, int threads) {
   int flips = 0;
   for (int pass = 0; pass < options.flip_passes; ++pass) {
+    detail::check_cancel(options.cancel);
     const int n = flip_pass(mesh, image, options, track, threads);
     flips += n;
     if (n == 0) break;
@@ -419,6 +421,7 @@ int move_vertices(ControlMesh& mesh, const Image8& image, const RefineOptions& o
   const MeshTopology topo = MeshTopology::build(mesh, image.width, image.height);
   int moves = 0;
   for (const std::vector<int32_t>& members : vertex_classes(mesh, topo)) {
+    detail::check_cancel(options.cancel);
     // 0: not tried (its ring is as it was when its move was last refused), 1: refused, 2: moved;
     // and a moved vertex's ring errors.
     std::vector<char> outcome(members.size(), 0);

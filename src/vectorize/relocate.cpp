@@ -10,6 +10,7 @@
 #include <limits>
 #include <numeric>
 
+#include "core/cancel_p.h"
 #include "core/geometry_p.h"
 
 namespace subvec::fit_detail {
@@ -35,6 +36,7 @@ class Relocator {
     double error = squared_error(system_, values);
     const int folded = folded_triangles();
     for (int it = 0; it < options_.relocate_iterations; ++it) {
+      detail::check_cancel(options_.cancel);
       linearize(values);
       const std::vector<double> step = conjugate_gradients(right_hand_side());
       const std::vector<Vec2> before = mesh_.positions;

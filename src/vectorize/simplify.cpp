@@ -40,6 +40,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/cancel_p.h"
 #include "core/parallel_p.h"
 #include "mesh/collapse_p.h"
 #include "mesh/quadric_p.h"
@@ -299,12 +300,14 @@ class Simplifier {
   // after. A worker collapses and moves only vertices it owns and reads its neighbourhood, which
   // nobody else writes meanwhile; it has its own queue, statistics and scratch space.
   static constexpr int32_t kEveryVertex = -1, kUnfrozen = -2;
+  static constexpr int64_t kCancelEvery = 4096;
   struct Worker {
     int32_t region = kEveryVertex;  // a region, every vertex, or every unfrozen vertex
     int64_t alive = 0;    // live vertices of the region
     int64_t stop = 0;     // simplify down to this many
     CollapseQueue queue;
     SimplifyStats stats;
+    bool cancelled = false;  // stopped early by options.cancel
     Arena arena;
     detail::VertexMarks marks;  // neighbourhood queries
     std::vector<int32_t> ring, faces;
@@ -981,7 +984,13 @@ void Simplifier::simplify_with(Worker& worker) {
   size_t rebuild_at = 4 * worker.queue.size();
   auto live = [&](const Entry& e) { return this->live(e); };
   Entry e;
-  while (worker.alive > worker.stop && worker.queue.pop(e, live)) {
+  // The cancel flag is looked at every kCancelEvery entries (the first one included); a worker
+  // that sees it stops, and run() throws on the calling thread.
+  for (int64_t popped = 0; worker.alive > worker.stop && worker.queue.pop(e, live); ++popped) {
+    if (popped % kCancelEvery == 0 && detail::cancelled(options_.cancel)) {
+      worker.cancelled = true;
+      break;
+    }
     if (!live(e)) continue;
     const int32_t remove = e.remove();
     const Plan p = plan_direction(remove, e.keep);
@@ -1037,6 +1046,7 @@ SimplifyStats Simplifier::run() {
       detail::parallel_for(static_cast<int>(workers.size()), options_.threads, [&](int r) { simplify_with(workers[r]); });
     }
     for (Worker& w : workers) {
+      if (w.cancelled) throw Error(ErrorCode::kCancelled, "cancelled");
       merge(w.stats);
       arenas_.push_back(std::move(w.arena));
     }
@@ -1048,6 +1058,7 @@ SimplifyStats Simplifier::run() {
     for (int64_t v = 0; v < nv; ++v) all.alive += vertex_alive_[v];
     all.stop = target;
     simplify_with(all);
+    if (all.cancelled) throw Error(ErrorCode::kCancelled, "cancelled");
     merge(all.stats);
   }
   write_back();
@@ -1068,7 +1079,11 @@ void Simplifier::simplify_regions_serially(std::vector<Worker>& regions) {
     return std::any_of(regions.begin(), regions.end(), [](const Worker& w) { return w.alive > w.stop; });
   };
   Entry e;
-  while (open() && all.queue.pop(e, live)) {
+  for (int64_t popped = 0; open() && all.queue.pop(e, live); ++popped) {
+    if (popped % kCancelEvery == 0 && detail::cancelled(options_.cancel)) {
+      regions[0].cancelled = true;
+      break;
+    }
     if (!live(e)) continue;
     Worker& region = regions[region_[e.remove()]];
     if (region.alive <= region.stop) continue;

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -58,9 +59,10 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   VectorizeReport& r = report ? *report : local;
   r = {};
   const std::vector<VectorizeStage> stages = vectorize_stages(options.segment.has_value());
-  // Each stage starts here: a cancelled job stops, and the progress callback hears of it.
+  // Each stage starts here: a cancelled job stops, and the progress callback hears of it. The long
+  // stages (simplify, refine, fit, levels) also check the flag inside their loops.
   auto begin = [&](const char* stage) {
-    if (options.cancel && options.cancel->load()) throw Error(ErrorCode::kCancelled, "cancelled");
+    detail::check_cancel(options.cancel);
     const auto at = std::find_if(stages.begin(), stages.end(),
                                  [&](const VectorizeStage& s) { return std::string(s.name) == stage; });
     if (options.progress) options.progress(stage, at->start);
@@ -127,6 +129,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   simplify_options.target_vertices = target;
   simplify_options.max_feature_error = options.max_feature_error;
   simplify_options.threads = options.threads;
+  simplify_options.cancel = options.cancel;
   r.simplify = simplify(mesh, image.width, image.height, simplify_options);
   lap("simplify");
 
@@ -134,6 +137,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   begin("refine");
   RefineOptions refine_options = options.refine;
   refine_options.threads = options.threads;
+  refine_options.cancel = options.cancel;
   r.refine = refine_mesh(mesh, image, refine_options);
   lap("refine");
 
@@ -141,6 +145,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   begin("fit");
   ColorFitOptions fit_options = options.fit;
   fit_options.threads = options.threads;
+  fit_options.cancel = options.cancel;
   const ColorFitStats fit = fit_colors(mesh, image.width, image.height, image, fit_options);
   lap("fit");
 
@@ -160,9 +165,11 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   begin("levels");
   LevelOptions level_options = options.levels;
   level_options.fit.threads = options.threads;
+  level_options.cancel = options.cancel;
+  level_options.fit.cancel = options.cancel;
   build_levels(out, image, level_options, &r.levels);
   lap("levels");
-  if (options.cancel && options.cancel->load()) throw Error(ErrorCode::kCancelled, "cancelled");
+  detail::check_cancel(options.cancel);
   if (options.progress) options.progress("done", 1.0);
   return out;
 }

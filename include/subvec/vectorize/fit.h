@@ -9,6 +9,7 @@
 // The paper's fit at the subdivided vertices is kept as an option for comparison.
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include "subvec/core/image.h"
@@ -38,6 +39,9 @@ struct ColorFitOptions {
   int relocate_cg_iterations = 12; // conjugate-gradient iterations per step
   int relocate_refit_every = 3;    // steps between color refits (and after the last)
   int threads = 0;               // <= 0: all cores; the result does not depend on it
+  // When set and true, fit_colors() throws Error(kCancelled) before its solve or at its next
+  // relocation or reweighting step (the mesh stays valid and keeps its colors).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct ColorFitStats {

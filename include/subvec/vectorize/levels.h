@@ -14,6 +14,7 @@
 // features of similar length (as in the paper, whose default w is 2).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -43,6 +44,9 @@ struct LevelOptions {
   // (feature id, level) overrides: the feature is present in levels 0 .. level and no coarser.
   std::vector<std::pair<int32_t, int>> feature_levels;
   ColorFitOptions fit;             // the color refit of each new level
+  // When set and true, build_levels() throws Error(kCancelled) before its next level or inside
+  // that level's color refit (which takes this flag when fit.cancel is null).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct LevelReport {

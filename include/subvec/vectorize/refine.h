@@ -16,6 +16,7 @@
 // (vertices move in color classes of the vertex graph, a class at a time).
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include "subvec/core/image.h"
@@ -44,6 +45,9 @@ struct RefineOptions {
   // falls (successive over-relaxation: the sweeps converge faster). In [1, 2].
   double over_relaxation = 1.5;
   int threads = 0;         // <= 0: all cores; the result does not depend on it
+  // When set and true, refine_mesh() throws Error(kCancelled) at its next flip pass or vertex
+  // class (the mesh is then part-refined, still valid).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct RefineStats {

@@ -5,6 +5,8 @@
 // (eq. 1); a collapse that leaves the curve more than `max_feature_error` from it is rolled back.
 #pragma once
 
+#include <atomic>
+
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec {
@@ -14,6 +16,9 @@ struct SimplifyOptions {
   double max_feature_error = 1.0;   // pixels
   double color_scale = 2.0;         // colors enter the quadrics as color_scale * (0..255)
   int threads = 0;                  // <= 0: all cores; the result does not depend on it
+  // When set and true, simplify() stops within a few thousand collapses and throws
+  // Error(kCancelled), leaving the mesh as it was.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct SimplifyStats {
@@ -25,7 +30,8 @@ struct SimplifyStats {
 
 // Simplifies a valid single-level mesh in place (it stays valid). The feature chains' initial
 // vertex positions are the detected feature polylines that refitting follows. Colors are left at
-// the quadric-optimal values; the global color fit (fit.h) replaces them.
+// the quadric-optimal values; the global color fit (fit.h) replaces them. Throws Error(kCancelled)
+// when options.cancel is set.
 SimplifyStats simplify(ControlMesh& mesh, int width, int height, const SimplifyOptions& options);
 
 }  // namespace subvec

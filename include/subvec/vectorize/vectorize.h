@@ -44,8 +44,10 @@ struct VectorizeOptions {
   // Called with a stage name and the fraction of the whole job done (0..1), at the start of each
   // stage of vectorize_stages() and with "done" and 1 at the end.
   std::function<void(const std::string& stage, double fraction)> progress;
-  // When set and true, the job stops at the next check (between stages) and throws
-  // Error(kCancelled). May be set from another thread or a signal handler.
+  // When set and true, the job stops at the next check and throws Error(kCancelled): between
+  // stages, and inside the long ones (vectorize() gives it to simplify, refine, the fit and the
+  // levels in place of their own `cancel`), so a stage of seconds stops within a fraction of one.
+  // May be set from another thread or a signal handler.
   const std::atomic<bool>* cancel = nullptr;
 };
 

@@ -431,8 +431,9 @@ TEST(Vectorize, ValidateNamesTheOptionOutOfRange) {
   EXPECT_EQ(message([](VectorizeOptions& o) { o.threads = -1; }), "threads must be in [0, 1024], got -1");
 }
 
-// The cancel flag stops the job at the next stage with a typed error; the progress callback hears
-// of every stage before it, in vectorize_stages() order, and of none after.
+// The cancel flag stops the job at its next check (here inside refine, cancel_test.cpp) with a
+// typed error; the progress callback hears of every stage before it, in vectorize_stages() order,
+// and of none after.
 TEST(Vectorize, CancelStopsAtTheNextStage) {
   const Image8 img = disk_image(64, 64, 31.7, 32.2, 17.3);
   std::atomic<bool> cancel{false};
