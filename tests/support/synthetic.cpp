@@ -310,4 +310,19 @@ VectorImage make_synthetic_image(const SyntheticOptions& o) {
   return image;
 }
 
+Image8 textured_disk(int w, int h) {
+  Image8 img(w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool inside = std::hypot(x + 0.5 - w / 2.0, y + 0.5 - h / 2.0) < h / 4.0;
+      const double ripple = 40 * std::sin(0.35 * x + 0.2 * y) * std::cos(0.25 * y);
+      uint8_t* p = img.row(y) + 3 * x;
+      p[0] = static_cast<uint8_t>(std::lround(inside ? 220 : 90 + ripple));
+      p[1] = static_cast<uint8_t>(std::lround(inside ? 150 + ripple / 2 : 120 + x));
+      p[2] = static_cast<uint8_t>(std::lround(inside ? 40 : 160 - ripple));
+    }
+  }
+  return img;
+}
+
 }  // namespace subvec::test

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "subvec/core/image.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec::test {
@@ -21,5 +22,9 @@ struct SyntheticOptions {
 // split along the features (corners on each side of a tear use that side's color value; an open
 // tear's jump fades to zero at its endpoints). Without features, color i belongs to vertex i.
 VectorImage make_synthetic_image(const SyntheticOptions& options = {});
+
+// A photograph-like RGB image: a disk (a tear once vectorized) of radius h/4 at the centre over a
+// smooth background with a ripple, so that vertex positions matter; w x h.
+Image8 textured_disk(int w, int h);
 
 }  // namespace subvec::test

@@ -18,26 +18,13 @@
 #include "subvec/vectorize/refine.h"
 #include "subvec/vectorize/simplify.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/synthetic.h"
 #include "vectorize/simplify_p.h"
 
 namespace subvec {
 namespace {
 
-// A disk (a tear once vectorized) over a rippled background: w x h, radius h/4 at the centre.
-Image8 rippled_disk(int w, int h) {
-  Image8 img(w, h, 3);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const bool inside = std::hypot(x + 0.5 - w / 2.0, y + 0.5 - h / 2.0) < h / 4.0;
-      const double ripple = 40 * std::sin(0.35 * x + 0.2 * y) * std::cos(0.25 * y);
-      uint8_t* p = img.row(y) + 3 * x;
-      p[0] = static_cast<uint8_t>(std::lround(inside ? 220 : 90 + ripple));
-      p[1] = static_cast<uint8_t>(std::lround(inside ? 150 + ripple / 2 : 120 + x));
-      p[2] = static_cast<uint8_t>(std::lround(inside ? 40 : 160 - ripple));
-    }
-  }
-  return img;
-}
+using test::textured_disk;
 
 bool same_mesh(const ControlMesh& a, const ControlMesh& b) {
   return a.positions == b.positions && a.colors == b.colors && a.triangles == b.triangles &&
@@ -58,7 +45,7 @@ bool cancelled(const Job& job) {
 
 class Cancel : public ::testing::Test {
  protected:
-  const Image8 img_ = rippled_disk(96, 80);
+  const Image8 img_ = textured_disk(96, 80);
   const ControlMesh dense_ = build_initial_mesh(img_, detect_features(img_));
   std::atomic<bool> set_{true}, unset_{false};
 
