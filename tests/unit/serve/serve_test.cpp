@@ -29,6 +29,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 VectorImage disk() {
   return subvec::read_svec(fs::path(SUBVEC_SOURCE_DIR) / "examples" / "01-disk.svec.json");
 }
@@ -430,16 +435,11 @@ TEST(ServeHttpFilter, SavedFilterEqualsTheFilterCommand) {
   ASSERT_EQ(save->status, 200) << save->body;
   server.stop();
   thread.join();
-  auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  const std::string a = bytes(saved), b = bytes(cli);
+  const std::string a = file_bytes(saved), b = file_bytes(cli);
   EXPECT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "saved " << a.size() << " bytes, subvec filter " << b.size();
   fs::remove_all(dir);
 }
-
 
 // `subvec serve photo.png` vectorizes as `subvec vectorize photo.png` does, levels included: with
 // the same options, Save writes the same bytes. (Options through the struct the CLI's flags fill,
@@ -482,11 +482,7 @@ TEST(ServeHttpVectorize, SavedDocumentEqualsTheVectorizeCommand) {
   ASSERT_EQ(save->status, 200) << save->body;
   server.stop();
   thread.join();
-  auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  const std::string a = bytes(saved), b = bytes(cli);
+  const std::string a = file_bytes(saved), b = file_bytes(cli);
   EXPECT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "saved " << a.size() << " bytes, subvec vectorize " << b.size();
   fs::remove_all(dir);
