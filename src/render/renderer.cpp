@@ -22,6 +22,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/messages_p.h"
 #include "core/parallel_p.h"
 #include "render/gpu/gpu_p.h"
 #include "render/raster_p.h"
@@ -71,15 +72,8 @@ int choose_depth(double mean_edge_pixels, double max_edge_pixels, int64_t num_fa
 
 namespace {
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, message);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+using detail::invalid;
+using detail::num;
 
 // A pixel count as an integer while it is one.
 std::string pixels(double v) {

@@ -27,9 +27,7 @@ using detail::walk;
 using coarsen_detail::Coarsener;
 using coarsen_detail::Kind;
 
-[[noreturn]] void invalid(const std::string& message) {
-  throw Error(ErrorCode::kInvalidArgument, "levels: " + message);
-}
+[[noreturn]] void invalid(const std::string& message) { detail::invalid("levels: " + message); }
 
 // Greedy half-edge collapses by quadric cost until `target` vertices remain. Kept chains stay within
 // `tolerance` of where they started; when nothing more can go, the tolerance doubles (up to
