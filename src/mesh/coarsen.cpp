@@ -53,9 +53,14 @@ Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::
   face_alive_.assign(tri_.size(), 1);
   vertex_alive_.assign(nv, 1);
   alive_count_ = nv;
-  vfaces_.assign(nv, {});
+  {
+    std::vector<int32_t> counts(nv, 0);
+    for (const Tri& t : tri_)
+      for (int32_t v : t) ++counts[v];
+    vfaces_.reserve(counts);
+  }
   for (size_t f = 0; f < tri_.size(); ++f)
-    for (int32_t v : tri_[f]) vfaces_[v].push_back(static_cast<int32_t>(f));
+    for (int32_t v : tri_[f]) vfaces_.push_back(v, static_cast<int32_t>(f), arena_);
   marks_.mark.assign(nv, 0);
   sides_.assign(nv, 0);
   kind_.assign(nv, Kind::kSmooth);
@@ -259,17 +264,16 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   // Apply: u's faces take v, with v's color on their side; the faces on the edge die.
   std::array<std::array<int32_t, 2>, 2> pairs;
   const int npairs = edge_color_pairs(u, v, pairs);
-  const std::vector<int32_t> faces_of_u = vfaces_[u];
+  const std::vector<int32_t> faces_of_u(vfaces_[u].begin(), vfaces_[u].end());
   detail::collapse_faces(
       faces_of_u, tri_, tcol_, u, v, pairs, npairs,
       [&](int32_t f) {
         face_alive_[f] = 0;
         for (int32_t w : tri_[f])
-          if (w != u) std::erase(vfaces_[w], f);
+          if (w != u) vfaces_.erase(w, f);
       },
-      [&](int32_t f) { vfaces_[v].push_back(f); });
-  std::sort(vfaces_[v].begin(), vfaces_[v].end());
-  vfaces_[u].clear();
+      [&](int32_t f) { vfaces_.push_back(v, f, arena_); });
+  vfaces_.clear(u);
   vertex_alive_[u] = 0;
   --alive_count_;
   if (tear_slot >= 0) {

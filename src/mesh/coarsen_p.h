@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "mesh/collapse_p.h"
+#include "mesh/collapse_queue_p.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec::coarsen_detail {
@@ -52,6 +53,7 @@ class Coarsener {
 
   Kind kind(int32_t v) const { return kind_[v]; }
   bool alive(int32_t v) const { return vertex_alive_[v] != 0; }
+  const std::vector<uint8_t>& vertex_alive() const { return vertex_alive_; }
   int alive_vertices() const { return alive_count_; }
   const std::vector<Vec2>& positions() const { return pos_; }
   int num_vertices() const { return static_cast<int>(pos_.size()); }
@@ -102,7 +104,8 @@ class Coarsener {
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
   std::vector<uint8_t> face_alive_, vertex_alive_, sides_;
-  std::vector<std::vector<int32_t>> vfaces_;
+  detail::IncidenceLists vfaces_;  // the simplifier's incidence lists (collapse_queue_p.h)
+  detail::Arena arena_;             // where they grow
   std::vector<Kind> kind_;
   std::vector<int32_t> merged_of_;
   std::vector<Rgb> merged_;

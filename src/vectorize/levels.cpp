@@ -3,13 +3,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <array>
 #include <cmath>
-#include <queue>
 #include <string>
 
 #include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "mesh/coarsen_p.h"
+#include "mesh/collapse_queue_p.h"
 #include "mesh/polyline_p.h"
 #include "mesh/quadric_p.h"
 #include "subvec/core/error.h"
@@ -50,17 +51,9 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
     const Quadric5 q = plane_quadric(p[0], p[1], p[2]);
     for (int k = 0; k < 3; ++k) quadric[tcol[f][k]] += q;
   }
-  struct Entry {
-    double cost;
-    int32_t u, v;
-    uint32_t version_u, version_v;
-    bool operator>(const Entry& o) const {
-      if (cost != o.cost) return cost > o.cost;
-      if (u != o.u) return u > o.u;
-      return v > o.v;
-    }
-  };
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  // The simplifier's queue and greedy loop (mesh/collapse_queue_p.h): cheapest first, ties by the
+  // removed and the kept vertex.
+  detail::CollapseQueue queue;
   std::vector<uint32_t> version(nv, 0);
   auto plan = [&](int32_t u, int32_t v) {
     if (c.kind(u) == Kind::kCorner) return;
@@ -74,7 +67,7 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
       q += quadric[pairs[i][1]];
       cost += std::max(0.0, reduce(q)(pv.x, pv.y));
     }
-    queue.push({cost, u, v, version[u], version[v]});
+    if (std::isfinite(cost)) queue.push(detail::make_entry(cost, u, v, version[u], version[v]));
   };
   std::vector<int32_t> ring, ring2;
   auto plan_around = [&](int32_t v) {
@@ -91,30 +84,26 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
       for (int32_t w : ring) plan(v, w);
     }
   };
-  plan_all();
   std::vector<EdgeVerts> collapses;
-  const double max_tolerance = tolerance * kMaxLoosening;
-  // The cancel flag is looked at every 4096 entries, the first one included.
-  for (int64_t popped = 0; c.alive_vertices() > target; ++popped) {
-    if (popped % 4096 == 0) detail::check_cancel(options.cancel);
-    if (queue.empty()) {
-      if (tolerance >= max_tolerance) break;
-      tolerance *= 2;
-      plan_all();
-      continue;
-    }
-    const Entry e = queue.top();
-    queue.pop();
-    if (!c.alive(e.u) || !c.alive(e.v) || version[e.u] != e.version_u || version[e.v] != e.version_v) continue;
-    if (!c.can_collapse(e.u, e.v, tolerance)) continue;
+  const auto more = [&] { return c.alive_vertices() > target; };
+  const auto live = [&](const detail::Entry& e) { return detail::entry_live(e, c.vertex_alive(), version); };
+  const auto step = [&](const detail::Entry& e) {
+    const int32_t u = e.remove(), v = e.keep;
+    if (!c.can_collapse(u, v, tolerance)) return;
     std::array<std::array<int32_t, 2>, 2> pairs;
-    const int n = c.edge_color_pairs(e.u, e.v, pairs);
+    const int n = c.edge_color_pairs(u, v, pairs);
     detail::merge_side_by_side(quadric, pairs, n);
-    c.neighbours(e.u, ring);
-    c.collapse(e.u, e.v);
-    collapses.push_back({e.u, e.v});
+    c.neighbours(u, ring);
+    c.collapse(u, v);
+    collapses.push_back({u, v});
     for (int32_t w : ring) ++version[w];
     for (int32_t w : ring) plan_around(w);
+  };
+  const double max_tolerance = tolerance * kMaxLoosening;
+  for (plan_all();; plan_all()) {
+    if (!detail::run_collapses(queue, options.cancel, more, live, step)) throw Error(ErrorCode::kCancelled, "cancelled");
+    if (!more() || tolerance >= max_tolerance) break;
+    tolerance *= 2;
   }
   return collapses;
 }

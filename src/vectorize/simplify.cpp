@@ -15,7 +15,7 @@
 // max_feature_error. No collapse may break the link condition or flip or flatten a triangle.
 //
 // Speed. Collapses are cheapest first from a lazy queue whose front alone is a heap (binned by
-// cost, see CollapseQueue). Faces and color values are renumbered in vertex order for locality.
+// cost, mesh/collapse_queue_p.h). Faces and color values are renumbered in vertex order for locality.
 // Most collapses run in parallel: the image is cut into 2 x 2 regions with frozen seams, each
 // simplified on its own (a Worker per region, writing only what it owns) down to the target plus its
 // frozen vertices, then one global pass finishes. The region phase is exactly one global pass with
@@ -23,8 +23,9 @@
 // bit); the final mesh is close to, not the same as, one global pass from the start. The output
 // does not depend on the thread count.
 //
-// The 5D quadric and the collapse of faces and colors are the levels' too (mesh/quadric_p.h,
-// mesh/collapse_p.h).
+// The 5D quadric, the collapse of faces and colors, the queue and the incidence lists are the
+// levels' too (mesh/quadric_p.h, mesh/collapse_p.h, mesh/collapse_queue_p.h), and so is the greedy
+// loop (run_collapses).
 #include "subvec/vectorize/simplify.h"
 
 #include <algorithm>
@@ -43,6 +44,7 @@
 #include "core/cancel_p.h"
 #include "core/parallel_p.h"
 #include "mesh/collapse_p.h"
+#include "mesh/collapse_queue_p.h"
 #include "mesh/quadric_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -51,7 +53,11 @@
 namespace subvec {
 namespace {
 
+using detail::Arena;
 using detail::best_color;
+using detail::CollapseQueue;
+using detail::Entry;
+using detail::IncidenceLists;
 using detail::plane_quadric;
 using detail::Point5;
 using detail::Quadric2;
@@ -85,203 +91,6 @@ struct FeatureState {
   double saliency = 0;
 };
 
-// A 4-ary min-heap: the four children of a node share one cache line (16-byte entries, the
-// array offset by three slots so that every group of four siblings starts on a 64-byte boundary),
-// which halves the depth and the cache misses of a binary heap; the lazy collapse queue is
-// dominated by them.
-template <class T>
-class QuadHeap {
-  static_assert(sizeof(T) == 16);
-  static constexpr size_t kPad = 3;
-
- public:
-  bool empty() const { return size_ == 0; }
-  size_t size() const { return size_; }
-  const T& top() const { return at(0); }
-  void clear() { size_ = 0; }
-  void push(const T& x) {
-    if (size_ == capacity_) grow();
-    size_t i = size_++;
-    while (i > 0) {
-      const size_t parent = (i - 1) / 4;
-      if (!(x < at(parent))) break;
-      at(i) = at(parent);
-      i = parent;
-    }
-    at(i) = x;
-  }
-  void pop() {
-    const T x = at(--size_);
-    if (size_ == 0) return;
-    const size_t n = size_;
-    size_t i = 0;
-    while (true) {
-      const size_t first = 4 * i + 1;
-      if (first >= n) break;
-      size_t best = first;
-      const size_t last = std::min(first + 4, n);
-      for (size_t c = first + 1; c < last; ++c)
-        if (at(c) < at(best)) best = c;
-      if (!(at(best) < x)) break;
-      at(i) = at(best);
-      i = best;
-    }
-    at(i) = x;
-  }
-
- private:
-  struct alignas(64) Line {
-    unsigned char bytes[64];
-  };
-  T& at(size_t i) { return reinterpret_cast<T*>(storage_.get())[i + kPad]; }
-  const T& at(size_t i) const { return reinterpret_cast<const T*>(storage_.get())[i + kPad]; }
-  void grow() {
-    const size_t capacity = std::max<size_t>(1024, 2 * capacity_);
-    std::unique_ptr<Line[]> storage(new Line[(capacity + kPad) * sizeof(T) / sizeof(Line) + 1]);
-    if (size_) std::memcpy(reinterpret_cast<T*>(storage.get()) + kPad, &at(0), size_ * sizeof(T));
-    storage_ = std::move(storage);
-    capacity_ = capacity;
-  }
-  std::unique_ptr<Line[]> storage_;
-  size_t size_ = 0, capacity_ = 0;
-};
-
-// A queue entry: the collapse of `remove` into `keep`, planned when the two vertices had these
-// versions. 16 bytes. Ordered by cost, then the removed and the kept vertex (determinism); the cost
-// is a non-negative float, so its bits order like the value and cost and removed vertex compare as
-// one 64-bit key. Versions are truncated: an entry that survives a wrap-around is still fully
-// re-planned and checked before it collapses anything.
-struct Entry {
-  uint64_t key;  // cost bits << 32 | remove
-  int32_t keep;
-  uint16_t version_remove, version_keep;
-  int32_t remove() const { return static_cast<int32_t>(key & 0xffffffffu); }
-  bool operator<(const Entry& o) const { return key != o.key ? key < o.key : keep < o.keep; }
-};
-
-// The lazy collapse queue: entries are never updated in place; a re-planned edge gets a new entry
-// and the old one goes stale, to be skipped when it comes out. Most entries go stale long before
-// they would reach the front, so only the front lives in a heap: entries are binned by the high
-// bits of their cost (1/16 of an octave per bin), the heap holds every entry of the bins up to
-// `front_`, and the bins above wait unsorted until the heap runs dry, when the next non-empty bin
-// is moved into the heap with its stale entries dropped. Entries come out in exactly the order of
-// one big heap, at the cost of a heap that stays small enough for the cache.
-class CollapseQueue {
- public:
-  size_t size() const { return size_; }
-  void clear() {
-    heap_.clear();
-    for (auto& bin : bins_) std::vector<Entry>().swap(bin);
-    front_ = 0;
-    size_ = 0;
-  }
-  void push(const Entry& e) {
-    const uint32_t b = bin(e);
-    if (b <= front_) {
-      heap_.push(e);
-    } else {
-      bins_[b].push_back(e);
-    }
-    ++size_;
-  }
-  // Takes the smallest entry into `out`; false when the queue is empty. `live(e)` says whether an
-  // entry is still current; entries that are not may be dropped unseen.
-  template <class Live>
-  bool pop(Entry& out, const Live& live) {
-    while (heap_.empty()) {
-      uint32_t b = front_ + 1;
-      while (b < kBins && bins_[b].empty()) ++b;
-      if (b == kBins) return false;
-      front_ = b;
-      std::vector<Entry> entries;
-      entries.swap(bins_[b]);
-      for (const Entry& e : entries) {
-        if (live(e)) heap_.push(e);
-        else --size_;
-      }
-    }
-    out = heap_.top();
-    heap_.pop();
-    --size_;
-    return true;
-  }
-
- private:
-  static constexpr int kShift = 32 + 19;  // float bits above the 4 leading mantissa bits
-  static constexpr uint32_t kBins = uint32_t{1} << (63 - kShift);
-  static uint32_t bin(const Entry& e) { return static_cast<uint32_t>(e.key >> kShift); }
-  QuadHeap<Entry> heap_;
-  std::vector<std::vector<Entry>> bins_ = std::vector<std::vector<Entry>>(kBins);
-  uint32_t front_ = 0;
-  size_t size_ = 0;
-};
-
-// Blocks of int32 that never move, handed out in order: one per worker, so that lists can grow
-// on several threads at once.
-class Arena {
- public:
-  int32_t* take(size_t n) {
-    if (n > left_) {
-      const size_t size = std::max<size_t>(n, 1 << 16);
-      chunks_.push_back(std::make_unique<int32_t[]>(size));
-      next_ = chunks_.back().get();
-      left_ = size;
-    }
-    int32_t* out = next_;
-    next_ += n, left_ -= n;
-    return out;
-  }
-
- private:
-  std::vector<std::unique_ptr<int32_t[]>> chunks_;
-  int32_t* next_ = nullptr;
-  size_t left_ = 0;
-};
-
-// The faces incident to each vertex: lists laid out in vertex order in one block, each with room to
-// grow; a full list moves to a block twice as large from the caller's arena. Lists keep their
-// order; growing a list invalidates views of it.
-class IncidenceLists {
- public:
-  // `counts[v]` entries will be pushed for each vertex v first.
-  void reserve(const std::vector<int32_t>& counts) {
-    data_.resize(counts.size());
-    size_.assign(counts.size(), 0);
-    capacity_.resize(counts.size());
-    size_t total = 0;
-    for (size_t v = 0; v < counts.size(); ++v) {
-      capacity_[v] = std::max(8, counts[v] + 2);
-      total += capacity_[v];
-    }
-    pool_ = std::make_unique<int32_t[]>(total);
-    total = 0;
-    for (size_t v = 0; v < counts.size(); ++v) data_[v] = pool_.get() + total, total += capacity_[v];
-  }
-  std::span<const int32_t> operator[](int32_t v) const { return {data_[v], size_t(size_[v])}; }
-  void push_back(int32_t v, int32_t f, Arena& arena) {
-    if (size_[v] == capacity_[v]) {
-      int32_t* data = arena.take(2 * size_t(capacity_[v]));
-      std::copy_n(data_[v], size_[v], data);
-      data_[v] = data;
-      capacity_[v] *= 2;
-    }
-    data_[v][size_[v]++] = f;
-  }
-  void erase(int32_t v, int32_t f) {
-    int32_t* first = data_[v];
-    int32_t* last = first + size_[v];
-    int32_t* at = std::find(first, last, f);
-    std::copy(at + 1, last, at);
-    --size_[v];
-  }
-  void clear(int32_t v) { size_[v] = 0; }
-
- private:
-  std::unique_ptr<int32_t[]> pool_;
-  std::vector<int32_t*> data_;
-  std::vector<int32_t> size_, capacity_;
-};
-
 class Simplifier {
  public:
   Simplifier(ControlMesh& mesh, int width, int height, const SimplifyOptions& options,
@@ -300,7 +109,6 @@ class Simplifier {
   // after. A worker collapses and moves only vertices it owns and reads its neighbourhood, which
   // nobody else writes meanwhile; it has its own queue, statistics and scratch space.
   static constexpr int32_t kEveryVertex = -1, kUnfrozen = -2;
-  static constexpr int64_t kCancelEvery = 4096;
   struct Worker {
     int32_t region = kEveryVertex;  // a region, every vertex, or every unfrozen vertex
     int64_t alive = 0;    // live vertices of the region
@@ -324,12 +132,7 @@ class Simplifier {
     if (w.region < 0) return w.region == kEveryVertex || !frozen_[v];
     return region_[v] == w.region && !frozen_[v];
   }
-  bool live(const Entry& e) const {
-    const int32_t remove = e.remove();
-    return vertex_alive_[remove] && vertex_alive_[e.keep] &&
-           static_cast<uint16_t>(version_[remove]) == e.version_remove &&
-           static_cast<uint16_t>(version_[e.keep]) == e.version_keep;
-  }
+  bool live(const Entry& e) const { return detail::entry_live(e, vertex_alive_, version_); }
   bool owns_window(const Worker& w, int32_t removed_node) const;
   void simplify_with(Worker& w);
   void simplify_regions_serially(std::vector<Worker>& regions);
@@ -698,9 +501,7 @@ void Simplifier::push_edges(Worker& worker, int32_t v) {
 
 void Simplifier::push(Worker& worker, const Plan& p) {
   if (p.remove < 0 || !std::isfinite(p.cost)) return;
-  const uint64_t cost_bits = std::bit_cast<uint32_t>(static_cast<float>(p.cost));
-  worker.queue.push({cost_bits << 32 | static_cast<uint32_t>(p.remove), p.keep, static_cast<uint16_t>(version_[p.remove]),
-              static_cast<uint16_t>(version_[p.keep])});
+  worker.queue.push(detail::make_entry(p.cost, p.remove, p.keep, version_[p.remove], version_[p.keep]));
 }
 
 // Re-plans every live edge of the worker into a fresh queue, dropping the stale entries that pile up.
@@ -982,25 +783,19 @@ void Simplifier::simplify_with(Worker& worker) {
   worker.marks.mark.assign(pos_.size(), 0);
   rebuild_queue(worker);
   size_t rebuild_at = 4 * worker.queue.size();
-  auto live = [&](const Entry& e) { return this->live(e); };
-  Entry e;
-  // The cancel flag is looked at every kCancelEvery entries (the first one included); a worker
-  // that sees it stops, and run() throws on the calling thread.
-  for (int64_t popped = 0; worker.alive > worker.stop && worker.queue.pop(e, live); ++popped) {
-    if (popped % kCancelEvery == 0 && detail::cancelled(options_.cancel)) {
-      worker.cancelled = true;
-      break;
-    }
-    if (!live(e)) continue;
-    const int32_t remove = e.remove();
-    const Plan p = plan_direction(remove, e.keep);
-    if (p.remove < 0) continue;
-    try_collapse(worker, p);
-    if (worker.queue.size() > rebuild_at) {
-      rebuild_queue(worker);
-      rebuild_at = std::max<size_t>(4 * worker.queue.size(), 1024);
-    }
-  }
+  // A worker that sees the cancel flag stops, and run() throws on the calling thread.
+  worker.cancelled = !detail::run_collapses(
+      worker.queue, options_.cancel, [&] { return worker.alive > worker.stop; },
+      [&](const Entry& e) { return live(e); },
+      [&](const Entry& e) {
+        const Plan p = plan_direction(e.remove(), e.keep);
+        if (p.remove < 0) return;
+        try_collapse(worker, p);
+        if (worker.queue.size() > rebuild_at) {
+          rebuild_queue(worker);
+          rebuild_at = std::max<size_t>(4 * worker.queue.size(), 1024);
+        }
+      });
   worker.marks.mark = {};
 }
 
@@ -1074,21 +869,15 @@ void Simplifier::simplify_regions_serially(std::vector<Worker>& regions) {
   all.marks.mark.assign(pos_.size(), 0);
   rebuild_queue(all);
   size_t rebuild_at = 4 * all.queue.size();
-  auto live = [&](const Entry& e) { return this->live(e); };
   auto open = [&] {
     return std::any_of(regions.begin(), regions.end(), [](const Worker& w) { return w.alive > w.stop; });
   };
-  Entry e;
-  for (int64_t popped = 0; open() && all.queue.pop(e, live); ++popped) {
-    if (popped % kCancelEvery == 0 && detail::cancelled(options_.cancel)) {
-      regions[0].cancelled = true;
-      break;
-    }
-    if (!live(e)) continue;
+  const bool finished = detail::run_collapses(all.queue, options_.cancel, open, [&](const Entry& e) { return live(e); },
+                                              [&](const Entry& e) {
     Worker& region = regions[region_[e.remove()]];
-    if (region.alive <= region.stop) continue;
+    if (region.alive <= region.stop) return;
     const Plan p = plan_direction(e.remove(), e.keep);
-    if (p.remove < 0) continue;
+    if (p.remove < 0) return;
     all.stats = {};
     if (try_collapse(all, p)) --region.alive;
     region.stats.collapses += all.stats.collapses;
@@ -1099,7 +888,8 @@ void Simplifier::simplify_regions_serially(std::vector<Worker>& regions) {
       rebuild_queue(all);
       rebuild_at = std::max<size_t>(4 * all.queue.size(), 1024);
     }
-  }
+  });
+  if (!finished) regions[0].cancelled = true;
   regions[0].arena = std::move(all.arena);
 }
 
