@@ -11,8 +11,12 @@
 // placement is cheap, and the best point on an edge has a closed form.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <vector>
+
+#include "core/parallel_p.h"
 
 namespace subvec::detail {
 
@@ -63,6 +67,36 @@ std::array<double, 3> best_color(const Quadric5& q, double x, double y);
 template <class Quadrics>
 void merge_side_by_side(Quadrics& quadrics, const std::array<std::array<int32_t, 2>, 2>& pairs, int npairs) {
   for (int i = 0; i < npairs; ++i) quadrics[pairs[i][1]] += quadrics[pairs[i][0]];
+}
+
+// The quadric of every color value: the sum, in face order, of the plane quadrics of the faces with
+// a corner of that value. `corner(f, k, point)` returns the color index of corner k of face f and
+// sets its 5D point. The color indices are cut into ranges over up to `threads` threads; each
+// visits every face and computes the quadric of those with a corner in its range (when colors
+// follow the vertex order, few faces straddle two ranges and are computed twice). The sums do not
+// depend on the thread count.
+template <class Corner>
+std::vector<Quadric5> color_quadrics(int num_faces, int num_colors, int threads, const Corner& corner) {
+  std::vector<Quadric5> quadric(num_colors);
+  const int parts = std::min(resolve_threads(threads), std::max(1, num_colors / 4096));
+  parallel_for(parts, parts, [&](int part) {
+    const int32_t begin = static_cast<int32_t>(int64_t(num_colors) * part / parts);
+    const int32_t end = static_cast<int32_t>(int64_t(num_colors) * (part + 1) / parts);
+    for (int f = 0; f < num_faces; ++f) {
+      Point5 p[3];
+      int32_t color[3];
+      bool any = false;
+      for (int k = 0; k < 3; ++k) {
+        color[k] = corner(f, k, p[k]);
+        any |= color[k] >= begin && color[k] < end;
+      }
+      if (!any) continue;
+      const Quadric5 q = plane_quadric(p[0], p[1], p[2]);
+      for (int k = 0; k < 3; ++k)
+        if (color[k] >= begin && color[k] < end) quadric[color[k]] += q;
+    }
+  });
+  return quadric;
 }
 
 }  // namespace subvec::detail

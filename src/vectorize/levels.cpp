@@ -19,7 +19,6 @@
 namespace subvec {
 namespace {
 
-using detail::plane_quadric;
 using detail::Point5;
 using detail::polyline_length;
 using detail::Quadric5;
@@ -37,20 +36,15 @@ constexpr double kMaxLoosening = 8;
 std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const LevelOptions& options) {
   const int nv = c.num_vertices();
   // Quadrics per merged color value, from the triangles' 5D points.
-  std::vector<Quadric5> quadric(c.num_merged());
   const double cs = options.color_scale;
-  const auto& tri = c.triangles();
-  const auto& tcol = c.triangle_colors();
-  for (size_t f = 0; f < tri.size(); ++f) {
-    Point5 p[3];
-    for (int k = 0; k < 3; ++k) {
-      const Vec2 x = c.positions()[tri[f][k]];
-      const auto& m = c.merged_colors()[tcol[f][k]];
-      p[k] = {x.x, x.y, cs * m[0], cs * m[1], cs * m[2]};
-    }
-    const Quadric5 q = plane_quadric(p[0], p[1], p[2]);
-    for (int k = 0; k < 3; ++k) quadric[tcol[f][k]] += q;
-  }
+  std::vector<Quadric5> quadric = detail::color_quadrics(
+      static_cast<int>(c.triangles().size()), c.num_merged(), options.fit.threads, [&](int f, int k, Point5& p) {
+        const Vec2 x = c.positions()[c.triangles()[f][k]];
+        const int32_t m = c.triangle_colors()[f][k];
+        const auto& rgb = c.merged_colors()[m];
+        p = {x.x, x.y, cs * rgb[0], cs * rgb[1], cs * rgb[2]};
+        return m;
+      });
   // The simplifier's queue and greedy loop (mesh/collapse_queue_p.h): cheapest first, ties by the
   // removed and the kept vertex.
   detail::CollapseQueue queue;

@@ -58,7 +58,6 @@ using detail::best_color;
 using detail::CollapseQueue;
 using detail::Entry;
 using detail::IncidenceLists;
-using detail::plane_quadric;
 using detail::Point5;
 using detail::Quadric2;
 using detail::reduce;
@@ -355,39 +354,15 @@ void Simplifier::build_chains() {
 }
 
 void Simplifier::initial_quadrics(const std::vector<int32_t>& color_of) {
-  const int nf = mesh_.num_triangles();
-  // Quadrics per color index from the corners' 5D points, each the sum of its faces' quadrics in
-  // face order. The color indices are cut into ranges over the threads; each thread visits every
-  // face and computes the quadric of those with a corner in its range (colors follow the vertex
-  // order, so few faces straddle two ranges and are computed twice). The sums do not depend on
-  // the thread count.
-  const int nc = mesh_.num_colors();
-  quadric_.assign(nc, Quadric{});
+  // Summed in the input's face order, onto the renumbered color values.
   const double cs = options_.color_scale;
-  const int parts = std::min(detail::resolve_threads(options_.threads), std::max(1, nc / 4096));
-  detail::parallel_for(parts, parts, [&](int part) {
-    const int32_t begin = static_cast<int32_t>(int64_t(nc) * part / parts);
-    const int32_t end = static_cast<int32_t>(int64_t(nc) * (part + 1) / parts);
-    for (int f = 0; f < nf; ++f) {
-      const Tri& t = mesh_.triangles[f];
-      const Tri& colors = mesh_.triangle_colors[f];
-      int32_t target[3];
-      bool any = false;
-      for (int k = 0; k < 3; ++k) {
-        target[k] = color_of[colors[k]];
-        any |= target[k] >= begin && target[k] < end;
-      }
-      if (!any) continue;
-      Point5 p[3];
-      for (int k = 0; k < 3; ++k) {
-        const Vec2 x = pos_[t[k]];
-        const Color c = mesh_.colors[colors[k]];
-        p[k] = {x.x, x.y, cs * c.r, cs * c.g, cs * c.b};
-      }
-      const Quadric q = plane_quadric(p[0], p[1], p[2]);
-      for (int k = 0; k < 3; ++k)
-        if (target[k] >= begin && target[k] < end) quadric_[target[k]] += q;
-    }
+  quadric_ = detail::color_quadrics(mesh_.num_triangles(), mesh_.num_colors(), options_.threads,
+                                    [&](int f, int k, Point5& p) {
+    const Vec2 x = pos_[mesh_.triangles[f][k]];
+    const int32_t c = mesh_.triangle_colors[f][k];
+    const Color rgb = mesh_.colors[c];
+    p = {x.x, x.y, cs * rgb.r, cs * rgb.g, cs * rgb.b};
+    return color_of[c];
   });
 }
 
