@@ -238,8 +238,9 @@ inline constexpr int64_t kCancelEvery = 4096;
 template <class More, class Live, class Step>
 bool run_collapses(CollapseQueue& queue, const std::atomic<bool>* cancel, More&& more, Live&& live, Step&& step) {
   Entry e;
-  for (int64_t popped = 0; more() && queue.pop(e, live); ++popped) {
-    if (popped % kCancelEvery == 0 && cancelled(cancel)) return false;
+  for (int64_t popped = 0; more(); ++popped) {
+    if (popped % kCancelEvery == 0 && cancelled(cancel)) return false;  // before taking an entry
+    if (!queue.pop(e, live)) break;
     if (!live(e)) continue;
     step(e);
   }
