@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 
 #include "core/geometry_p.h"
@@ -65,9 +66,7 @@ Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::
   sides_.assign(nv, 0);
   kind_.assign(nv, Kind::kSmooth);
   for (int v = 0; v < nv; ++v) {
-    const Vec2 p = pos_[v];
-    sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == width ? 4 : 0) |
-                                     (p.y == height ? 8 : 0));
+    sides_[v] = detail::image_sides(pos_[v], width, height);
     switch (topo.vertex_tags[v]) {
       case VertexTag::kSmooth: kind_[v] = Kind::kSmooth; break;
       case VertexTag::kTear: kind_[v] = Kind::kTear; break;
@@ -75,37 +74,9 @@ Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::
       case VertexTag::kCorner: kind_[v] = Kind::kCorner; break;
     }
   }
-  chain_of_.assign(nv, -1);
-  for (const Feature& f : merged.features) {
-    Chain c;
-    c.id = f.id;
-    c.saliency = f.saliency;
-    c.closed = f.closed();
-    c.nodes.assign(f.vertices.begin(), f.vertices.end() - (c.closed ? 1 : 0));
-    for (size_t i = 0; i < c.nodes.size(); ++i) {
-      c.original.push_back(static_cast<int32_t>(i));
-      c.points.push_back(pos_[c.nodes[i]]);
-      if (kind_[c.nodes[i]] == Kind::kTear) chain_of_[c.nodes[i]] = static_cast<int32_t>(chains_.size());
-    }
-    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) tear_edges_.insert(key(f.vertices[i], f.vertices[i + 1]));
-    chains_.push_back(std::move(c));
-  }
-  // A vertex that is a tear by its edges but lies on two chains (two features meeting end to end)
-  // is a chain end: keep it.
-  for (int v = 0; v < nv; ++v)
-    if (kind_[v] == Kind::kTear && chain_slot(v) < 0) kind_[v] = Kind::kCorner;
-}
-
-int Coarsener::chain_slot(int32_t v) const {
-  const int32_t c = chain_of_[v];
-  if (c < 0) return -1;
-  const auto& nodes = chains_[c].nodes;
-  const auto it = std::find(nodes.begin(), nodes.end(), v);
-  if (it == nodes.end()) return -1;
-  const int slot = static_cast<int>(it - nodes.begin());
-  // An open chain's ends are corners, never tear vertices.
-  if (!chains_[c].closed && (slot == 0 || slot + 1 == static_cast<int>(nodes.size()))) return -1;
-  return slot;
+  // A vertex that is a tear by its edges but ends a chain (two features meeting end to end) is a
+  // chain end: it stays.
+  chains_.build(merged.features, pos_, kind_);
 }
 
 void Coarsener::neighbours(int32_t v, std::vector<int32_t>& out) const {
@@ -143,20 +114,20 @@ bool Coarsener::can_collapse(int32_t u, int32_t v, double feature_tolerance, dou
   const int nf = faces_with_edge(u, v, faces);
   if (nf < 1 || nf > 2) return false;
   const auto along_chain = [&] {
-    const int slot = chain_slot(u);
-    if (slot < 0) return false;
-    const Chain& c = chains_[chain_of_[u]];
-    const int n = static_cast<int>(c.nodes.size());
-    if (c.closed && n <= 4) return false;
-    const int prev = slot > 0 ? slot - 1 : n - 1, next = slot + 1 < n ? slot + 1 : 0;
-    if (c.nodes[prev] != v && c.nodes[next] != v) return false;
-    // The chain's points from prev to next (u's among them) must stay near the new edge.
-    const Vec2 a = pos_[c.nodes[prev]], b = pos_[c.nodes[next]];
-    const int np = static_cast<int>(c.points.size());
-    for (int i = c.original[prev] + 1;; ++i) {
+    const int32_t node = chains_.node_of[u];
+    if (node < 0) return false;
+    const detail::Chain& c = chains_.chains[chains_.chain_of[u]];
+    if (c.closed && c.size <= 4) return false;
+    const detail::ChainNode& prev = chains_.nodes[chains_.nodes[node].prev];
+    const detail::ChainNode& next = chains_.nodes[chains_.nodes[node].next];
+    if (prev.vertex != v && next.vertex != v) return false;
+    // The chain's initial points from prev to next (u's among them) must stay near the new edge.
+    const Vec2 a = pos_[prev.vertex], b = pos_[next.vertex];
+    const int np = static_cast<int>(c.target.size());
+    for (int i = static_cast<int>(prev.param) + 1;; ++i) {
       const int j = i % np;
-      if (j == c.original[next]) break;
-      if (detail::segment_distance(c.points[j], a, b) > feature_tolerance) return false;
+      if (j == static_cast<int>(next.param)) break;
+      if (detail::segment_distance(c.target[j], a, b) > feature_tolerance) return false;
     }
     return true;
   };
@@ -192,12 +163,10 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   std::vector<int32_t> ring;
   neighbours(u, ring);
   std::array<int32_t, 2> chain_nbrs{-1, -1};
-  int tear_slot = -1;
-  if (kind_[u] == Kind::kTear) {
-    tear_slot = chain_slot(u);
-    const auto& nodes = chains_[chain_of_[u]].nodes;
-    const int n = static_cast<int>(nodes.size());
-    chain_nbrs = {nodes[tear_slot > 0 ? tear_slot - 1 : n - 1], nodes[tear_slot + 1 < n ? tear_slot + 1 : 0]};
+  const bool tear = kind_[u] == Kind::kTear;
+  if (tear) {
+    const detail::ChainNode& node = chains_.nodes[chains_.node_of[u]];
+    chain_nbrs = {chains_.nodes[node.prev].vertex, chains_.nodes[node.next].vertex};
     r.position_ring = {chain_nbrs[0], chain_nbrs[1]};
   } else if (kind_[u] == Kind::kBorder) {
     for (int32_t w : ring)
@@ -210,7 +179,7 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   // color serves both sides would pull the jump toward zero. Failing those, from the rest of the
   // same side.
   std::array<bool, 2> one_sided{false, false};
-  if (tear_slot >= 0) {
+  if (tear) {
     for (int i = 0; i < 2; ++i) {
       int32_t seen = -1;
       bool single = true;
@@ -243,7 +212,7 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
         w.neighbours.push_back({x, tcol_[f][k]});
       }
     }
-    if (tear_slot >= 0) {
+    if (tear) {
       auto along = [&](const std::pair<int32_t, int32_t>& n) {
         return (n.first == chain_nbrs[0] && !one_sided[0]) || (n.first == chain_nbrs[1] && !one_sided[1]);
       };
@@ -264,68 +233,23 @@ CollapseRecord Coarsener::collapse(int32_t u, int32_t v) {
   // Apply: u's faces take v, with v's color on their side; the faces on the edge die.
   std::array<std::array<int32_t, 2>, 2> pairs;
   const int npairs = edge_color_pairs(u, v, pairs);
-  const std::vector<int32_t> faces_of_u(vfaces_[u].begin(), vfaces_[u].end());
-  detail::collapse_faces(
-      faces_of_u, tri_, tcol_, u, v, pairs, npairs,
-      [&](int32_t f) {
-        face_alive_[f] = 0;
-        for (int32_t w : tri_[f])
-          if (w != u) vfaces_.erase(w, f);
-      },
-      [&](int32_t f) { vfaces_.push_back(v, f, arena_); });
-  vfaces_.clear(u);
-  vertex_alive_[u] = 0;
+  std::vector<int32_t> scratch;
+  detail::collapse_incidence(u, v, pairs, npairs, tri_, tcol_, vfaces_, face_alive_, vertex_alive_, arena_, scratch);
   --alive_count_;
-  if (tear_slot >= 0) {
-    Chain& c = chains_[chain_of_[u]];
-    c.nodes.erase(c.nodes.begin() + tear_slot);
-    c.original.erase(c.original.begin() + tear_slot);
-    tear_edges_.erase(key(u, chain_nbrs[0]));
-    tear_edges_.erase(key(u, chain_nbrs[1]));
-    tear_edges_.insert(key(chain_nbrs[0], chain_nbrs[1]));
-    chain_of_[u] = -1;
-  }
+  if (tear) chains_.unlink(u);  // its two chain edges become one
   return r;
 }
 
 ControlMesh Coarsener::result(std::vector<int32_t>& parents, std::vector<int32_t>& color_merged) const {
-  ControlMesh out;
-  std::vector<int32_t> vmap(pos_.size(), -1), cmap(merged_.size(), -1);
+  std::vector<int32_t> order(tri_.size()), vmap;
+  std::iota(order.begin(), order.end(), 0);
+  ControlMesh out = detail::live_mesh(pos_, vertex_alive_, tri_, tcol_, face_alive_, order, num_merged(), creases_, chains_,
+                                      [&](int32_t m, int32_t) {
+    return Color{static_cast<float>(merged_[m][0]), static_cast<float>(merged_[m][1]), static_cast<float>(merged_[m][2])};
+  }, vmap, color_merged);
   parents.clear();
-  color_merged.clear();
-  for (size_t v = 0; v < pos_.size(); ++v) {
-    if (!vertex_alive_[v]) continue;
-    vmap[v] = out.num_vertices();
-    out.positions.push_back(pos_[v]);
-    parents.push_back(static_cast<int32_t>(v));
-  }
-  for (size_t f = 0; f < tri_.size(); ++f) {
-    if (!face_alive_[f]) continue;
-    Tri t, c;
-    for (int k = 0; k < 3; ++k) {
-      t[k] = vmap[tri_[f][k]];
-      int32_t& ci = cmap[tcol_[f][k]];
-      if (ci < 0) {
-        ci = out.num_colors();
-        const Rgb& m = merged_[tcol_[f][k]];
-        out.colors.push_back({static_cast<float>(m[0]), static_cast<float>(m[1]), static_cast<float>(m[2])});
-        color_merged.push_back(tcol_[f][k]);
-      }
-      c[k] = ci;
-    }
-    out.triangles.push_back(t);
-    out.triangle_colors.push_back(c);
-  }
-  for (const EdgeVerts& e : creases_)
-    if (vmap[e[0]] >= 0 && vmap[e[1]] >= 0) out.creases.push_back({vmap[e[0]], vmap[e[1]]});
-  for (const Chain& c : chains_) {
-    Feature g;
-    g.id = c.id;
-    g.saliency = c.saliency;
-    for (int32_t v : c.nodes) g.vertices.push_back(vmap[v]);
-    if (c.closed) g.vertices.push_back(g.vertices.front());
-    out.features.push_back(std::move(g));
-  }
+  for (size_t v = 0; v < vmap.size(); ++v)
+    if (vmap[v] >= 0) parents.push_back(static_cast<int32_t>(v));
   return out;
 }
 

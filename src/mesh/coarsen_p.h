@@ -13,12 +13,12 @@
 
 #include <array>
 #include <cstdint>
-#include <unordered_set>
 #include <utility>
 #include <vector>
 
+#include "mesh/chains_p.h"
 #include "mesh/collapse_p.h"
-#include "mesh/collapse_queue_p.h"
+#include "mesh/collapse_engine_p.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec::coarsen_detail {
@@ -81,37 +81,20 @@ class Coarsener {
 
  private:
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
-  bool tear_edge(int32_t a, int32_t b) const { return tear_edges_.count(key(a, b)) > 0; }
+  bool tear_edge(int32_t a, int32_t b) const { return chains_.tear_edge(a, b); }
   bool sharp_edge(int32_t a, int32_t b) const;
   bool has_edge(int32_t a, int32_t b) const;
-  static uint64_t key(int32_t a, int32_t b) {
-    if (a > b) std::swap(a, b);
-    return (uint64_t{static_cast<uint32_t>(a)} << 32) | static_cast<uint32_t>(b);
-  }
-  // Position of v in its chain's node list, or -1.
-  int chain_slot(int32_t v) const;
-
-  struct Chain {
-    int32_t id = 0;
-    double saliency = 0;
-    bool closed = false;
-    std::vector<int32_t> nodes;     // live vertices in order (closed: first not repeated)
-    std::vector<int32_t> original;  // each node's index into `points`
-    std::vector<Vec2> points;       // the chain this step started from
-  };
 
   int width_, height_;
   std::vector<Vec2> pos_;
   std::vector<Tri> tri_, tcol_;
   std::vector<uint8_t> face_alive_, vertex_alive_, sides_;
-  detail::IncidenceLists vfaces_;  // the simplifier's incidence lists (collapse_queue_p.h)
+  detail::IncidenceLists vfaces_;  // the engine's incidence lists (collapse_engine_p.h)
   detail::Arena arena_;             // where they grow
   std::vector<Kind> kind_;
   std::vector<int32_t> merged_of_;
   std::vector<Rgb> merged_;
-  std::vector<Chain> chains_;
-  std::vector<int32_t> chain_of_;  // chain of a tear vertex, else -1
-  std::unordered_set<uint64_t> tear_edges_;
+  detail::FeatureChains chains_;  // the kept features, as the simplifier's linked nodes
   std::vector<EdgeVerts> creases_;
   mutable detail::VertexMarks marks_;  // scratch for can_collapse
   int alive_count_ = 0;

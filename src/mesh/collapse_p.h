@@ -20,6 +20,12 @@ namespace subvec::detail {
 // corners, on a tear (feature) chain, or a corner (image corner, feature end, junction).
 enum class VertexKind : uint8_t { kSmooth, kBorder, kTear, kCorner };
 
+// Which sides of the width x height image p lies on, as a bit mask: 1 x = 0, 2 y = 0, 4 x = width,
+// 8 y = height (two bits at an image corner).
+inline uint8_t image_sides(Vec2 p, int width, int height) {
+  return static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == width ? 4 : 0) | (p.y == height ? 8 : 0));
+}
+
 // The paper's constraints on removing u into its neighbour v over an edge with `edge_faces` faces,
 // by their kinds (§4; §5 for the levels): a corner stays; a smooth vertex may go into any
 // neighbour; a border vertex only along its image side (`same_side`) over a border edge (one face)

@@ -10,7 +10,7 @@
 #include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "mesh/coarsen_p.h"
-#include "mesh/collapse_queue_p.h"
+#include "mesh/collapse_engine_p.h"
 #include "mesh/polyline_p.h"
 #include "mesh/quadric_p.h"
 #include "subvec/core/error.h"
@@ -45,7 +45,7 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
         p = {x.x, x.y, cs * rgb[0], cs * rgb[1], cs * rgb[2]};
         return m;
       });
-  // The simplifier's queue and greedy loop (mesh/collapse_queue_p.h): cheapest first, ties by the
+  // The simplifier's queue and greedy loop (mesh/collapse_engine_p.h): cheapest first, ties by the
   // removed and the kept vertex.
   detail::CollapseQueue queue;
   std::vector<uint32_t> version(nv, 0);

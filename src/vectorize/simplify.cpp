@@ -15,7 +15,7 @@
 // max_feature_error. No collapse may break the link condition or flip or flatten a triangle.
 //
 // Speed. Collapses are cheapest first from a lazy queue whose front alone is a heap (binned by
-// cost, mesh/collapse_queue_p.h). Faces and color values are renumbered in vertex order for locality.
+// cost, mesh/collapse_engine_p.h). Faces and color values are renumbered in vertex order for locality.
 // Most collapses run in parallel: the image is cut into 2 x 2 regions with frozen seams, each
 // simplified on its own (a Worker per region, writing only what it owns) down to the target plus its
 // frozen vertices, then one global pass finishes. The region phase is exactly one global pass with
@@ -24,7 +24,7 @@
 // does not depend on the thread count.
 //
 // The 5D quadric, the collapse of faces and colors, the queue and the incidence lists are the
-// levels' too (mesh/quadric_p.h, mesh/collapse_p.h, mesh/collapse_queue_p.h), and so is the greedy
+// levels' too (mesh/quadric_p.h, mesh/collapse_p.h, mesh/collapse_engine_p.h), and so is the greedy
 // loop (run_collapses).
 #include "subvec/vectorize/simplify.h"
 
@@ -43,8 +43,9 @@
 
 #include "core/cancel_p.h"
 #include "core/parallel_p.h"
+#include "mesh/chains_p.h"
 #include "mesh/collapse_p.h"
-#include "mesh/collapse_queue_p.h"
+#include "mesh/collapse_engine_p.h"
 #include "mesh/quadric_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
@@ -72,23 +73,6 @@ std::array<double, 4> bspline(double s) {
           s * s * s / 6};
 }
 
-// Feature chains are doubly linked lists of nodes, so that removing a vertex and visiting its
-// neighbourhood along the chain cost O(1) whatever the feature's length.
-struct Node {
-  int32_t vertex;
-  int32_t prev = -1, next = -1;  // -1 at the ends of an open chain
-  double param;                  // position along the detected polyline, in target indices
-  bool alive = true;
-};
-
-struct FeatureState {
-  int32_t head = -1;            // first node (any node of a closed chain)
-  int32_t size = 0;             // live nodes
-  std::vector<Vec2> target;     // the detected polyline (initial chain positions)
-  bool closed = false;
-  int32_t id = 0;
-  double saliency = 0;
-};
 
 class Simplifier {
  public:
@@ -124,7 +108,6 @@ class Simplifier {
   void renumber_for_locality(std::vector<int32_t>& face_of, std::vector<int32_t>& color_of);
   void build_incidence(const std::vector<int32_t>& face_of);
   void classify_vertices();
-  void build_chains();
   void initial_quadrics(const std::vector<int32_t>& color_of);
   void split_regions(int num_regions_x, int num_regions_y);
   bool owns(const Worker& w, int32_t v) const {
@@ -145,8 +128,6 @@ class Simplifier {
   bool image_corner(Vec2 p) const { return (p.x == 0 || p.x == w_) && (p.y == 0 || p.y == h_); }
   bool sharp(int32_t v) const { return kind_[v] == Kind::kTear || kind_[v] == Kind::kCorner; }
   int faces_with_edge(int32_t u, int32_t v, int32_t* out) const;
-  bool feature_neighbour(int32_t u, int32_t v) const;
-  bool tear_edge(int32_t a, int32_t b) const;
   void write_back();
 
   // Feature refit (eq. 1), in three steps: the window of chain nodes it reads and moves, the rows
@@ -168,7 +149,7 @@ class Simplifier {
     Vec2 target;
   };
   bool refit_window(int32_t removed, RefitWindow& out) const;
-  void fit_rows(const RefitWindow& win, const FeatureState& f, std::vector<FitRow>& rows) const;
+  void fit_rows(const RefitWindow& win, const detail::Chain& f, std::vector<FitRow>& rows) const;
   double refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8>& moved, int& num_moved) const;
 
   ControlMesh& mesh_;
@@ -183,14 +164,10 @@ class Simplifier {
   IncidenceLists vfaces_;
   std::vector<Kind> kind_;
   std::vector<uint8_t> sides_;     // bit mask: 1 x=0, 2 y=0, 4 x=W, 8 y=H
-  std::vector<int32_t> feature_;   // feature index of tear vertices, else -1
-  std::vector<int32_t> node_of_;   // node of tear vertices, else -1
-  std::vector<Node> nodes_;
-  std::vector<int32_t> corner_node_offsets_, corner_nodes_;  // chain nodes of non-tear vertices, CSR
   std::vector<int32_t> only_color_;  // the color of a vertex with one color value, else -1
   std::vector<uint32_t> version_;
   std::vector<Quadric> quadric_;   // per color index
-  std::vector<FeatureState> features_;
+  detail::FeatureChains chains_;   // the features, as linked nodes
   std::vector<Arena> arenas_;     // where incidence lists grew
   std::vector<int16_t> region_;   // region of each vertex in the parallel phase
   std::vector<uint8_t> frozen_;   // left alone in the parallel phase (seams, shared closed features)
@@ -204,7 +181,7 @@ void Simplifier::setup() {
   renumber_for_locality(face_of, color_of);
   build_incidence(face_of);
   classify_vertices();
-  build_chains();
+  chains_.build(mesh_.features, pos_, kind_);  // the refit's targets (eq. 1)
   initial_quadrics(color_of);
 }
 
@@ -276,10 +253,7 @@ void Simplifier::classify_vertices() {
   // one side of the image (in a valid mesh no other edge does), creases are listed, tears are the
   // features' edges; feature ends and the image corners are corners.
   sides_.assign(nv, 0);
-  for (int v = 0; v < nv; ++v) {
-    const Vec2 p = pos_[v];
-    sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == w_ ? 4 : 0) | (p.y == h_ ? 8 : 0));
-  }
+  for (int v = 0; v < nv; ++v) sides_[v] = detail::image_sides(pos_[v], w_, h_);
   std::vector<uint8_t> creases(nv, 0), tears(nv, 0), corner(nv, 0);
   for (int v = 0; v < nv; ++v) {
     if (!sides_[v]) continue;
@@ -309,48 +283,6 @@ void Simplifier::classify_vertices() {
     else kind_[v] = Kind::kCorner;
   }
 
-}
-
-// The feature chains as linked nodes; their initial positions are the targets of the refit (eq. 1).
-void Simplifier::build_chains() {
-  const int nv = mesh_.num_vertices();
-  feature_.assign(nv, -1);
-  node_of_.assign(nv, -1);
-  for (const Feature& f : mesh_.features) {
-    FeatureState s;
-    s.id = f.id;
-    s.saliency = f.saliency;
-    s.closed = f.closed();
-    const size_t n = f.vertices.size() - (s.closed ? 1 : 0);
-    const int32_t first = static_cast<int32_t>(nodes_.size());
-    s.head = first;
-    s.size = static_cast<int32_t>(n);
-    for (size_t i = 0; i < n; ++i) {
-      const int32_t v = f.vertices[i];
-      Node node{v, -1, -1, 0.0, true};
-      node.param = static_cast<double>(i);
-      node.prev = i > 0 ? first + static_cast<int32_t>(i) - 1 : (s.closed ? first + static_cast<int32_t>(n) - 1 : -1);
-      node.next = i + 1 < n ? first + static_cast<int32_t>(i) + 1 : (s.closed ? first : -1);
-      s.target.push_back(pos_[v]);
-      if (kind_[v] == Kind::kTear) {
-        feature_[v] = static_cast<int32_t>(features_.size());
-        node_of_[v] = static_cast<int32_t>(nodes_.size());
-      }
-      nodes_.push_back(node);
-    }
-    features_.push_back(std::move(s));
-  }
-  // Chain nodes at corners (a corner may end or join several chains), for tear edge lookups.
-  corner_node_offsets_.assign(size_t(nv) + 1, 0);
-  for (const Node& n : nodes_)
-    if (kind_[n.vertex] != Kind::kTear) ++corner_node_offsets_[n.vertex + 1];
-  std::partial_sum(corner_node_offsets_.begin(), corner_node_offsets_.end(), corner_node_offsets_.begin());
-  corner_nodes_.resize(corner_node_offsets_.back());
-  {
-    std::vector<int32_t> fill(corner_node_offsets_.begin(), corner_node_offsets_.end() - 1);
-    for (int32_t i = 0; i < static_cast<int32_t>(nodes_.size()); ++i)
-      if (kind_[nodes_[i].vertex] != Kind::kTear) corner_nodes_[fill[nodes_[i].vertex]++] = i;
-  }
 }
 
 void Simplifier::initial_quadrics(const std::vector<int32_t>& color_of) {
@@ -383,27 +315,6 @@ int Simplifier::faces_with_edge(int32_t u, int32_t v, int32_t* out) const {
   return detail::faces_with_edge(vfaces_[u], tri_, v, out);
 }
 
-// Whether (a, b) is a tear edge: consecutive in a feature chain.
-bool Simplifier::tear_edge(int32_t a, int32_t b) const {
-  auto linked = [&](int32_t node, int32_t other) {
-    const Node& n = nodes_[node];
-    return (n.prev >= 0 && nodes_[n.prev].vertex == other) || (n.next >= 0 && nodes_[n.next].vertex == other);
-  };
-  if (node_of_[a] >= 0) return linked(node_of_[a], b);
-  if (node_of_[b] >= 0) return linked(node_of_[b], a);
-  for (int32_t i = corner_node_offsets_[a]; i < corner_node_offsets_[a + 1]; ++i)
-    if (linked(corner_nodes_[i], b)) return true;
-  return false;
-}
-
-// Whether (u, v) is an edge of u's feature chain.
-bool Simplifier::feature_neighbour(int32_t u, int32_t v) const {
-  const int32_t n = node_of_[u];
-  if (n < 0) return false;
-  const Node& node = nodes_[n];
-  return (node.prev >= 0 && nodes_[node.prev].vertex == v) || (node.next >= 0 && nodes_[node.next].vertex == v);
-}
-
 Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
   Plan p;
   const Kind ku = kind_[u], kv = kind_[v];
@@ -420,8 +331,8 @@ Simplifier::Plan Simplifier::plan_direction(int32_t u, int32_t v) const {
     const int nfaces = faces_with_edge(u, v, faces);
     if (nfaces < 1 || nfaces > 2) return p;
     const auto along_chain = [&] {
-      const FeatureState& f = features_[feature_[u]];
-      return (kv == Kind::kTear || kv == Kind::kCorner) && feature_neighbour(u, v) && !(f.closed && f.size <= 4);
+      const detail::Chain& f = chains_.chains[chains_.chain_of[u]];
+      return (kv == Kind::kTear || kv == Kind::kCorner) && chains_.chain_neighbour(u, v) && !(f.closed && f.size <= 4);
     };
     if (!detail::kinds_allow_collapse(ku, kv, nfaces, (sides_[u] & sides_[v]) != 0, along_chain)) return p;
 
@@ -501,23 +412,23 @@ void Simplifier::rebuild_queue(Worker& worker) {
 // Windows stop early at corners ("hard" ends).
 bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
   out = RefitWindow{};
-  const Node& r = nodes_[removed];
-  const FeatureState& f = features_[feature_[r.vertex]];
+  const detail::ChainNode& r = chains_.nodes[removed];
+  const detail::Chain& f = chains_.chains[chains_.chain_of[r.vertex]];
   std::array<int32_t, 2 * kRefitReach + 1> back{}, fwd{};
   int nb = 0, nf = 0;
   bool& hard_start = out.hard_start;
   bool& hard_end = out.hard_end;
-  for (int32_t n = r.prev;; n = nodes_[n].prev) {
+  for (int32_t n = r.prev;; n = chains_.nodes[n].prev) {
     if (n < 0 || n == removed) { hard_start = true; break; }
     back[nb++] = n;
-    if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_start = true; break; }
+    if (kind_[chains_.nodes[n].vertex] == Kind::kCorner) { hard_start = true; break; }
     if (nb == kRefitReach) break;
   }
-  for (int32_t n = r.next;; n = nodes_[n].next) {
+  for (int32_t n = r.next;; n = chains_.nodes[n].next) {
     if (n < 0 || n == removed) { hard_end = true; break; }
     if (nb > 0 && n == back[nb - 1] && !hard_start) break;  // a short loop met itself
     fwd[nf++] = n;
-    if (kind_[nodes_[n].vertex] == Kind::kCorner) { hard_end = true; break; }
+    if (kind_[chains_.nodes[n].vertex] == Kind::kCorner) { hard_end = true; break; }
     if (nf == kRefitReach) break;
   }
   // Window w_0..w_K in chain order; `centre` is the index of the node after the removal.
@@ -530,7 +441,7 @@ bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
   bool& periodic = out.periodic;
   if (f.closed && !hard_start && !hard_end && f.size - 1 <= 2 * kRefitReach) {
     std::vector<int32_t> loop;
-    for (int32_t n = r.next; n != removed && static_cast<int>(loop.size()) < f.size; n = nodes_[n].next) loop.push_back(n);
+    for (int32_t n = r.next; n != removed && static_cast<int>(loop.size()) < f.size; n = chains_.nodes[n].next) loop.push_back(n);
     count = 0;
     for (int32_t n : loop) win[count++] = n;
     periodic = true;
@@ -545,7 +456,7 @@ bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
   for (int k = periodic ? 0 : centre - 2; k <= (periodic ? K : centre + 1); ++k) {
     if (!slot_ok(k)) continue;
     if (periodic && nfree == 4) break;
-    if (kind_[nodes_[win[wrap(k)]].vertex] == Kind::kTear) free_slots[nfree++] = wrap(k);
+    if (kind_[chains_.nodes[win[wrap(k)]].vertex] == Kind::kTear) free_slots[nfree++] = wrap(k);
   }
   // Segments k (between w_k and w_{k+1}) that the removal or a free node can change, and that the
   // window can evaluate (soft ends need one more node of context).
@@ -563,14 +474,14 @@ bool Simplifier::refit_window(int32_t removed, RefitWindow& out) const {
 
 // The rows of eq. 1 over the window's segments: each target point of the detected polyline
 // between two nodes, and the limit curve at its parameter as weights on the window's slots.
-void Simplifier::fit_rows(const RefitWindow& win, const FeatureState& f, std::vector<FitRow>& rows) const {
+void Simplifier::fit_rows(const RefitWindow& win, const detail::Chain& f, std::vector<FitRow>& rows) const {
   const int K = win.K(), total = static_cast<int>(f.target.size());
   const bool periodic = win.periodic;
   auto wrap = [&](int k) { return win.wrap(k); };
   rows.clear();
   for (int k = win.seg_lo; k <= win.seg_hi; ++k) {
-    const double p0 = nodes_[win.win[wrap(k)]].param;
-    double p1 = nodes_[win.win[wrap(k + 1)]].param;
+    const double p0 = chains_.nodes[win.win[wrap(k)]].param;
+    double p1 = chains_.nodes[win.win[wrap(k + 1)]].param;
     if (p1 <= p0) p1 += total;  // wraps around a closed target
     const int j_begin = static_cast<int>(std::ceil(p0));
     const int j_end = static_cast<int>(std::floor(p1)) - (k < win.seg_hi && p1 == std::floor(p1) ? 1 : 0);
@@ -611,12 +522,12 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
   RefitWindow window;
   if (!refit_window(removed, window)) return 0;
   thread_local std::vector<FitRow> rows;
-  fit_rows(window, features_[feature_[nodes_[removed].vertex]], rows);
+  fit_rows(window, chains_.chains[chains_.chain_of[chains_.nodes[removed].vertex]], rows);
   const auto& win = window.win;
   const int count = window.count, nfree = window.nfree;
   const auto& free_slots = window.free_slots;
   std::array<Vec2, 2 * kRefitReach + 2> q;
-  for (int i = 0; i < count; ++i) q[i] = pos_[nodes_[win[i]].vertex];
+  for (int i = 0; i < count; ++i) q[i] = pos_[chains_.nodes[win[i]].vertex];
   if (nfree > 0 && !rows.empty()) {
     // Normal equations of the small least-squares problem (eq. 1), x and y at once, with a light
     // pull toward the current positions for free nodes that no target point constrains.
@@ -649,7 +560,7 @@ double Simplifier::refit(int32_t removed, std::array<std::pair<int32_t, Vec2>, 8
     const Eigen::Matrix<double, 4, 2> x = ata.ldlt().solve(atb);
     for (int i = 0; i < nfree && num_moved < 8; ++i) {
       q[free_slots[i]] = {x(i, 0), x(i, 1)};
-      moved[num_moved++] = {nodes_[win[free_slots[i]]].vertex, q[free_slots[i]]};
+      moved[num_moved++] = {chains_.nodes[win[free_slots[i]]].vertex, q[free_slots[i]]};
     }
   }
   double worst = 0;
@@ -665,7 +576,7 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   const int32_t u = e.remove, v = e.keep;
   SimplifyStats& stats = worker.stats;
   // A collapse along a feature refits nodes up to five away: they must all be the worker's.
-  const int32_t removed_node = kind_[u] == Kind::kTear ? node_of_[u] : -1;
+  const int32_t removed_node = kind_[u] == Kind::kTear ? chains_.node_of[u] : -1;
   if (removed_node >= 0 && !owns_window(worker, removed_node)) return false;
   {
     int32_t faces[2];
@@ -675,7 +586,7 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
       return false;
     }
     // Two tear edges of a dying triangle (u, v, w) would merge into one edge claimed twice.
-    const auto sharp_tear_edge = [&](int32_t a, int32_t b) { return sharp(a) && sharp(b) && tear_edge(a, b); };
+    const auto sharp_tear_edge = [&](int32_t a, int32_t b) { return sharp(a) && sharp(b) && chains_.tear_edge(a, b); };
     if (detail::folds_sharp_edges(faces, std::min(nfaces, 2), tri_, u, v, sharp_tear_edge)) {
       ++stats.rejected_topology;
       return false;
@@ -717,30 +628,11 @@ bool Simplifier::try_collapse(Worker& worker, const Plan& e) {
   std::array<std::array<int32_t, 2>, 2> pairs;
   const int npairs = detail::edge_color_pairs(faces, nfaces, tri_, tcol_, u, v, pairs);
   detail::merge_side_by_side(quadric_, pairs, npairs);
-  std::vector<int32_t>& faces_of_u = worker.faces;
-  faces_of_u.assign(vfaces_[u].begin(), vfaces_[u].end());  // v's list may move
-  detail::collapse_faces(
-      faces_of_u, tri_, tcol_, u, v, pairs, npairs,
-      [&](int32_t f) {
-        face_alive_[f] = 0;
-        for (int32_t w : tri_[f])
-          if (w != u) vfaces_.erase(w, f);
-      },
-      [&](int32_t f) { vfaces_.push_back(v, f, worker.arena); });
-  vfaces_.clear(u);
-  vertex_alive_[u] = 0;
+  detail::collapse_incidence(u, v, pairs, npairs, tri_, tcol_, vfaces_, face_alive_, vertex_alive_, worker.arena,
+                             worker.faces);  // v's list may move
   --worker.alive;
   for (int i = 0; i < num_moved; ++i) pos_[moved[i].first] = moved[i].second;
-  if (removed_node >= 0) {  // unlink the node; its two chain edges become one
-    Node& n = nodes_[removed_node];
-    FeatureState& f = features_[feature_[u]];
-    if (n.prev >= 0) nodes_[n.prev].next = n.next;
-    if (n.next >= 0) nodes_[n.next].prev = n.prev;
-    if (f.head == removed_node) f.head = n.next;
-    n.alive = false;
-    std::atomic_ref<int32_t>(f.size).fetch_sub(1, std::memory_order_relaxed);  // an open chain may span workers
-    node_of_[u] = -1;
-  }
+  if (removed_node >= 0) chains_.unlink(u);  // its two chain edges become one
   ++stats.collapses;
 
   // Costs change around v and every moved vertex.
@@ -884,16 +776,16 @@ void Simplifier::split_regions(int nx, int ny) {
     if (region_[t[0]] == region_[t[1]] && region_[t[1]] == region_[t[2]]) continue;
     for (int32_t v : t) frozen_[v] = 1;
   }
-  for (const FeatureState& f : features_) {
+  for (const detail::Chain& f : chains_.chains) {
     if (!f.closed) continue;
     bool shared = false;
     int32_t n = f.head;
-    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) {
-      const int32_t v = nodes_[n].vertex;
-      shared |= frozen_[v] || region_[v] != region_[nodes_[f.head].vertex];
+    for (int32_t i = 0; i < f.size; ++i, n = chains_.nodes[n].next) {
+      const int32_t v = chains_.nodes[n].vertex;
+      shared |= frozen_[v] || region_[v] != region_[chains_.nodes[f.head].vertex];
     }
     if (!shared) continue;
-    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) frozen_[nodes_[n].vertex] = 1;
+    for (int32_t i = 0; i < f.size; ++i, n = chains_.nodes[n].next) frozen_[chains_.nodes[n].vertex] = 1;
   }
 }
 
@@ -904,57 +796,26 @@ bool Simplifier::owns_window(const Worker& worker, int32_t removed_node) const {
   constexpr int kReach = kRefitReach;
   for (int direction = 0; direction < 2; ++direction) {
     int count = 0;
-    for (int32_t n = direction ? nodes_[removed_node].next : nodes_[removed_node].prev; n >= 0 && n != removed_node;
-         n = direction ? nodes_[n].next : nodes_[n].prev) {
-      if (!owns(worker, nodes_[n].vertex)) return false;
-      if (kind_[nodes_[n].vertex] == Kind::kCorner || ++count == kReach) break;
+    for (int32_t n = direction ? chains_.nodes[removed_node].next : chains_.nodes[removed_node].prev; n >= 0 && n != removed_node;
+         n = direction ? chains_.nodes[n].next : chains_.nodes[n].prev) {
+      if (!owns(worker, chains_.nodes[n].vertex)) return false;
+      if (kind_[chains_.nodes[n].vertex] == Kind::kCorner || ++count == kReach) break;
     }
   }
   return true;
 }
 
 void Simplifier::write_back() {
-  ControlMesh out;
-  std::vector<int32_t> vmap(pos_.size(), -1), cmap(quadric_.size(), -1);
-  for (size_t v = 0; v < pos_.size(); ++v) {
-    if (!vertex_alive_[v]) continue;
-    vmap[v] = out.num_vertices();
-    out.positions.push_back(pos_[v]);
-  }
-  std::vector<int32_t> color_vertex, face_of(tri_.size());
+  // Faces in the input's order; each color at its quadric's best value where its vertex ended.
+  std::vector<int32_t> face_of(tri_.size()), vmap, used;
   for (size_t i = 0; i < tri_.size(); ++i) face_of[face_order_[i]] = static_cast<int32_t>(i);
-  for (const int32_t f : face_of) {
-    if (!face_alive_[f]) continue;
-    Tri t, c;
-    for (int k = 0; k < 3; ++k) {
-      t[k] = vmap[tri_[f][k]];
-      int32_t& ci = cmap[tcol_[f][k]];
-      if (ci < 0) {
-        ci = static_cast<int32_t>(color_vertex.size());
-        color_vertex.push_back(tri_[f][k]);
-        const Vec2 p = pos_[tri_[f][k]];
-        const auto rgb = best_color(quadric_[tcol_[f][k]], p.x, p.y);
-        const double scale = 1 / options_.color_scale;
-        out.colors.push_back({static_cast<float>(rgb[0] * scale), static_cast<float>(rgb[1] * scale),
-                              static_cast<float>(rgb[2] * scale)});
-      }
-      c[k] = ci;
-    }
-    out.triangles.push_back(t);
-    out.triangle_colors.push_back(c);
-  }
-  for (const EdgeVerts& e : mesh_.creases)
-    if (vmap[e[0]] >= 0 && vmap[e[1]] >= 0) out.creases.push_back({vmap[e[0]], vmap[e[1]]});
-  for (const FeatureState& f : features_) {
-    Feature g;
-    g.id = f.id;
-    g.saliency = f.saliency;
-    int32_t n = f.head;
-    for (int32_t i = 0; i < f.size; ++i, n = nodes_[n].next) g.vertices.push_back(vmap[nodes_[n].vertex]);
-    if (f.closed) g.vertices.push_back(g.vertices.front());
-    out.features.push_back(std::move(g));
-  }
-  mesh_ = std::move(out);
+  const double scale = 1 / options_.color_scale;
+  mesh_ = detail::live_mesh(pos_, vertex_alive_, tri_, tcol_, face_alive_, face_of, static_cast<int>(quadric_.size()),
+                            mesh_.creases, chains_, [&](int32_t c, int32_t v) {
+    const auto rgb = best_color(quadric_[c], pos_[v].x, pos_[v].y);
+    return Color{static_cast<float>(rgb[0] * scale), static_cast<float>(rgb[1] * scale),
+                 static_cast<float>(rgb[2] * scale)};
+  }, vmap, used);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The collapse engine's fast storage (mesh/collapse_queue_p.h, mesh/quadric_p.h) against slow,
+// The collapse engine's fast storage (mesh/collapse_engine_p.h, mesh/quadric_p.h) against slow,
 // obvious references: the binned lazy queue against sorting every entry, the incidence lists
 // against std::vector, the thread-split quadric sums against one serial loop.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <set>
 #include <vector>
 
-#include "mesh/collapse_queue_p.h"
+#include "mesh/collapse_engine_p.h"
 #include "mesh/quadric_p.h"
 
 namespace subvec {

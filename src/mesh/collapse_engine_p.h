@@ -1,12 +1,20 @@
-// The collapse engine's storage, shared by the simplification of vectorization (vectorize/
-// simplify.cpp) and the coarsening between levels (mesh/coarsen.cpp, vectorize/levels.cpp): the lazy
-// queue that orders collapses cheapest first, and the per-vertex lists of incident faces that
-// collapses keep current. With collapse_p.h (what a collapse may do and how it changes the faces)
-// and quadric_p.h (what it costs), both engines are the same greedy loop (run_collapses below) over
-// the same data; they differ in where the kept vertex goes and in their feature rules.
+// The one collapse engine of the library (paper §4 and §5), shared by the simplification of
+// vectorization (vectorize/simplify.cpp) and the coarsening between levels (mesh/coarsen.cpp,
+// vectorize/levels.cpp, replayed by pyramid/): the lazy queue that orders collapses cheapest first,
+// the per-vertex lists of incident faces, the feature chains (chains_p.h), the collapse applied to
+// them (collapse_incidence), the greedy loop (run_collapses) and the renumbered mesh it leaves
+// (live_mesh). What a collapse may do and how it changes the faces and colors is collapse_p.h;
+// what it costs is the 5D quadric of quadric_p.h (color_quadrics).
+//
+// Design note. The two users differ only in their policies: the simplification places the kept
+// vertex at the best point of the edge and refits the chain around a removed tear vertex (eq. 1),
+// region by region in parallel; the levels make half-edge collapses (the kept vertex stays, so
+// the pyramid can predict the removed one from its neighbours) and keep chains within a distance
+// of where the step began.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cstdint>
@@ -16,6 +24,9 @@
 #include <vector>
 
 #include "core/cancel_p.h"
+#include "mesh/chains_p.h"
+#include "mesh/collapse_p.h"
+#include "subvec/mesh/vector_image.h"
 
 namespace subvec::detail {
 // A 4-ary min-heap: the four children of a node share one cache line (16-byte entries, the
@@ -229,6 +240,67 @@ class IncidenceLists {
   std::vector<int32_t*> data_;
   std::vector<int32_t> size_, capacity_;
 };
+
+// The half-edge collapse of u into v on the engine's storage: collapse_faces (collapse_p.h) with
+// the faces on the edge dying and leaving their vertices' lists, u's other faces joining v's list
+// (growing from `arena`), and u dead. `scratch` holds a copy of u's list while they change.
+inline void collapse_incidence(int32_t u, int32_t v, const std::array<std::array<int32_t, 2>, 2>& pairs, int npairs,
+                               std::vector<Tri>& tri, std::vector<Tri>& tcol, IncidenceLists& vfaces,
+                               std::vector<uint8_t>& face_alive, std::vector<uint8_t>& vertex_alive, Arena& arena,
+                               std::vector<int32_t>& scratch) {
+  scratch.assign(vfaces[u].begin(), vfaces[u].end());
+  collapse_faces(
+      scratch, tri, tcol, u, v, pairs, npairs,
+      [&](int32_t f) {
+        face_alive[f] = 0;
+        for (int32_t w : tri[f])
+          if (w != u) vfaces.erase(w, f);
+      },
+      [&](int32_t f) { vfaces.push_back(v, f, arena); });
+  vfaces.clear(u);
+  vertex_alive[u] = 0;
+}
+
+// The live mesh, renumbered: live vertices in ascending order (`vmap`: each vertex's new index, -1
+// when dead), live faces in `face_order` (every face index once), color values numbered by first
+// use (`used`: each new color's value, `color(value, vertex)` its Color), the creases and the
+// chains.
+template <class ColorOf>
+ControlMesh live_mesh(const std::vector<Vec2>& pos, const std::vector<uint8_t>& vertex_alive, const std::vector<Tri>& tri,
+                      const std::vector<Tri>& tcol, const std::vector<uint8_t>& face_alive,
+                      std::span<const int32_t> face_order, int num_colors, const std::vector<EdgeVerts>& creases,
+                      const FeatureChains& chains, const ColorOf& color, std::vector<int32_t>& vmap,
+                      std::vector<int32_t>& used) {
+  ControlMesh out;
+  vmap.assign(pos.size(), -1);
+  used.clear();
+  std::vector<int32_t> cmap(num_colors, -1);
+  for (size_t v = 0; v < pos.size(); ++v) {
+    if (!vertex_alive[v]) continue;
+    vmap[v] = out.num_vertices();
+    out.positions.push_back(pos[v]);
+  }
+  for (const int32_t f : face_order) {
+    if (!face_alive[f]) continue;
+    Tri t, c;
+    for (int k = 0; k < 3; ++k) {
+      t[k] = vmap[tri[f][k]];
+      int32_t& ci = cmap[tcol[f][k]];
+      if (ci < 0) {
+        ci = out.num_colors();
+        out.colors.push_back(color(tcol[f][k], tri[f][k]));
+        used.push_back(tcol[f][k]);
+      }
+      c[k] = ci;
+    }
+    out.triangles.push_back(t);
+    out.triangle_colors.push_back(c);
+  }
+  for (const EdgeVerts& e : creases)
+    if (vmap[e[0]] >= 0 && vmap[e[1]] >= 0) out.creases.push_back({vmap[e[0]], vmap[e[1]]});
+  chains.write(vmap, out.features);
+  return out;
+}
 
 // The greedy loop of both engines: entries come out cheapest first while `more()`; a stale one
 // (`live(e)` false) is skipped, a live one goes to `step(e)`. The cancel flag is looked at every
