@@ -94,7 +94,8 @@ bool is_image_file(const fs::path& p) {
 std::vector<Item> list_items(const BatchArgs& a) {
   std::error_code ec;
   if (!fs::is_directory(a.input, ec)) {
-    throw Error(ErrorCode::kIo, "'" + a.input + "' is not a directory");
+    throw Error(ErrorCode::kIo, a.input + (fs::exists(a.input, ec) ? ": not a directory"
+                                                                   : ": no such directory"));
   }
   std::vector<Item> items;
   for (fs::directory_iterator it(a.input, ec), end; !ec && it != end; it.increment(ec)) {

@@ -1,8 +1,8 @@
 // subvec: the command-line front end. It only translates: options -> parameter structs -> library
 // calls -> files and text (docs/cli.md). Error policy: a subvec::Error or any other exception
 // becomes one line "subvec: <message>" on stderr and exit status 1; a command-line mistake found by
-// CLI11 becomes one line "subvec: <message> (see 'subvec <command> --help')" and CLI11's exit
-// status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
+// CLI11 becomes one line "subvec: <command>: <message>; <hint>" (usage_error: the closest option or
+// command name, messages.h, or the help to read) and CLI11's exit status (100-114). Outputs are written atomically by the library, so a failed run never leaves a
 // partial file and never clobbers an existing one.
 
 #include <CLI/CLI.hpp>
@@ -470,19 +470,22 @@ void run_vectorize(const VectorizeArgs& a) {
 
 // ---- command line ----------------------------------------------------------------------------
 
-// The name of the deepest subcommand CLI11 got to, for the hint after a usage error.
+// The deepest subcommand CLI11 got to (the app itself when none).
+const CLI::App* deepest_command(const CLI::App& app) {
+  const CLI::App* at = &app;
+  while (!at->get_subcommands().empty()) at = at->get_subcommands().front();
+  return at;
+}
+
+// "subvec render" for render, "subvec" for the app itself.
 std::string command_path(const CLI::App& app) {
   std::string path = "subvec";
-  const CLI::App* at = &app;
-  while (true) {
-    const auto subs = at->get_subcommands();
-    if (subs.empty()) break;
-    at = subs.front();
+  for (const CLI::App* at = &app; !at->get_subcommands().empty();) {
+    at = at->get_subcommands().front();
     path += " " + at->get_name();
   }
   return path;
 }
-
 // info, convert and compare: run from their callbacks.
 void add_file_commands(CLI::App& app) {
   // info
@@ -560,22 +563,91 @@ void add_vectorize_command(CLI::App& app) {
       "  subvec vectorize apple.png -o apple.svec --segment 30,40,440,460   # outline the apple");
 }
 
-// A command-line mistake: one line naming it and the help to read, and CLI11's exit status.
+// A command-line mistake: one line "subvec: [command: ]problem; hint" and CLI11's exit status.
+// The hint is the closest valid name for an unknown option or command (messages.h), else the help
+// to read. CLI11's own messages are reworded into subvec's (lower case, no "The following ...").
 int usage_error(CLI::App& app, const CLI::ParseError& e) {
-  std::string message = e.what();
+  using subvec_cli::closest_name;
+  const CLI::App* at = deepest_command(app);
+  const std::string help = "see '" + command_path(app) + " --help'";
+  std::string message = subvec_cli::lower_first(e.what());
+  std::string hint = help;
   int status = e.get_exit_code();
-  if (app.get_subcommands().empty() && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
+
+  // A word that is no option here: the first of them, with the closest option name.
+  auto unknown = [&](const std::vector<std::string>& extra) {
+    for (const std::string& word : extra) {
+      if (word.size() < 2 || word[0] != '-') continue;
+      const std::string name = word.substr(0, word.find('='));
+      message = "unknown option " + name;
+      std::vector<std::string> names;
+      for (const CLI::Option* o : at->get_options()) {
+        for (const std::string& l : o->get_lnames()) names.push_back("--" + l);
+        for (const std::string& n : o->get_snames()) names.push_back("-" + n);
+      }
+      if (const std::string near = closest_name(name, names); !near.empty())
+        hint = "did you mean " + near + "?";
+      return;
+    }
+    std::string words;
+    for (const std::string& word : extra) words += (words.empty() ? "'" : " '") + word + "'";
+    message = (extra.size() == 1 ? "unexpected argument " : "unexpected arguments ") + words;
+  };
+
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    commands.push_back(sub->get_name());
+  std::string command_list;
+  for (size_t i = 0; i < commands.size(); ++i)
+    command_list += (i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ") + commands[i];
+
+  if (at == &app && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
     // No command: either none was given or the first word is not one.
     const std::vector<std::string> extra = app.remaining();
     if (extra.empty()) {
-      message = "a command is required: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare";
+      message = "a command is required: " + command_list;
+    } else if (extra.front().rfind('-', 0) == 0) {
+      unknown(extra);
+      status = int(CLI::ExitCodes::ExtrasError);
     } else {
-      message = (extra.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                extra.front() + "' (expected a command: vectorize, batch, render, edit, stylize, filter, serve, info, convert or compare)";
+      message = "unknown command '" + extra.front() + "'";
+      const std::string near = closest_name(extra.front(), commands);
+      hint = !near.empty() ? "did you mean " + near + "?"
+             : extra.front() == "help" ? "run 'subvec --help'"
+                                       : "expected " + command_list;
       status = int(CLI::ExitCodes::ExtrasError);
     }
+  } else if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
+    std::vector<std::string> extra = at->remaining();
+    if (extra.empty()) extra = app.remaining(true);
+    unknown(extra);
+  } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr) {
+    // "--width: 1 required INT:INT in [1 - 65536] missing": the option's name, then CLI11's text.
+    const std::string name = message.substr(0, message.find(':'));
+    message = name.rfind('-', 0) == 0 ? name + " needs a value" : message;
+  } else if (dynamic_cast<const CLI::ConversionError*>(&e) != nullptr) {
+    // "Could not convert: --seed = seven"
+    const std::string prefix = "could not convert: ";
+    if (message.rfind(prefix, 0) == 0) {
+      const std::string rest = message.substr(prefix.size());
+      const size_t eq = rest.find(" = ");
+      message = eq == std::string::npos ? "cannot convert " + rest
+                                        : rest.substr(0, eq) + ": cannot convert '" +
+                                              rest.substr(eq + 3) + "'";
+    }
+  } else if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr) {
+    // "input is required" (a positional argument) or "--output is required".
+    const std::string name = message.substr(0, message.find(' '));
+    if (!name.empty() && name[0] != '-' && message == name + " is required")
+      message = "the " + name + " argument is required";
+  } else if (dynamic_cast<const CLI::ValidationError*>(&e) != nullptr) {
+    // "--width: Value 0 not in range 1 to 65536": lower case after the option's name too.
+    const size_t colon = message.find(": ");
+    if (colon != std::string::npos)
+      message = message.substr(0, colon + 2) + subvec_cli::lower_first(message.substr(colon + 2));
   }
-  std::cerr << "subvec: " << one_line(message) << " (see '" << command_path(app) << " --help')\n";
+  const std::string where = at == &app ? "" : at->get_name() + ": ";
+  std::cerr << "subvec: " << one_line(where + message + "; " + hint) << "\n";
   return status;
 }
 

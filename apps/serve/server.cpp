@@ -275,8 +275,11 @@ void EditorServer::run() { impl_->server.listen_after_bind(); }
 void EditorServer::start() {
   Impl& s = *impl_;
   const auto& in = s.options.input;
+  if (!std::filesystem::exists(in)) throw Error(ErrorCode::kIo, in.string() + ": no such file");
   if (!std::filesystem::is_regular_file(in)) {
-    throw Error(ErrorCode::kIo, "cannot read '" + in.string() + "': no such file");
+    throw Error(ErrorCode::kIo, in.string() + (std::filesystem::is_directory(in)
+                                                   ? ": is a directory"
+                                                   : ": not a regular file"));
   }
   if (s.options.output && s.options.output->has_filename()) {
     subvec::svec_format_for(*s.options.output);  // throws for an unknown extension

@@ -48,6 +48,8 @@ std::vector<uint8_t> read_file(const std::filesystem::path& path, int64_t max_by
   do {
     raw = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   } while (raw < 0 && errno == EINTR);
+  // A missing file reads the same from every reader: "PATH: no such file".
+  if (raw < 0 && errno == ENOENT) throw Error(ErrorCode::kIo, path.string() + ": no such file");
   if (raw < 0) throw Error(ErrorCode::kIo, os_error(path, "open", errno));
   Fd fd(raw);
   struct stat st {};

@@ -29,6 +29,7 @@
 #include <dlfcn.h>
 #include <png.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <csetjmp>
@@ -41,6 +42,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -465,13 +467,31 @@ cv::Mat to_8bit(const cv::Mat& m, const fs::path& path) {
 
 }  // namespace
 
+std::string image_format_name(const std::vector<uint8_t>& bytes) {
+  if (is_png(bytes)) return "PNG";
+  if (is_jpeg(bytes)) return "JPEG";
+  if (is_webp(bytes)) return "WebP";
+  if (is_tiff(bytes)) return "TIFF";
+  if (is_bmp(bytes)) return "BMP";
+  if (bytes.size() >= 6 && std::memcmp(bytes.data(), "GIF8", 4) == 0) return "GIF";
+  if (bytes.size() >= 5 && std::memcmp(bytes.data(), "%PDF-", 5) == 0) return "PDF";
+  // SVG: XML text (after a byte order mark, blanks, a prolog or comments) with an <svg element
+  // near its start.
+  const std::string_view head(reinterpret_cast<const char*>(bytes.data()),
+                              std::min<size_t>(bytes.size(), 4096));
+  const size_t first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  if (first != std::string_view::npos && head[first] == '<' && head.find("<svg") != std::string_view::npos)
+    return "SVG";
+  return "";
+}
+
+bool is_raster_input(const std::string& format) {
+  return format == "PNG" || format == "JPEG" || format == "WebP" || format == "TIFF" || format == "BMP";
+}
+
 Image8 read_image(const fs::path& path, int64_t max_pixels) {
   silence_opencv();
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) fail(ErrorCode::kIo, path, "no such file");
-  if (fs::is_directory(status)) fail(ErrorCode::kIo, path, "is a directory");
-
+  // A missing file or a directory: read_file's messages, the same for every reader.
   const std::vector<uint8_t> bytes = read_file(path);
   if (bytes.empty()) fail(ErrorCode::kBadFile, path, "file is empty");
 

@@ -9,6 +9,7 @@
 #include "io/svec_p.h"
 #include "subvec/core/error.h"
 #include "subvec/io/file.h"
+#include "subvec/io/image_io.h"
 #include "subvec/mesh/validate.h"
 
 namespace subvec {
@@ -35,6 +36,23 @@ int first_significant_byte(std::span<const uint8_t> bytes) {
   return i < bytes.size() ? bytes[i] : -1;
 }
 
+// "a PNG image, not a .svec or .svec.json file; vectorize it first: subvec vectorize photo.png
+// -o photo.svec" (read_svec puts the path in front). PDF, SVG and GIF are not vectorize's inputs.
+std::string not_a_vector_image(const std::filesystem::path& path, const std::string& format) {
+  const bool vector = format == "PDF" || format == "SVG";
+  std::string message = std::string(format == "SVG" ? "an " : "a ") + format +
+                        (vector ? " file" : " image") + ", not a .svec or .svec.json file";
+  if (is_raster_input(format)) {
+    std::filesystem::path out = path.filename();
+    out.replace_extension(".svec");
+    message += "; vectorize it first: subvec vectorize " + path.string() + " -o " + out.string();
+  } else if (vector) {
+    message += "; subvec writes " + format + " (render -o out." + lower(format) +
+               ") but cannot read it";
+  }
+  return message;
+}
+
 }  // namespace
 
 SvecFormat svec_format_for(const std::filesystem::path& path) {
@@ -59,7 +77,10 @@ VectorImage read_svec(const std::filesystem::path& path) {
                                               bytes.size() - skip));
     }
     if (bytes.empty()) throw Error(ErrorCode::kBadFile, "file is empty");
-    // Neither form: let the binary reader name the wrong magic bytes.
+    // Neither form. An image in another format is named, with what to do instead; anything
+    // else goes to the binary reader, which names the wrong magic bytes.
+    if (const std::string format = image_format_name(bytes); !format.empty())
+      throw Error(ErrorCode::kBadFile, not_a_vector_image(path, format));
     return parse_svec_binary(bytes);
   } catch (const Error& e) {
     const std::string prefix = path.string() + ": ";

@@ -122,7 +122,7 @@ def test_same_stem_fails_the_second_image(cli, folder, tmp_path):
 
 def test_bad_arguments(cli, tmp_path):
     r = cli("batch", tmp_path / "nope", "-o", tmp_path / "out", check=False)
-    assert r.returncode == 1 and r.stderr.count("\n") == 1 and "is not a directory" in r.stderr
+    assert r.returncode == 1 and r.stderr.count("\n") == 1 and "nope: no such directory" in r.stderr
     (tmp_path / "empty").mkdir()
     r = cli("batch", tmp_path / "empty", "-o", tmp_path / "out", check=False)
     assert r.returncode == 1 and "no images" in r.stderr

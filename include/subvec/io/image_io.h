@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "subvec/core/image.h"
@@ -14,6 +15,13 @@ namespace subvec {
 // EXIF orientation applied. Images over `max_pixels` are refused, from the header before decoding
 // (PNG, JPEG, BMP, WebP, classic TIFF). Throws Error(kIo / kBadFile / kLimit) with the path in the message.
 Image8 read_image(const std::filesystem::path& path, int64_t max_pixels = int64_t{1} << 28);
+
+// What kind of image file `bytes` (its start is enough) holds, from its magic bytes: "PNG",
+// "JPEG", "WebP", "TIFF", "BMP" (the formats read_image takes), "GIF", "PDF", "SVG", or "" for
+// none of these. The vector image reader uses it to say what a wrong file is.
+std::string image_format_name(const std::vector<uint8_t>& bytes);
+// True for the five formats read_image (and so vectorize) takes.
+bool is_raster_input(const std::string& format);
 
 // The PNG file (8-bit RGB or RGBA) of an image. Throws Error(kInvalidArgument) for an empty or
 // malformed image, Error(kIo) if encoding fails.

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "unit/io/svec_test_util.h"
 
@@ -72,7 +73,7 @@ TEST_F(FileTest, FailedWriteLeavesNothingBehindAndClobbersNothing) {
 
 TEST_F(FileTest, ReadErrorsNameThePath) {
   expect_error([&] { (void)read_file(dir_ / "nope.svec"); }, ErrorCode::kIo,
-               {"nope.svec", "cannot open", "No such file"});
+               {(dir_ / "nope.svec").string() + ": no such file"});
   expect_error([&] { (void)read_file(dir_); }, ErrorCode::kIo, {"is a directory"});
   write(dir_ / "big", std::string(100, 'x'));
   EXPECT_EQ(read_file(dir_ / "big", 100).size(), 100u);
@@ -122,7 +123,62 @@ TEST_F(FileTest, SvecErrorsArePrefixedWithThePath) {
   write(dir_ / "empty.svec", "");
   expect_error([&] { (void)read_svec(dir_ / "empty.svec"); }, ErrorCode::kBadFile,
                {"empty.svec: file is empty"});
-  expect_error([&] { (void)read_svec(dir_ / "none.svec"); }, ErrorCode::kIo, {"none.svec"});
+  expect_error([&] { (void)read_svec(dir_ / "none.svec"); }, ErrorCode::kIo,
+               {(dir_ / "none.svec").string() + ": no such file"});
+}
+
+// One wording for a missing file, whichever reader meets it.
+TEST_F(FileTest, MissingFilesReadTheSameEverywhere) {
+  for (const char* name : {"none.svec", "none.png", "none.svec.json"}) {
+    const std::string expected = (dir_ / name).string() + ": no such file";
+    for (int reader = 0; reader < 3; ++reader) {
+      try {
+        if (reader == 0) (void)read_file(dir_ / name);
+        if (reader == 1) (void)read_svec(dir_ / name);
+        if (reader == 2) (void)read_image(dir_ / name);
+        ADD_FAILURE() << name << ": no error from reader " << reader;
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::kIo);
+        EXPECT_EQ(std::string(e.what()), expected) << "reader " << reader;
+      }
+    }
+  }
+}
+
+// An image in another format, given where a vector image belongs: named, with what to do.
+TEST_F(FileTest, ReadSvecNamesOtherImageFormats) {
+  Image8 pixels;
+  pixels.width = 2, pixels.height = 1, pixels.channels = 3;
+  pixels.pixels.assign(6, 200);
+  write_png(dir_ / "photo.png", pixels);
+  const std::string path = (dir_ / "photo.png").string();
+  expect_error([&] { (void)read_svec(dir_ / "photo.png"); }, ErrorCode::kBadFile,
+               {path + ": a PNG image, not a .svec or .svec.json file; vectorize it first: "
+                       "subvec vectorize " + path + " -o photo.svec"});
+  using namespace std::string_literals;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"\xff\xd8\xff\xe0 jfif"s, "a JPEG image, not a .svec or .svec.json file; vectorize it first"},
+      {"RIFF\x10\0\0\0WEBPVP8 "s, "a WebP image"},
+      {"II*\0\x08\0\0\0"s, "a TIFF image"},
+      {"BM\x3a\0\0\0"s, "a BMP image"},
+      {"GIF89a\x01\0"s, "a GIF image, not a .svec or .svec.json file"},
+      {"%PDF-1.4\n"s, "a PDF file, not a .svec or .svec.json file; subvec writes PDF"},
+      {"<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\"/>"s,
+       "an SVG file, not a .svec or .svec.json file; subvec writes SVG (render -o out.svg) but cannot "
+       "read it"},
+  };
+  for (const auto& [bytes, expected] : cases) {
+    write(dir_ / "x.svec", bytes);
+    expect_error([&] { (void)read_svec(dir_ / "x.svec"); }, ErrorCode::kBadFile,
+                 {(dir_ / "x.svec").string() + ": " + expected});
+  }
+  // GIF, PDF and SVG are no input of vectorize: no such suggestion.
+  write(dir_ / "x.svec", "%PDF-1.4\n");
+  try {
+    (void)read_svec(dir_ / "x.svec");
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).find("vectorize"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(FileTest, WriteSvecRefusesInvalidImagesAndUnknownExtensions) {
