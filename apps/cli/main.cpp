@@ -601,6 +601,7 @@ int usage_error(CLI::App& app, const CLI::ParseError& e) {
   for (size_t i = 0; i < commands.size(); ++i)
     command_list += (i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ") + commands[i];
 
+  const std::vector<std::string> leftover = app.remaining(true);  // words no option took
   if (at == &app && e.get_exit_code() == int(CLI::ExitCodes::RequiredError)) {
     // No command: either none was given or the first word is not one.
     const std::vector<std::string> extra = app.remaining();
@@ -617,6 +618,12 @@ int usage_error(CLI::App& app, const CLI::ParseError& e) {
                                        : "expected " + command_list;
       status = int(CLI::ExitCodes::ExtrasError);
     }
+  } else if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr &&
+             std::any_of(leftover.begin(), leftover.end(),
+                         [](const std::string& w) { return w.size() > 1 && w[0] == '-'; })) {
+    // "info -x": CLI11 misses the input first, but the unknown option is the mistake.
+    unknown(leftover);
+    status = int(CLI::ExitCodes::ExtrasError);
   } else if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
     std::vector<std::string> extra = at->remaining();
     if (extra.empty()) extra = app.remaining(true);

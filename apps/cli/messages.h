@@ -41,10 +41,11 @@ inline size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 // The name in `names` closest to a mistyped `word` ("--jsn" -> "--json", "rendr" -> "render"), or
-// "" when none is close: at most 1 edit for words of up to 4 letters, 2 for longer ones, or the
-// only name that `word` (3 letters or more, dashes aside) begins.
+// "" when none is close: at most 1 edit for words of 2 to 4 letters, 2 for longer ones, or the
+// only name that `word` (3 letters or more, dashes aside) begins; none for one letter.
 inline std::string closest_name(const std::string& word, const std::vector<std::string>& names) {
   const size_t letters = word.size() - std::min(word.find_first_not_of('-'), word.size());
+  if (letters < 2) return "";  // "-x": any one-letter option is one edit away
   const size_t limit = letters <= 4 ? 1 : 2;
   std::string best;
   size_t best_distance = limit + 1;

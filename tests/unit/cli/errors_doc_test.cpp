@@ -134,6 +134,9 @@ TEST_F(DocumentedErrors, UnknownOptionsGetTheClosestName) {
       {"infoo disk.svec.json", "unknown command 'infoo'; did you mean info?"},
       {"vectorise photo.png -o p.svec", "unknown command 'vectorise'; did you mean vectorize?"},
       {"render disk.svec.json -o d.png --frobnicate", "render: unknown option --frobnicate; see 'subvec render --help'"},
+      // An unknown option is the mistake even where CLI11 first misses a required argument.
+      {"info -x", "info: unknown option -x; see 'subvec info --help'"},
+      {"render -o d.png --widht 3", "render: unknown option --widht; did you mean --width?"},
   };
   for (const auto& [args, expected] : cases) {
     const CliRun r = run(args);
