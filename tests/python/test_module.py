@@ -255,7 +255,12 @@ def test_bad_arrays_raise_invalid_argument():
 def test_bad_files_raise_file_and_bad_file_errors(tmp_path):
     with pytest.raises(subvec.FileError) as e:
         subvec.load(tmp_path / "missing.svec")
-    assert "missing.svec" in str(e.value) and isinstance(e.value, OSError)
+    assert str(e.value) == f"{tmp_path / 'missing.svec'}: no such file" and isinstance(e.value, OSError)
+    # A photograph where a vector image belongs: the library's reader names it, as the CLI does.
+    photo = EXAMPLES / "04-rocket.png"
+    with pytest.raises(subvec.BadFileError, match=r"04-rocket\.png: a PNG image, not a \.svec or "
+                       r"\.svec\.json file; vectorize it first: subvec vectorize .* -o 04-rocket\.svec"):
+        subvec.load(photo)
     (tmp_path / "junk.svec").write_bytes(b"SUBVEC\x00\x1a truncated")
     with pytest.raises(subvec.BadFileError, match="junk.svec"):
         subvec.load(tmp_path / "junk.svec")
