@@ -45,6 +45,7 @@ if(NOT EXISTS ${WORK_DIR}/disk@2x.png)
 endif()
 
 if(DEFINED PYTHON AND DEFINED PYTHON_DIR)
-  step("import the installed Python module" ${CMAKE_COMMAND} -E env PYTHONPATH=${prefix}/${PYTHON_DIR}
-       ${PYTHON} -c "import subvec, sys; sys.exit(0 if subvec.__file__.startswith('${prefix}/') else 'imported ' + subvec.__file__)")
+  step("import the installed Python module" ${PYTHON} ${SOURCE_DIR}/tests/install/check_module.py
+       ${prefix}/${PYTHON_DIR} ${SOURCE_DIR}/examples/01-disk.svec.json)
+  message(STATUS "${step_output}")
 endif()
