@@ -169,8 +169,9 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
   if (width_given) options.width = a.width;
   if (scale_given) options.scale = a.scale;
   options.max_pixels = a.max_pixels;
+  subvec::RenderSize size;
   try {
-    subvec::render_size(options, image.width, image.height);
+    size = subvec::render_size(options, image.width, image.height);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), std::string(e.what()) + " (--max-pixels raises the limit)");
@@ -183,19 +184,34 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
   options.antialias = !a.no_aa;
   options.threads = a.threads;
   options.depth = a.depth;
-  // --gpu (docs/gpu.md): OpenGL through headless EGL; without a context, one line and the CPU.
+  // --gpu (docs/gpu.md): OpenGL through headless EGL; without a context, or when the context is a
+  // software rasterizer (slower than the CPU renderer), one line and the CPU.
   if (a.gpu) {
     const std::string why = subvec::gpu_unavailable_reason();
-    if (why.empty()) {
-      options.backend = subvec::Backend::kGpu;
-    } else {
+    if (!why.empty()) {
       std::fprintf(stderr, "subvec: GPU rendering unavailable (%s); rendering on the CPU\n",
                    why.c_str());
+    } else if (const subvec::GpuRendererInfo gl = subvec::gpu_renderer(); gl.software) {
+      std::fprintf(stderr,
+                   "subvec: --gpu: OpenGL is %s (software); rendering on the CPU, which is faster "
+                   "here\n",
+                   gl.name.c_str());
+    } else {
+      options.backend = subvec::Backend::kGpu;
     }
   }
 
-  const subvec::Image8 raster = subvec::render(image, options);
-  subvec::write_png(a.output, raster);
+  if (options.backend == subvec::Backend::kGpu) {
+    subvec::write_png(a.output, subvec::render(image, options));
+    return;
+  }
+  // In tiles, rows streamed to the PNG encoder: memory independent of the output size.
+  std::optional<subvec::PngWriter> png;
+  subvec::render_strips(image, options, [&](int, const subvec::Image8& strip) {
+    if (!png) png.emplace(a.output, size.width, size.height, strip.channels);
+    png->write_rows(strip);
+  });
+  png->finish();
 }
 
 // ---- info ------------------------------------------------------------------------------------

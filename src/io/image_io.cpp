@@ -27,10 +27,14 @@
 #include "subvec/io/image_io.h"
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <unistd.h>
 #include <png.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cerrno>
 #include <bit>
 #include <csetjmp>
 #include <cstdlib>
@@ -628,6 +632,125 @@ void write_png(const fs::path& path, const Image8& image) {
     throw Error(e.code(), "cannot write " + in_quotes(path) + ": " + e.what());
   }
   write_file_atomic(path, encoded);
+}
+
+// ---- PngWriter ---------------------------------------------------------------------------------
+
+struct PngWriter::Impl {
+  fs::path path, temp;
+  int fd = -1;
+  int width = 0, height = 0, channels = 0, written = 0;
+  bool done = false;
+  PngError error;
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  std::vector<uint8_t> buffer;  // encoded bytes not yet written to the file
+  int write_errno = 0;
+
+  [[noreturn]] void fail(const std::string& why) {
+    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": " + why);
+  }
+  void flush_buffer() {
+    size_t done_bytes = 0;
+    while (done_bytes < buffer.size()) {
+      const ssize_t n = ::write(fd, buffer.data() + done_bytes, buffer.size() - done_bytes);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) fail(std::strerror(errno));
+      done_bytes += size_t(n);
+    }
+    buffer.clear();
+  }
+  static void on_write(png_structp p, png_bytep data, png_size_t n) {
+    auto* self = static_cast<Impl*>(png_get_io_ptr(p));
+    self->buffer.insert(self->buffer.end(), data, data + n);
+  }
+  ~Impl() {
+    png_destroy_write_struct(&png, &info);
+    if (fd >= 0) ::close(fd);
+    if (!done && !temp.empty()) ::unlink(temp.c_str());
+  }
+};
+
+PngWriter::PngWriter(const fs::path& path, int width, int height, int channels)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  if (width <= 0 || height <= 0 || (channels != 3 && channels != 4) || width > (1 << 24) ||
+      height > (1 << 24)) {
+    throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(path) + ": size " +
+                                                 std::to_string(width) + " x " +
+                                                 std::to_string(height) + " x " +
+                                                 std::to_string(channels) + " is not an image");
+  }
+  m.width = width, m.height = height, m.channels = channels;
+  if (path.filename().empty()) m.fail("not a file name");
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  static std::atomic<uint64_t> counter{0};
+  for (int attempt = 0; m.fd < 0; ++attempt) {
+    std::string name = ".";
+    name.append(path.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
+    name.append("-png-").append(std::to_string(counter.fetch_add(1)));
+    m.temp = dir / name;
+    m.fd = ::open(m.temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (m.fd < 0 && !(errno == EEXIST && attempt < 100) && errno != EINTR) {
+      const int err = errno;
+      m.temp.clear();
+      m.fail(std::string("cannot create a temporary file: ") + std::strerror(err));
+    }
+  }
+  m.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &m.error, png_on_error, png_on_warning);
+  m.info = m.png ? png_create_info_struct(m.png) : nullptr;
+  if (!m.png || !m.info) throw std::bad_alloc();
+  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
+  png_set_write_fn(m.png, &m, Impl::on_write, png_flush);
+  // As encode_png(), so that the bytes are the same.
+  png_set_IHDR(m.png, m.info, png_uint_32(width), png_uint_32(height), 8,
+               channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(m.png, 1);
+  png_write_info(m.png, m.info);
+}
+
+PngWriter::~PngWriter() = default;
+
+void PngWriter::write_rows(const Image8& rows) {
+  Impl& m = *impl_;
+  if (m.done || rows.width != m.width || rows.channels != m.channels || rows.height < 0 ||
+      rows.height > m.height - m.written ||
+      rows.pixels.size() != size_t(rows.width) * size_t(rows.height) * size_t(rows.channels)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "cannot write " + in_quotes(m.path) + ": rows that do not fit the image");
+  }
+  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
+  for (int y = 0; y < rows.height; ++y) png_write_row(m.png, rows.row(y));
+  m.written += rows.height;
+  if (m.buffer.size() >= (size_t(4) << 20)) m.flush_buffer();
+}
+
+void PngWriter::finish() {
+  Impl& m = *impl_;
+  if (m.done || m.written != m.height) {
+    throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(m.path) + ": " +
+                                                 std::to_string(m.written) + " of " +
+                                                 std::to_string(m.height) + " rows written");
+  }
+  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
+  png_write_end(m.png, nullptr);
+  m.flush_buffer();
+  if (::fsync(m.fd) != 0) m.fail(std::string("cannot flush: ") + std::strerror(errno));
+  const int fd = m.fd;
+  m.fd = -1;
+  if (::close(fd) != 0) m.fail(std::string("cannot close: ") + std::strerror(errno));
+  if (::rename(m.temp.c_str(), m.path.c_str()) != 0) {
+    m.fail(std::string("cannot rename the temporary file onto it: ") + std::strerror(errno));
+  }
+  m.done = true;
+  const fs::path dir = m.path.has_parent_path() ? m.path.parent_path() : ".";
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
 }
 
 }  // namespace subvec

@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 #include "render/raster_p.h"
 
@@ -205,7 +206,7 @@ inline __m128i lowest_bit(__m128i v) {
 // 4 x 2 candidates in that window are flagged in q.large and own nothing here. Coordinates are
 // within the +-2^29 guard band of to_fixed(), so differences fit in int32.
 [[gnu::always_inline]] inline void cover_quad(const Fixed* fixed, const Tri* tris, int n,
-                                              int last_x, int first_y, int last_y,
+                                              int first_x, int last_x, int first_y, int last_y,
                                               QuadCoverage& q) {
   // Corners k of the four triangles as (x, y) vectors over the lanes.
   __m128i xs[3], ys[3];
@@ -235,7 +236,7 @@ inline __m128i lowest_bit(__m128i v) {
   const __m128i small =
       _mm_and_si128(_mm_cmplt_epi32(_mm_sub_epi32(cx1, cx0), _mm_set1_epi32(4)),
                     _mm_cmplt_epi32(_mm_sub_epi32(cy1, cy0), _mm_set1_epi32(2)));
-  q.px0 = max_epi32(cx0, _mm_setzero_si128());
+  q.px0 = max_epi32(cx0, _mm_set1_epi32(first_x));
   q.py0 = max_epi32(cy0, _mm_set1_epi32(first_y));
   const __m128i columns = _mm_sub_epi32(min_epi32(cx1, _mm_set1_epi32(last_x)), q.px0);  // - 1
   const __m128i rows = _mm_sub_epi32(min_epi32(cy1, _mm_set1_epi32(last_y)), q.py0);     // - 1
@@ -510,16 +511,19 @@ template <int kRounds>
 // slot of its 16 subsamples (RGBA8 words, alpha 255 once written).
 class MarkTiles {
  public:
-  MarkTiles(int width, int height)
+  // Marks for rows [row0, row1) of a view `width` pixels wide; row0 is a multiple of the tile
+  // height. Coordinates below are the view's.
+  MarkTiles(int width, int row0, int row1)
       : width_(width),
-        height_(height),
+        row0_(row0),
+        height_(row1),
         tiles_x_((width + kTile - 1) / kTile),
-        tile_(size_t(tiles_x_) * ((height + kTile - 1) / kTile), -1) {}
+        tile_(size_t(tiles_x_) * ((row1 - row0 + kTile - 1) / kTile), -1) {}
 
   bool empty() const { return masks_.empty(); }
 
   void mark(int x, int y) {
-    int32_t& t = tile_[size_t(y >> kTileBits) * tiles_x_ + (x >> kTileBits)];
+    int32_t& t = tile_[size_t((y - row0_) >> kTileBits) * tiles_x_ + (x >> kTileBits)];
     if (t < 0) {
       t = static_cast<int32_t>(masks_.size());
       masks_.push_back(0);
@@ -530,7 +534,8 @@ class MarkTiles {
   // Marks every pixel that the segment a-b touches (conservatively, a little more).
   void mark_segment(Fixed a, Fixed b) {
     if (a.y > b.y) std::swap(a, b);
-    const int r0 = std::max(pixel_floor(a.y), 0), r1 = std::min(pixel_floor(b.y), height_ - 1);
+    const int r0 = std::max(pixel_floor(a.y), row0_),
+              r1 = std::min(pixel_floor(b.y), height_ - 1);
     if (std::max(a.x, b.x) < 0 || pixel_floor(std::min(a.x, b.x)) >= width_) return;
     const double dy = double(b.y) - a.y;
     for (int r = r0; r <= r1; ++r) {
@@ -565,8 +570,8 @@ class MarkTiles {
   bool any_tile(int x0, int x1, int y0, int y1) const {
     x0 = std::max(x0, 0) >> kTileBits;
     x1 = std::min(x1, width_ - 1) >> kTileBits;
-    y0 = std::max(y0, 0) >> kTileBits;
-    y1 = std::min(y1, height_ - 1) >> kTileBits;
+    y0 = (std::max(y0, row0_) - row0_) >> kTileBits;
+    y1 = (std::min(y1, height_ - 1) - row0_) >> kTileBits;
     if (x0 > x1 || y0 > y1) return false;
     if (x1 - x0 <= 1 && y1 - y0 <= 1) {  // small boxes: the (at most) four tiles at the corners
       const int32_t* r0 = tile_.data() + size_t(y0) * tiles_x_;
@@ -585,8 +590,9 @@ class MarkTiles {
   // the set bits of the tile masks.
   template <class Visit>
   void for_each_marked(int x0, int x1, int y0, int y1, Visit&& visit) {
-    x0 = std::max(x0, 0), x1 = std::min(x1, width_ - 1), y0 = std::max(y0, 0),
-    y1 = std::min(y1, height_ - 1);
+    x0 = std::max(x0, 0), x1 = std::min(x1, width_ - 1), y0 = std::max(y0, row0_) - row0_,
+    y1 = std::min(y1, height_ - 1) - row0_;
+    if (x0 > x1 || y0 > y1) return;
     for (int ty = y0 >> kTileBits; ty <= y1 >> kTileBits; ++ty) {
       // Rows of this tile inside [y0, y1], as a byte selector.
       const int ly0 = std::max(y0 - (ty << kTileBits), 0),
@@ -603,17 +609,17 @@ class MarkTiles {
         while (mask) {
           const int b = std::countr_zero(mask);
           mask &= mask - 1;
-          visit((tx << kTileBits) + (b & (kTile - 1)), (ty << kTileBits) + (b >> kTileBits),
+          visit((tx << kTileBits) + (b & (kTile - 1)), row0_ + (ty << kTileBits) + (b >> kTileBits),
                 samples_.data() + size_t(slots_[size_t(t) * kTile * kTile + b]) * kSubsamples);
         }
       }
     }
   }
 
-  // Replaces each marked pixel of rows [y0, y1) by the mean of its written subsamples; alpha is
-  // the covered fraction.
-  void resolve(Image8& out, int y0, int y1) {
-    for_each_marked(0, width_ - 1, y0, y1 - 1, [&](int x, int y, const uint32_t* s) {
+  // Replaces each marked pixel of columns [x0, x1) and rows [y0, y1) by the mean of its written
+  // subsamples; alpha is the covered fraction. Row 0 of `out` is row row0.
+  void resolve(Image8& out, int x0, int x1, int y0, int y1) {
+    for_each_marked(x0, x1 - 1, y0, y1 - 1, [&](int x, int y, const uint32_t* s) {
       uint32_t sum[3] = {0, 0, 0}, count = 0;
       for (int i = 0; i < kSubsamples; ++i) {
         if ((s[i] >> 24) == 0) continue;
@@ -622,7 +628,7 @@ class MarkTiles {
         sum[2] += (s[i] >> 16) & 0xff;
         ++count;
       }
-      uint8_t* p = out.row(y) + size_t(x) * out.channels;
+      uint8_t* p = out.row(y - row0_) + size_t(x) * out.channels;
       if (count == 0) {
         if (out.channels == 4) std::memset(p, 0, 4);
         return;
@@ -636,7 +642,7 @@ class MarkTiles {
  private:
   static int bit(int x, int y) { return ((y & (kTile - 1)) << kTileBits) | (x & (kTile - 1)); }
 
-  int width_, height_, tiles_x_;
+  int width_, row0_, height_, tiles_x_;  // height_: the end row
   std::vector<int32_t> tile_;      // per tile: index into masks_, or -1
   std::vector<uint64_t> masks_;    // per marked tile
   std::vector<int32_t> slots_;     // per marked tile, 64 pixels: slot in samples_, or -1
@@ -650,6 +656,7 @@ struct Frame {
   const Fixed* fixed;  // #N output positions
   int width, height;
   MarkTiles* marks;  // nullptr without marked pixels
+  PixelRect clip;    // the pixels drawn; row 0 of the output is row clip.y0
 };
 
 // Pass 1: the pixel-centre samples of the band's blocks, rows [band_y0, band_y1). The triangles
@@ -659,9 +666,14 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
                   Image8& out, int band_y0, int band_y1, std::vector<int32_t>* near) {
   const RefinedMesh& mesh = *f.mesh;
   const Tri* tris = mesh.triangles.data();
-  const int last_x = f.width - 1, last_y = band_y1 - 1;
-  uint8_t* const pixels = out.pixels.data();
+  const int first_x = f.clip.x0, last_x = f.clip.x1 - 1, last_y = band_y1 - 1;
   const size_t stride = size_t(out.width) * kChannels;
+  // Row py of the view is row py - clip.y0 of `out` (unsigned arithmetic: the origin may lie
+  // before the buffer; every pixel written lies in it).
+  const uintptr_t pixels = uintptr_t(out.pixels.data()) - uintptr_t(f.clip.y0) * stride;
+  auto at = [&](int px, int py) {
+    return reinterpret_cast<uint8_t*>(pixels + uintptr_t(py) * stride + uintptr_t(px) * kChannels);
+  };
   TriangleSetup t;
   Shader shader;
   auto draw = [&](uint8_t* p, uint32_t rgb) {
@@ -674,7 +686,7 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
   auto draw_triangle = [&](int32_t ti) {
     const Tri& tri = tris[ti];
     t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
-    const int px0 = std::max(first_centre(t.min_x), 0),
+    const int px0 = std::max(first_centre(t.min_x), first_x),
               px1 = std::min(last_centre(t.max_x), last_x);
     const int py0 = std::max(first_centre(t.min_y), band_y0),
               py1 = std::min(last_centre(t.max_y), last_y);
@@ -682,7 +694,7 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
     bool shaded = false;
     for_each_centre(t, px0, px1, py0, py1, [&](int px, int py, float e1, float e2) {
       if (!shaded) init_shader(shader, mesh, ti, float(t.area2)), shaded = true;
-      draw(pixels + size_t(py) * stride + size_t(px) * kChannels, shader.shade(e1, e2));
+      draw(at(px, py), shader.shade(e1, e2));
     });
   };
 #if defined(__SSE2__)
@@ -721,7 +733,7 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
         quad = tail;
         quad_colors = tail_colors;
       }
-      cover_quad(f.fixed, quad, n, last_x, band_y0, last_y, q);
+      cover_quad(f.fixed, quad, n, first_x, last_x, band_y0, last_y, q);
       // A triangle owns 0, 1 or 2 of its candidates, unpredictably: the first (two) are shaded and
       // drawn without branches (a missing one, kNone, to a dummy pixel), only the rare others
       // one by one.
@@ -748,8 +760,7 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
         }
         auto draw_lane = [&](int lane) {
           // (Unsigned arithmetic: a lane without candidates may have its origin off the output.)
-          const uintptr_t origin = uintptr_t(pixels) + uintptr_t(py0[lane]) * stride +
-                                   uintptr_t(px0[lane]) * kChannels;
+          const uintptr_t origin = uintptr_t(at(px0[lane], py0[lane]));
           offsets[QuadCoverage::kNone] = uintptr_t(dummy) - origin;
           for (int r = 0; r < kRounds; ++r)
             draw(reinterpret_cast<uint8_t*>(origin + offsets[c[r][lane]]), rgb[r][lane]);
@@ -780,8 +791,7 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
         for (uint32_t owned = lane_of<uint32_t>(rest, lane); owned; owned &= owned - 1) {
           const int c = std::countr_zero(owned);
           const float i = float(c & 3), j = float(c >> 2);
-          draw(pixels + size_t(py0[lane] + (c >> 2)) * stride +
-                   size_t(px0[lane] + (c & 3)) * kChannels,
+          draw(at(px0[lane] + (c & 3), py0[lane] + (c >> 2)),
                shader.shade(e1 + i * e1_x + j * e1_y, e2 + i * e2_x + j * e2_y));
         }
       }
@@ -797,13 +807,13 @@ void draw_centres(const Frame& f, std::span<const int32_t> units, const Unit* un
 void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int band_y0, int band_y1) {
   const RefinedMesh& mesh = *f.mesh;
   MarkTiles& marks = *f.marks;
-  const int last_x = f.width - 1, last_y = band_y1 - 1;
+  const int last_x = f.clip.x1 - 1, last_y = band_y1 - 1;
   TriangleSetup t;
   Shader shader;
   for (const int32_t ti : triangles) {
     const Tri& tri = mesh.triangles[ti];
     t.init(f.fixed[tri[0]], f.fixed[tri[1]], f.fixed[tri[2]]);
-    const int ax0 = std::max(pixel_floor(t.min_x), 0), ax1 = std::min(pixel_floor(t.max_x), last_x);
+    const int ax0 = std::max(pixel_floor(t.min_x), f.clip.x0), ax1 = std::min(pixel_floor(t.max_x), last_x);
     const int ay0 = std::max(pixel_floor(t.min_y), band_y0),
               ay1 = std::min(pixel_floor(t.max_y), last_y);
     if (!t.init_edges()) continue;
@@ -820,19 +830,20 @@ void draw_subsamples(const Frame& f, std::span<const int32_t> triangles, int ban
 // ---- Overlays ----------------------------------------------------------------------------------
 
 // Anti-aliased overlay primitives: coverage of a pixel centre at distance d from a primitive of
-// half width w is clamp(w + 0.5 - d, 0, 1), a box-filtered edge. Rows [y0, y1) only.
-void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer> layers,
-                       std::vector<float>& coverage) {
-  const int w = out.width;
+// half width w is clamp(w + 0.5 - d, 0, 1), a box-filtered edge. Columns [x0, x1) and rows
+// [y0, y1) of the view only; row 0 of `out` is view row `row0`.
+void draw_overlay_band(Image8& out, int x0, int x1, int y0, int y1, int row0,
+                       std::span<const OverlayLayer> layers, std::vector<float>& coverage) {
+  const int w = x1 - x0;
   coverage.assign(size_t(y1 - y0) * w, 0.f);
   auto pixel = [](float v, int lo, int hi) {  // floor, clamped (also for huge or NaN values)
     const float f = std::floor(v);
     return f > float(lo) ? (f < float(hi) ? static_cast<int>(f) : hi) : lo;
   };
   for (const OverlayLayer& layer : layers) {
-    int bx0 = w, bx1 = -1, by0 = y1, by1 = y0 - 1;  // touched region
+    int bx0 = x1, bx1 = x0 - 1, by0 = y1, by1 = y0 - 1;  // touched region
     auto splat = [&](float minx, float maxx, float miny, float maxy, auto&& cov) {
-      const int px0 = pixel(minx, 0, w), px1 = pixel(maxx, -1, w - 1);
+      const int px0 = pixel(minx, x0, x1), px1 = pixel(maxx, x0 - 1, x1 - 1);
       const int py0 = pixel(miny, y0, y1), py1 = pixel(maxy, y0 - 1, y1 - 1);
       if (px0 > px1 || py0 > py1) return;
       bx0 = std::min(bx0, px0), bx1 = std::max(bx1, px1), by0 = std::min(by0, py0),
@@ -840,7 +851,7 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
       for (int py = py0; py <= py1; ++py) {
         float* row = coverage.data() + size_t(py - y0) * w;
         for (int px = px0; px <= px1; ++px)
-          row[px] = std::max(row[px], cov(float(px) + 0.5f, float(py) + 0.5f));
+          row[px - x0] = std::max(row[px - x0], cov(float(px) + 0.5f, float(py) + 0.5f));
       }
     };
     const float reach = layer.half_width + 1.f;
@@ -865,10 +876,10 @@ void draw_overlay_band(Image8& out, int y0, int y1, std::span<const OverlayLayer
     // Source-over compositing with straight alpha.
     for (int py = by0; py <= by1; ++py) {
       float* row = coverage.data() + size_t(py - y0) * w;
-      uint8_t* dst = out.row(py);
+      uint8_t* dst = out.row(py - row0);
       for (int px = bx0; px <= bx1; ++px) {
-        const float a = row[px] * layer.opacity;
-        row[px] = 0.f;
+        const float a = row[px - x0] * layer.opacity;
+        row[px - x0] = 0.f;
         if (a <= 0.f) continue;
         uint8_t* p = dst + size_t(px) * out.channels;
         const float da = out.channels == 4 ? p[3] / 255.f : 1.f;
@@ -961,9 +972,9 @@ void bound_unit(const RefinedMesh& mesh, const Frame& f, const ViewTransform& vi
     x0 = pixel_floor(bx0), x1 = pixel_floor(bx1), y0 = pixel_floor(by0), y1 = pixel_floor(by1);
   }
   unit.x0 = x0, unit.x1 = x1;
-  unit.y0 = std::max(y0, 0);
-  unit.y1 = std::min(y1, f.height - 1);
-  if (x1 < 0 || x0 >= f.width || unit.begin >= unit.end) unit.y1 = unit.y0 - 1;  // culled
+  unit.y0 = std::max(y0, f.clip.y0);
+  unit.y1 = std::min(y1, f.clip.y1 - 1);
+  if (x1 < f.clip.x0 || x0 >= f.clip.x1 || unit.begin >= unit.end) unit.y1 = unit.y0 - 1;  // culled
 }
 
 }  // namespace
@@ -978,14 +989,22 @@ Image8 rasterize(const RefinedMesh& mesh, const ViewTransform& view, const Raste
 void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const RasterOptions& options,
                     std::span<const OverlayLayer> overlay, RasterScratch* scratch, Image8& out) {
   const int width = view.width, height = view.height, threads = std::max(options.threads, 1);
+  const PixelRect clip = options.clip.value_or(PixelRect{0, 0, width, height});
+  if (clip.x0 < 0 || clip.y0 < 0 || clip.x1 > width || clip.y1 > height || clip.x0 >= clip.x1 ||
+      clip.y0 >= clip.y1 || clip.y0 % kTile != 0 ||
+      (options.clip && (out.width != width || out.height != clip.y1 - clip.y0 ||
+                        out.channels != options.channels))) {
+    throw std::logic_error("rasterize_into: bad clip");
+  }
   // A reused frame is cleared band by band just before the band is drawn, so that the drawing
   // finds its rows in cache (clearing a 4K frame up front costs a cache miss per line later).
-  const bool reused =
-      out.width == width && out.height == height && out.channels == options.channels;
-  if (!reused) out = Image8(width, height, options.channels);
+  // A clipped frame is the caller's, cleared by it.
+  const bool reused = !options.clip && out.width == width && out.height == height &&
+                      out.channels == options.channels;
+  if (!reused && !options.clip) out = Image8(width, height, options.channels);
   RasterScratch local;
   RasterScratch& work = scratch ? *scratch : local;
-  Frame f{&mesh, nullptr, width, height, nullptr};
+  Frame f{&mesh, nullptr, width, height, nullptr, clip};
 
   // Snap the vertices and bound the blocks of triangles. Blocks come from the caller with
   // image-space boxes (then both run as one parallel loop), or are cut here, 64 triangles each,
@@ -1013,7 +1032,7 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   if (!given) parallel_for(unit_jobs, threads, bound_units);
 
   // Mark the pixels crossed by discontinuities (serial: cheap, and keeps the tile order fixed).
-  MarkTiles marks(width, height);
+  MarkTiles marks(width, clip.y0, clip.y1);
   if (options.antialias) {
     for (const EdgeVerts& e : mesh.tear_edges) marks.mark_segment(f.fixed[e[0]], f.fixed[e[1]]);
     if (options.antialias_border) {
@@ -1026,19 +1045,21 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   // Bin the blocks by band: a block goes to every band that its bounding box's pixel rows meet
   // (the band pass culls each triangle further). Serial and in block order, so each band's list
   // is in triangle order whatever the thread count.
-  const int shift = band_shift(height, threads), band_h = 1 << shift;
-  const int num_bands = (height + band_h - 1) / band_h;
+  const int shift = band_shift(clip.y1 - clip.y0, threads), band_h = 1 << shift;
+  const int num_bands = (clip.y1 - clip.y0 + band_h - 1) / band_h;
   work.band_begin.assign(num_bands + 2, 0);
   int64_t* begin = work.band_begin.data() + 1;  // count into begin[band + 1], then prefix
   for (const Unit& unit : work.units) {
-    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band)
+    for (int band = (unit.y0 - clip.y0) >> shift;
+         unit.y0 <= unit.y1 && band <= (unit.y1 - clip.y0) >> shift; ++band)
       ++begin[band + 1];
   }
   for (int band = 0; band < num_bands; ++band) begin[band + 1] += begin[band];
   work.binned.resize(begin[num_bands]);
   for (int u = 0; u < num_units; ++u) {
     const Unit& unit = work.units[u];
-    for (int band = unit.y0 >> shift; unit.y0 <= unit.y1 && band <= unit.y1 >> shift; ++band) {
+    for (int band = (unit.y0 - clip.y0) >> shift;
+         unit.y0 <= unit.y1 && band <= (unit.y1 - clip.y0) >> shift; ++band) {
       work.binned[begin[band]++] = u;
     }
   }
@@ -1059,14 +1080,14 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
   std::sort(order.begin(), order.end());
   parallel_for(num_bands, threads, [&](int job) {
     const int band = order[job].second;
-    const int y0 = band * band_h, y1 = std::min(height, y0 + band_h);
+    const int y0 = clip.y0 + band * band_h, y1 = std::min(clip.y1, y0 + band_h);
     if (reused) std::fill(out.row(y0), out.row(y0) + size_t(y1 - y0) * width * out.channels, 0);
     const std::span<const int32_t> list(work.binned.data() + work.band_begin[band],
                                         work.binned.data() + work.band_begin[band + 1]);
     thread_local std::vector<int32_t> near_list;
     near_list.clear();
     std::vector<int32_t>* near =
-        f.marks && marks.any_tile(0, width - 1, y0, y1 - 1) ? &near_list : nullptr;
+        f.marks && marks.any_tile(clip.x0, clip.x1 - 1, y0, y1 - 1) ? &near_list : nullptr;
     if (options.channels == 4) {
       draw_centres<4>(f, list, work.units.data(), out, y0, y1, near);
     } else {
@@ -1074,11 +1095,11 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
     }
     if (near) {
       draw_subsamples(f, near_list, y0, y1);
-      marks.resolve(out, y0, y1);
+      marks.resolve(out, clip.x0, clip.x1, y0, y1);
     }
     if (!overlay.empty()) {
       thread_local std::vector<float> coverage;
-      draw_overlay_band(out, y0, y1, overlay, coverage);
+      draw_overlay_band(out, clip.x0, clip.x1, y0, y1, clip.y0, overlay, coverage);
     }
   });
 }
@@ -1088,9 +1109,15 @@ void draw_overlay(Image8& out, std::span<const OverlayLayer> overlay, int thread
   constexpr int kBand = 64;
   parallel_for((out.height + kBand - 1) / kBand, std::max(threads, 1), [&](int band) {
     thread_local std::vector<float> coverage;
-    draw_overlay_band(out, band * kBand, std::min(out.height, (band + 1) * kBand), overlay,
-                      coverage);
+    draw_overlay_band(out, 0, out.width, band * kBand, std::min(out.height, (band + 1) * kBand), 0,
+                      overlay, coverage);
   });
+}
+
+void draw_overlay_clipped(Image8& out, const PixelRect& clip, std::span<const OverlayLayer> overlay) {
+  if (overlay.empty()) return;
+  std::vector<float> coverage;
+  draw_overlay_band(out, clip.x0, clip.x1, clip.y0, clip.y1, clip.y0, overlay, coverage);
 }
 
 std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransform& view,
@@ -1118,7 +1145,7 @@ std::vector<int32_t> sample_coverage(const RefinedMesh& mesh, const ViewTransfor
       Tri quad[4];
       for (int lane = 0; lane < 4; ++lane) quad[lane] = tris[ti + (lane < n ? lane : 0)];
       QuadCoverage q;
-      cover_quad(fixed.data(), quad, n, width - 1, 0, height - 1, q);
+      cover_quad(fixed.data(), quad, n, 0, width - 1, 0, height - 1, q);
       for (int lane = 0; lane < n; ++lane) {
         if ((q.large >> lane) & 1) count_centres(tris[ti + lane]);
         const int px0 = lane_of<int32_t>(q.px0, lane), py0 = lane_of<int32_t>(q.py0, lane);

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -60,6 +61,11 @@ struct TriangleBlock {
   float x0, y0, x1, y1;
 };
 
+// A rectangle of a view's output pixels: columns [x0, x1), rows [y0, y1).
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 struct RasterOptions {
   int channels = 3;               // 3: RGB; 4: RGBA, uncovered samples transparent
   bool antialias = true;          // supersample pixels crossed by tear edges
@@ -69,6 +75,12 @@ struct RasterOptions {
   // good binning; empty: all triangles, in blocks of 64 bounded per frame. A caller that keeps a
   // refinement across frames keeps its blocks too, and blocks out of the view cost nothing.
   std::span<const TriangleBlock> blocks;
+  // Draw only these pixels of the view (a tile, renderer.cpp's render_strips): `out` then holds
+  // the clip's rows at the view's full width (view.width x (y1 - y0), row 0 = view row y0), is
+  // neither cleared nor reallocated, and only the clip's pixels are written. Every pixel comes out
+  // as the unclipped frame has it, provided the mesh holds every triangle (and tear or border
+  // edge) that meets the clip, and the overlays every primitive near it.
+  std::optional<PixelRect> clip;
 };
 
 // A vertex in output pixels, 24.8 fixed point.
@@ -101,6 +113,9 @@ void rasterize_into(const RefinedMesh& mesh, const ViewTransform& view, const Ra
 // Composites overlay layers over a finished frame (what rasterize() does band by band), for frames
 // drawn elsewhere (the GPU path).
 void draw_overlay(Image8& out, std::span<const OverlayLayer> overlay, int threads);
+// The same for the pixels of `clip` only, `out` holding the view's rows from clip.y0 (as
+// RasterOptions::clip).
+void draw_overlay_clipped(Image8& out, const PixelRect& clip, std::span<const OverlayLayer> overlay);
 
 // Test hook: runs the coverage traversal of rasterize() over every triangle and counts how many
 // triangles claim each sample. Returns #H*W counts of the pixel-centre samples, or with

@@ -19,7 +19,10 @@
 #include "subvec/render/renderer.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "core/messages_p.h"
@@ -275,25 +278,24 @@ struct RefineCache {
 
 // Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
 // bounds each block's vertices.
-void update_blocks(RefineCache& c, int threads) {
-  const RefinedMesh& r = c.refined;
+void update_blocks(const RefinedMesh& r, std::vector<detail::TriangleBlock>& blocks, int threads) {
   constexpr int32_t kBlock = 64;
-  if (c.blocks.empty()) {
+  if (blocks.empty()) {
     for (int32_t t = 0; t < r.num_triangles();) {
       int32_t end = t + 1;
       while (end < r.num_triangles() && end - t < kBlock &&
              r.triangle_parent[end] == r.triangle_parent[t])
         ++end;
-      c.blocks.push_back({t, end, 0, 0, 0, 0});
+      blocks.push_back({t, end, 0, 0, 0, 0});
       t = end;
     }
   }
   constexpr int kBlocksPerJob = 1024;
-  const int jobs = (static_cast<int>(c.blocks.size()) + kBlocksPerJob - 1) / kBlocksPerJob;
+  const int jobs = (static_cast<int>(blocks.size()) + kBlocksPerJob - 1) / kBlocksPerJob;
   detail::parallel_for(jobs, threads, [&](int job) {
-    const size_t end = std::min(c.blocks.size(), size_t(job + 1) * kBlocksPerJob);
+    const size_t end = std::min(blocks.size(), size_t(job + 1) * kBlocksPerJob);
     for (size_t i = size_t(job) * kBlocksPerJob; i < end; ++i) {
-      detail::TriangleBlock& block = c.blocks[i];
+      detail::TriangleBlock& block = blocks[i];
       float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
       for (int32_t t = block.begin; t < block.end; ++t) {
         for (const int32_t v : r.triangles[t]) {
@@ -415,13 +417,13 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
     c.depth = plan.depth;
     c.faces = std::move(plan.faces);
     c.on_gpu = false;
-    update_blocks(c, threads);
+    update_blocks(c.refined, c.blocks, threads);
   } else if (c.positions_stale && c.colors_stale) {
     c.subdivision->evaluate(mesh.positions, mesh.colors, c.refined, threads);
-    update_blocks(c, threads);
+    update_blocks(c.refined, c.blocks, threads);
   } else if (c.positions_stale) {
     c.subdivision->evaluate_positions(mesh.positions, c.refined.positions, threads);
-    update_blocks(c, threads);
+    update_blocks(c.refined, c.blocks, threads);
   } else if (c.colors_stale) {
     c.subdivision->evaluate_colors(mesh.colors, c.refined.colors, threads);
   }
@@ -503,6 +505,129 @@ Image8 render(const VectorImage& image, const RenderOptions& options) {
   return out;
 }
 
+namespace {
+
+// What a worker keeps from tile to tile, so that later tiles reuse its pages.
+struct TileWork {
+  RefinedMesh refined;
+  std::vector<detail::TriangleBlock> blocks;
+  detail::RasterScratch scratch;
+  std::vector<int32_t> faces;
+};
+
+// Output pixels around a tile within which its faces are selected: the overlays reach 2.75 pixels
+// past their primitives, and snapping and the marks of tear pixels less than one.
+constexpr double kTileMargin = 4;
+
+// Draws the pixels `clip` of the view of `plan` into `strip` (the view's rows from clip.y0).
+void draw_tile(const VectorImage& image, const RenderOptions& options, const MeshTopology& topology,
+               std::span<const std::array<double, 4>> boxes, const detail::ViewPlan& plan,
+               std::span<const detail::OverlayLayer> mesh_overlay, const detail::PixelRect& clip,
+               int threads, TileWork& work, Image8& strip) {
+  const ControlMesh& mesh = image.levels[options.level];
+  const detail::ViewTransform& v = plan.view;
+  const double x0 = v.x0 + (clip.x0 - kTileMargin) / v.sx, x1 = v.x0 + (clip.x1 + kTileMargin) / v.sx;
+  const double y0 = v.y0 + (clip.y0 - kTileMargin) / v.sy, y1 = v.y0 + (clip.y1 + kTileMargin) / v.sy;
+  work.faces.clear();
+  for (const int32_t f : plan.faces) {
+    const auto& b = boxes[f];
+    if (b[2] < x0 || b[0] > x1 || b[3] < y0 || b[1] > y1) continue;
+    work.faces.push_back(f);
+  }
+  if (work.faces.empty()) {
+    if (options.overlay == Overlay::kMesh) detail::draw_overlay_clipped(strip, clip, mesh_overlay);
+    detail::draw_strokes(image.strokes, options.level, v, clip, strip);
+    return;
+  }
+  const bool all = work.faces.size() == size_t(mesh.num_triangles());
+  {
+    const Subdivision subdivision(mesh, topology, plan.depth,
+                                  all ? std::span<const int32_t>{} : std::span<const int32_t>(work.faces));
+    // evaluate_once() copies the topology only when the triangle count differs: another tile's
+    // refinement may have the same count. Emptied (capacity kept), it is always copied.
+    work.refined.triangles.clear();
+    subdivision.evaluate_once(mesh.positions, mesh.colors, work.refined, threads);
+  }
+  work.blocks.clear();
+  update_blocks(work.refined, work.blocks, threads);
+  detail::RasterOptions raster;
+  raster.channels = plan.channels;
+  raster.antialias = options.antialias;
+  raster.antialias_border = plan.channels == 4;
+  raster.threads = threads;
+  raster.blocks = work.blocks;
+  raster.clip = clip;
+  std::vector<detail::OverlayLayer> features;
+  if (options.overlay == Overlay::kFeatures) features = detail::feature_overlay(work.refined, v);
+  detail::rasterize_into(work.refined, v, raster,
+                         options.overlay == Overlay::kFeatures ? features
+                         : options.overlay == Overlay::kMesh
+                             ? mesh_overlay
+                             : std::span<const detail::OverlayLayer>{},
+                         &work.scratch, strip);
+  detail::draw_strokes(image.strokes, options.level, v, clip, strip);
+}
+
+}  // namespace
+
+void render_strips(const VectorImage& image, const RenderOptions& options,
+                   const std::function<void(int y0, const Image8& strip)>& sink,
+                   const TileOptions& tiles) {
+  if (image.width < 1 || image.height < 1) {
+    throw Error(ErrorCode::kInvalidArgument, "the image has no pixels");
+  }
+  if (tiles.tile != 0 && (tiles.tile < 64 || tiles.tile > 8192 || tiles.tile % 64 != 0)) {
+    detail::invalid("tile size " + std::to_string(tiles.tile) +
+                    " is not 0 (automatic) or a multiple of 64 in 64..8192");
+  }
+  State state;
+  LevelState& ls = level_state(image, state, options.level);
+  const ControlMesh& mesh = image.levels[options.level];
+  const detail::ViewPlan plan = detail::plan_view(image, mesh, ls.boxes, options);
+  const int threads = detail::resolve_threads(options.threads);
+  const int width = plan.view.width, height = plan.view.height;
+  // Automatic size: the largest of 2048, 1024, 512, 256 whose tile holds at most 2^18 refined
+  // triangles at the view's mean density (ring included, a tile refines up to a few times that).
+  int tile = tiles.tile;
+  if (tile == 0) {
+    const double density = double(plan.faces.size()) * std::ldexp(1.0, 2 * plan.depth) /
+                           (double(width) * double(height));
+    tile = 2048;
+    while (tile > 256 && density * double(tile) * double(tile) > double(1 << 18)) tile /= 2;
+  }
+  std::vector<detail::OverlayLayer> mesh_overlay;
+  if (options.overlay == Overlay::kMesh)
+    mesh_overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
+  const int columns = (width + tile - 1) / tile;
+  // Several tiles a strip: one per worker, each drawn on one thread; else one tile at a time on
+  // all of them. Tiles own disjoint pixels, so the order does not change the output.
+  const bool across = columns >= 2 && threads >= 2;
+  const int workers = across ? std::min(threads, columns) : 1;
+  std::vector<TileWork> work(workers);
+  Image8 strip;
+  for (int y = 0; y < height; y += tile) {
+    const int rows = std::min(tile, height - y);
+    if (strip.height != rows) {
+      strip = Image8(width, rows, plan.channels);
+    } else {
+      std::fill(strip.pixels.begin(), strip.pixels.end(), uint8_t{0});
+    }
+    auto draw = [&](int column, TileWork& w, int inner) {
+      const detail::PixelRect clip{column * tile, y, std::min(width, (column + 1) * tile), y + rows};
+      draw_tile(image, options, *ls.topology, ls.boxes, plan, mesh_overlay, clip, inner, w, strip);
+    };
+    if (across) {
+      // Worker k draws columns k, k + workers, ...
+      detail::parallel_for(workers, workers, [&](int k) {
+        for (int column = k; column < columns; column += workers) draw(column, work[k], 1);
+      });
+    } else {
+      for (int column = 0; column < columns; ++column) draw(column, work[0], threads);
+    }
+    sink(y, strip);
+  }
+}
+
 struct Renderer::Impl {
   VectorImage image;
   State state;
@@ -530,6 +655,23 @@ void Renderer::render(const RenderOptions& options, Image8& out) {
 Backend Renderer::last_backend() const { return impl_->state.last_backend; }
 
 std::string gpu_unavailable_reason() { return detail::gpu_probe(); }
+
+bool is_software_renderer(std::string_view gl_renderer) {
+  std::string lower(gl_renderer);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* word : {"llvmpipe", "softpipe", "swrast", "software", "swiftshader", "lavapipe"}) {
+    if (lower.find(word) != std::string::npos) return true;
+  }
+  return false;
+}
+
+GpuRendererInfo gpu_renderer() {
+  GpuRendererInfo info;
+  if (!detail::gpu_probe().empty()) return info;
+  info.name = detail::gpu_probe_renderer();
+  info.software = is_software_renderer(info.name);
+  return info;
+}
 
 void Renderer::set_positions(int level, std::span<const Vec2> positions) {
   VectorImage& image = impl_->image;

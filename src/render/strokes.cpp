@@ -30,7 +30,12 @@ struct Chord {
 }  // namespace
 
 void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransform& view, Image8& out) {
-  const int width = out.width, height = out.height;
+  draw_strokes(strokes, level, view, PixelRect{0, 0, out.width, out.height}, out);
+}
+
+void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransform& view,
+                  const PixelRect& clip, Image8& out) {
+  const int width = view.width, height = view.height;
   const double scale = std::sqrt(view.sx * view.sy);
   std::vector<float> coverage;
   std::vector<Chord> chords;
@@ -69,10 +74,10 @@ void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransfor
     }
 
     // Coverage over the stroke's pixels, clipped to the frame.
-    const int x0 = std::max(0, static_cast<int>(std::floor(std::max(bx0, -1.0))));
-    const int y0 = std::max(0, static_cast<int>(std::floor(std::max(by0, -1.0))));
-    const int x1 = std::min(width - 1, static_cast<int>(std::min(bx1, double(width))));
-    const int y1 = std::min(height - 1, static_cast<int>(std::min(by1, double(height))));
+    const int x0 = std::max(clip.x0, static_cast<int>(std::floor(std::max(bx0, -1.0))));
+    const int y0 = std::max(clip.y0, static_cast<int>(std::floor(std::max(by0, -1.0))));
+    const int x1 = std::min(clip.x1 - 1, static_cast<int>(std::min(bx1, double(width))));
+    const int y1 = std::min(clip.y1 - 1, static_cast<int>(std::min(by1, double(height))));
     if (x0 > x1 || y0 > y1) continue;
     const int cw = x1 - x0 + 1, ch = y1 - y0 + 1;
     coverage.assign(size_t(cw) * ch, 0.f);
@@ -101,7 +106,7 @@ void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransfor
     const float color[3] = {stroke.color.r, stroke.color.g, stroke.color.b};
     for (int py = y0; py <= y1; ++py) {
       const float* row = coverage.data() + size_t(py - y0) * cw;
-      uint8_t* dst = out.row(py);
+      uint8_t* dst = out.row(py - clip.y0);
       for (int px = x0; px <= x1; ++px) {
         const float a = row[px - x0];
         if (a <= 0.f) continue;

@@ -14,5 +14,9 @@ namespace subvec::detail {
 // tapering linearly to zero over `taper` of its length at both ends, anti-aliased and composited
 // source-over with straight alpha.
 void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransform& view, Image8& out);
+// The same for the pixels of `clip` only, `out` holding the view's rows from clip.y0 at full width
+// (RasterOptions::clip): each pixel as draw_strokes() over the whole frame gives it.
+void draw_strokes(std::span<const Stroke> strokes, int level, const ViewTransform& view,
+                  const PixelRect& clip, Image8& out);
 
 }  // namespace subvec::detail

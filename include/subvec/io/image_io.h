@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,5 +30,26 @@ std::vector<uint8_t> encode_png(const Image8& image);
 
 // Writes a PNG (RGB or RGBA) atomically: to a temporary file beside `path`, then renamed.
 void write_png(const std::filesystem::path& path, const Image8& image);
+
+// A PNG (8-bit RGB or RGBA) written row by row, for images that are drawn in strips and never
+// held whole (render_strips): the rows go through libpng to a temporary file beside `path`,
+// which finish() renames onto it; a writer destroyed unfinished removes its temporary file, so
+// `path` is never left partial. The bytes are write_png()'s for the same pixels. Throws
+// Error(kInvalidArgument) for a bad size or strip, Error(kIo) if writing fails.
+class PngWriter {
+ public:
+  PngWriter(const std::filesystem::path& path, int width, int height, int channels);
+  ~PngWriter();
+  PngWriter(const PngWriter&) = delete;
+  PngWriter& operator=(const PngWriter&) = delete;
+  // The next rows.height rows (rows.width and rows.channels as given to the constructor).
+  void write_rows(const Image8& rows);
+  // After the last row: completes the file and renames it onto `path`.
+  void finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace subvec

@@ -8,10 +8,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "subvec/core/image.h"
@@ -47,7 +49,8 @@ struct RenderOptions {
   std::optional<Window> window;  // default: the whole image
   // Outputs over this many pixels are refused (Error(kLimit)): a file of a few hundred bytes may
   // declare a 65536 x 4096 image, whose render at 1x would take half a minute and gigabytes.
-  // 2^26 (8192 x 8192) renders in seconds with about 400 MB. At most kMaxRenderPixels.
+  // 2^26 (8192 x 8192) of a 1.4k-vertex photograph takes 7.5-9 s and about 1 GB at the default
+  // depth through render_strips (1.6 s, 195 MB at depth 4; scripts/bench-render). At most kMaxRenderPixels.
   int64_t max_pixels = int64_t{1} << 26;
   int level = 0;                 // level of detail
   Overlay overlay = Overlay::kNone;
@@ -78,6 +81,18 @@ RenderSize render_size(const RenderOptions& options, int image_width, int image_
 // be created through EGL, else a one-line reason. The first call tries once; later calls return the
 // same answer.
 std::string gpu_unavailable_reason();
+
+// The OpenGL renderer that Backend::kGpu would draw with (GL_RENDERER of the probed context; ""
+// when gpu_unavailable_reason() is not ""), and whether it is a software rasterizer.
+struct GpuRendererInfo {
+  std::string name;
+  bool software = false;
+};
+GpuRendererInfo gpu_renderer();
+// Whether a GL_RENDERER string names a software rasterizer: Mesa's llvmpipe, softpipe or swrast,
+// or another CPU implementation ("software" in the name). Those draw on the CPU, slower than
+// subvec's own rasterizer.
+bool is_software_renderer(std::string_view gl_renderer);
 
 // The depth rule (docs/performance.md): with L the mean control edge length, in output pixels, of
 // the faces whose limit surface may touch the window, the depth is the smallest k in 0..8 with
@@ -119,6 +134,26 @@ ViewMesh view_mesh(const VectorImage& image, const RenderOptions& options);
 // Throws Error(kInvalidArgument) for a bad level, size, window or depth, Error(kLimit) for an
 // output over the size limits, Error(kInvalidMesh) when the level fails validate_level().
 Image8 render(const VectorImage& image, const RenderOptions& options);
+
+// Tiles of render_strips(): square tiles of `tile` output pixels a side (a multiple of 64, 64 to
+// 8192), drawn in horizontal strips of one tile row. 0: chosen from the refined triangles per
+// output pixel (256 to 2048: at most about 2^18 refined triangles a tile before the ring).
+struct TileOptions {
+  int tile = 0;
+};
+
+// Draws the render of `options` in tiles, strip by strip, top to bottom: sink(y0, strip) receives
+// rows [y0, y0 + strip.height) of the output, at the output's full width, each row once and in
+// order; `strip` is valid during the call only. The depth is the one render() chooses for the
+// whole view (the depth rule over every visible face); each tile then refines only the control
+// faces whose limit surface may come within a few output pixels of it (with the ring they need),
+// and draws only its own pixels, so the rows are render()'s byte for byte (tears, border,
+// overlays and strokes included), whatever the tile size or thread count. Peak memory depends on
+// the tile size and the mesh, not on the output size. Always on the CPU (options.backend is not
+// used). Errors as render(), before the first call of `sink`; what `sink` throws propagates.
+void render_strips(const VectorImage& image, const RenderOptions& options,
+                   const std::function<void(int y0, const Image8& strip)>& sink,
+                   const TileOptions& tiles = {});
 
 // A renderer that keeps the refinement of the last view, so that redrawing the same view, a view
 // inside it at the same depth (pan, zoom within a level), or drawing after an edit of positions or

@@ -38,6 +38,8 @@ namespace subvec::detail {
 // `no_display` (when given) tells whether the failure is that no EGL display exists at all (no
 // driver, no device), as opposed to a display without a usable OpenGL 4.3 context.
 std::string gpu_probe(bool* no_display = nullptr);
+// The GL_RENDERER string of the context gpu_probe() created ("" when none could be).
+std::string gpu_probe_renderer();
 
 // One EGL context with its programs and buffers. Not thread-safe; each call makes the context
 // current on the calling thread.
@@ -46,6 +48,8 @@ class GpuRasterizer {
   // nullptr and a one-line `error` when no context can be created.
   static std::unique_ptr<GpuRasterizer> create(std::string& error);
   virtual ~GpuRasterizer() = default;
+  // The context's GL_RENDERER string (e.g. "NVIDIA H200/PCIe/SSE2", "llvmpipe (LLVM 15.0.6, 256 bits)").
+  virtual std::string renderer() const = 0;
 
   // A new refinement: uploads its limit stencils (built here when not built yet) and its
   // triangles. The control values must be set afterwards.

@@ -392,6 +392,8 @@ class GlRasterizer final : public GpuRasterizer {
       throw Error(ErrorCode::kIo, std::string("GPU: OpenGL ") + (version ? version : "?") +
                                       " is older than 4.3 (compute shaders)");
     }
+    const char* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    renderer_ = name ? name : "";
     stencil2_ = link({compile(GL_COMPUTE_SHADER, "#define N 2\n" + std::string(kStencilShader),
                               "stencil")},
                      "stencil");
@@ -782,6 +784,10 @@ class GlRasterizer final : public GpuRasterizer {
   int64_t num_corners_ = 0, resolved_size_ = 0, marks_size_ = 0;
   int num_vertices_ = 0, num_colors_ = 0;
   std::vector<uint8_t> staging_;
+  std::string renderer_;
+
+ public:
+  std::string renderer() const override { return renderer_; }
 };
 
 }  // namespace
@@ -804,14 +810,26 @@ std::unique_ptr<GpuRasterizer> GpuRasterizer::create(std::string& error) {
   return r;
 }
 
-std::string gpu_probe(bool* no_display) {
-  if (no_display) *no_display = !display().initialized_any;
-  static const std::string reason = [] {
+namespace {
+
+// The probe's answer: the reason ("" when a context was created) and that context's renderer.
+const std::pair<std::string, std::string>& probe() {
+  static const std::pair<std::string, std::string> answer = [] {
     std::string error;
     const std::unique_ptr<GpuRasterizer> r = GpuRasterizer::create(error);
-    return r ? std::string() : error;
+    return r ? std::pair<std::string, std::string>{std::string(), r->renderer()}
+             : std::pair<std::string, std::string>{error, std::string()};
   }();
-  return reason;
+  return answer;
 }
+
+}  // namespace
+
+std::string gpu_probe(bool* no_display) {
+  if (no_display) *no_display = !display().initialized_any;
+  return probe().first;
+}
+
+std::string gpu_probe_renderer() { return probe().second; }
 
 }  // namespace subvec::detail

@@ -14,4 +14,6 @@ std::string gpu_probe(bool* no_display) {
   return "this subvec was built without GPU support (SUBVEC_GPU=OFF)";
 }
 
+std::string gpu_probe_renderer() { return {}; }
+
 }  // namespace subvec::detail
