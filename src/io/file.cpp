@@ -1,8 +1,9 @@
 // Whole-file reads and atomic writes (io/file.h), on POSIX calls so that every failure carries the
 // operating system's reason.
 //
-// write_file_atomic writes a temporary file next to the target (same directory, hence same file
-// system, so rename() is atomic), fsyncs it, renames it over the target and fsyncs the directory.
+// AtomicFile (and write_file_atomic, which is one) writes a temporary file next to the target (same
+// directory, hence same file system, so rename() is atomic), fsyncs it, renames it over the target
+// and fsyncs the directory.
 // On any failure the temporary file is removed and the target is left as it was.
 #include "subvec/io/file.h"
 
@@ -88,47 +89,79 @@ std::vector<uint8_t> read_file(const std::filesystem::path& path, int64_t max_by
   return bytes;
 }
 
-void write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+struct AtomicFile::Impl {
+  std::filesystem::path path, temp;
+  int fd = -1;
+  bool committed = false;
+
+  [[noreturn]] void fail(const char* action, int err) {
+    throw Error(ErrorCode::kIo, os_error(path, action, err));
+  }
+};
+
+AtomicFile::AtomicFile(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
   static std::atomic<uint64_t> counter{0};
+  Impl& m = *impl_;
+  m.path = path;
   if (path.filename().empty()) throw Error(ErrorCode::kIo, path.string() + ": not a file name");
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
 
   // A unique name in the same directory: pid and a process-wide counter; O_EXCL guards the rest.
-  std::filesystem::path temp;
-  int raw = -1;
-  for (int attempt = 0; raw < 0; ++attempt) {
+  for (int attempt = 0; m.fd < 0; ++attempt) {
     std::string name = ".";
     name.append(path.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
     name.append("-").append(std::to_string(counter.fetch_add(1)));
-    temp = dir / name;
-    raw = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (raw < 0 && !(errno == EEXIST && attempt < 100) && errno != EINTR) {
-      throw Error(ErrorCode::kIo, os_error(path, "create a temporary file", errno));
+    m.temp = dir / name;
+    m.fd = ::open(m.temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (m.fd < 0 && !(errno == EEXIST && attempt < 100) && errno != EINTR) {
+      const int err = errno;
+      m.temp.clear();
+      m.fail("create a temporary file", err);
     }
   }
-  Fd fd(raw);
-  auto fail = [&](const char* action, int err) {
-    ::unlink(temp.c_str());
-    throw Error(ErrorCode::kIo, os_error(path, action, err));
-  };
+}
 
+AtomicFile::~AtomicFile() {
+  Impl& m = *impl_;
+  if (m.fd >= 0) ::close(m.fd);
+  if (!m.committed && !m.temp.empty()) ::unlink(m.temp.c_str());
+}
+
+const std::filesystem::path& AtomicFile::path() const { return impl_->path; }
+
+void AtomicFile::write(std::span<const uint8_t> bytes) {
+  Impl& m = *impl_;
+  if (m.fd < 0) throw Error(ErrorCode::kIo, m.path.string() + ": written after commit");
   size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::write(fd.get(), bytes.data() + done, bytes.size() - done);
+    const ssize_t n = ::write(m.fd, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) fail("write", errno);
+    if (n < 0) m.fail("write", errno);
     done += size_t(n);
   }
-  if (::fsync(fd.get()) != 0) fail("flush", errno);
-  if (::close(fd.release()) != 0) fail("close", errno);
-  if (::rename(temp.c_str(), path.c_str()) != 0) fail("rename the temporary file onto", errno);
+}
+
+void AtomicFile::commit() {
+  Impl& m = *impl_;
+  if (m.fd < 0) throw Error(ErrorCode::kIo, m.path.string() + ": committed twice");
+  if (::fsync(m.fd) != 0) m.fail("flush", errno);
+  if (::close(std::exchange(m.fd, -1)) != 0) m.fail("close", errno);
+  if (::rename(m.temp.c_str(), m.path.c_str()) != 0) m.fail("rename the temporary file onto", errno);
+  m.committed = true;
 
   // Make the rename itself durable; a failure here leaves a complete file, so it is not an error.
+  const std::filesystem::path dir = m.path.has_parent_path() ? m.path.parent_path() : ".";
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd >= 0) {
     ::fsync(dir_fd);
     ::close(dir_fd);
   }
+}
+
+void write_file_atomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  AtomicFile file(path);
+  file.write(bytes);
+  file.commit();
 }
 
 }  // namespace subvec

@@ -27,14 +27,10 @@
 #include "subvec/io/image_io.h"
 
 #include <dlfcn.h>
-#include <fcntl.h>
-#include <unistd.h>
 #include <png.h>
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <cerrno>
 #include <bit>
 #include <csetjmp>
 #include <cstdlib>
@@ -637,44 +633,30 @@ void write_png(const fs::path& path, const Image8& image) {
 // ---- PngWriter ---------------------------------------------------------------------------------
 
 struct PngWriter::Impl {
-  fs::path path, temp;
-  int fd = -1;
+  explicit Impl(const fs::path& target) : file(target) {}
+  AtomicFile file;  // the temporary file, renamed onto the target by finish()
   int width = 0, height = 0, channels = 0, written = 0;
   bool done = false;
   PngError error;
   png_structp png = nullptr;
   png_infop info = nullptr;
   std::vector<uint8_t> buffer;  // encoded bytes not yet written to the file
-  int write_errno = 0;
 
   [[noreturn]] void fail(const std::string& why) {
-    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(path) + ": " + why);
+    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(file.path()) + ": " + why);
   }
   void flush_buffer() {
-    size_t done_bytes = 0;
-    while (done_bytes < buffer.size()) {
-      const ssize_t n = ::write(fd, buffer.data() + done_bytes, buffer.size() - done_bytes);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) fail(std::strerror(errno));
-      done_bytes += size_t(n);
-    }
+    file.write(buffer);
     buffer.clear();
   }
   static void on_write(png_structp p, png_bytep data, png_size_t n) {
     auto* self = static_cast<Impl*>(png_get_io_ptr(p));
     self->buffer.insert(self->buffer.end(), data, data + n);
   }
-  ~Impl() {
-    png_destroy_write_struct(&png, &info);
-    if (fd >= 0) ::close(fd);
-    if (!done && !temp.empty()) ::unlink(temp.c_str());
-  }
+  ~Impl() { png_destroy_write_struct(&png, &info); }
 };
 
-PngWriter::PngWriter(const fs::path& path, int width, int height, int channels)
-    : impl_(std::make_unique<Impl>()) {
-  Impl& m = *impl_;
-  m.path = path;
+PngWriter::PngWriter(const fs::path& path, int width, int height, int channels) {
   if (width <= 0 || height <= 0 || (channels != 3 && channels != 4) || width > (1 << 24) ||
       height > (1 << 24)) {
     throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(path) + ": size " +
@@ -682,22 +664,9 @@ PngWriter::PngWriter(const fs::path& path, int width, int height, int channels)
                                                  std::to_string(height) + " x " +
                                                  std::to_string(channels) + " is not an image");
   }
+  impl_ = std::make_unique<Impl>(path);
+  Impl& m = *impl_;
   m.width = width, m.height = height, m.channels = channels;
-  if (path.filename().empty()) m.fail("not a file name");
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  static std::atomic<uint64_t> counter{0};
-  for (int attempt = 0; m.fd < 0; ++attempt) {
-    std::string name = ".";
-    name.append(path.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
-    name.append("-png-").append(std::to_string(counter.fetch_add(1)));
-    m.temp = dir / name;
-    m.fd = ::open(m.temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (m.fd < 0 && !(errno == EEXIST && attempt < 100) && errno != EINTR) {
-      const int err = errno;
-      m.temp.clear();
-      m.fail(std::string("cannot create a temporary file: ") + std::strerror(err));
-    }
-  }
   m.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &m.error, png_on_error, png_on_warning);
   m.info = m.png ? png_create_info_struct(m.png) : nullptr;
   if (!m.png || !m.info) throw std::bad_alloc();
@@ -719,7 +688,7 @@ void PngWriter::write_rows(const Image8& rows) {
       rows.height > m.height - m.written ||
       rows.pixels.size() != size_t(rows.width) * size_t(rows.height) * size_t(rows.channels)) {
     throw Error(ErrorCode::kInvalidArgument,
-                "cannot write " + in_quotes(m.path) + ": rows that do not fit the image");
+                "cannot write " + in_quotes(m.file.path()) + ": rows that do not fit the image");
   }
   if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
   for (int y = 0; y < rows.height; ++y) png_write_row(m.png, rows.row(y));
@@ -730,27 +699,15 @@ void PngWriter::write_rows(const Image8& rows) {
 void PngWriter::finish() {
   Impl& m = *impl_;
   if (m.done || m.written != m.height) {
-    throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(m.path) + ": " +
+    throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(m.file.path()) + ": " +
                                                  std::to_string(m.written) + " of " +
                                                  std::to_string(m.height) + " rows written");
   }
   if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
   png_write_end(m.png, nullptr);
   m.flush_buffer();
-  if (::fsync(m.fd) != 0) m.fail(std::string("cannot flush: ") + std::strerror(errno));
-  const int fd = m.fd;
-  m.fd = -1;
-  if (::close(fd) != 0) m.fail(std::string("cannot close: ") + std::strerror(errno));
-  if (::rename(m.temp.c_str(), m.path.c_str()) != 0) {
-    m.fail(std::string("cannot rename the temporary file onto it: ") + std::strerror(errno));
-  }
+  m.file.commit();
   m.done = true;
-  const fs::path dir = m.path.has_parent_path() ? m.path.parent_path() : ".";
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
 }
 
 }  // namespace subvec
