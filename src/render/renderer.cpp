@@ -118,8 +118,7 @@ ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
   // Visible faces and their mean edge length in output pixels.
   double edge_sum = 0;
   for (int f = 0; f < mesh.num_triangles(); ++f) {
-    const auto& b = boxes[f];
-    if (b[2] < w.x0 || b[0] > w.x1 || b[3] < w.y0 || b[1] > w.y1) continue;
+    if (!box_meets(boxes[f], w)) continue;
     p.faces.push_back(f);
     const Tri& t = mesh.triangles[f];
     for (int k = 0; k < 3; ++k) {
@@ -308,6 +307,19 @@ void update_blocks(const RefinedMesh& r, std::vector<detail::TriangleBlock>& blo
   });
 }
 
+// The rasterizer's options for a view of `plan`: anti-aliasing as asked, the border's too when the
+// window leaves the image.
+detail::RasterOptions raster_options(const detail::ViewPlan& plan, const RenderOptions& options,
+                                     int threads, std::span<const detail::TriangleBlock> blocks) {
+  detail::RasterOptions raster;
+  raster.channels = plan.channels;
+  raster.antialias = options.antialias;
+  raster.antialias_border = plan.channels == 4;
+  raster.threads = threads;
+  raster.blocks = blocks;
+  return raster;
+}
+
 struct State {
   std::vector<LevelState> levels;
   RefineCache cache;
@@ -429,12 +441,7 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
   }
   c.positions_stale = c.colors_stale = false;
 
-  detail::RasterOptions raster;
-  raster.channels = plan.channels;
-  raster.antialias = options.antialias;
-  raster.antialias_border = plan.channels == 4;
-  raster.threads = threads;
-  raster.blocks = c.blocks;
+  const detail::RasterOptions raster = raster_options(plan, options, threads, c.blocks);
   std::vector<detail::OverlayLayer> overlay;
   if (options.overlay == Overlay::kMesh)
     overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
@@ -526,13 +533,11 @@ void draw_tile(const VectorImage& image, const RenderOptions& options, const Mes
                int threads, TileWork& work, Image8& strip) {
   const ControlMesh& mesh = image.levels[options.level];
   const detail::ViewTransform& v = plan.view;
-  const double x0 = v.x0 + (clip.x0 - kTileMargin) / v.sx, x1 = v.x0 + (clip.x1 + kTileMargin) / v.sx;
-  const double y0 = v.y0 + (clip.y0 - kTileMargin) / v.sy, y1 = v.y0 + (clip.y1 + kTileMargin) / v.sy;
+  const Window tile{v.x0 + (clip.x0 - kTileMargin) / v.sx, v.y0 + (clip.y0 - kTileMargin) / v.sy,
+                    v.x0 + (clip.x1 + kTileMargin) / v.sx, v.y0 + (clip.y1 + kTileMargin) / v.sy};
   work.faces.clear();
   for (const int32_t f : plan.faces) {
-    const auto& b = boxes[f];
-    if (b[2] < x0 || b[0] > x1 || b[3] < y0 || b[1] > y1) continue;
-    work.faces.push_back(f);
+    if (detail::box_meets(boxes[f], tile)) work.faces.push_back(f);
   }
   if (work.faces.empty()) {
     if (options.overlay == Overlay::kMesh) detail::draw_overlay_clipped(strip, clip, mesh_overlay);
@@ -550,12 +555,7 @@ void draw_tile(const VectorImage& image, const RenderOptions& options, const Mes
   }
   work.blocks.clear();
   update_blocks(work.refined, work.blocks, threads);
-  detail::RasterOptions raster;
-  raster.channels = plan.channels;
-  raster.antialias = options.antialias;
-  raster.antialias_border = plan.channels == 4;
-  raster.threads = threads;
-  raster.blocks = work.blocks;
+  detail::RasterOptions raster = raster_options(plan, options, threads, work.blocks);
   raster.clip = clip;
   std::vector<detail::OverlayLayer> features;
   if (options.overlay == Overlay::kFeatures) features = detail::feature_overlay(work.refined, v);

@@ -22,6 +22,12 @@ constexpr int kMaxAutoDepth = 8;
 std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh,
                                               const MeshTopology& topology);
 
+// Whether a face's ring box meets the window: the renderer's visibility rule, for a view and for
+// each tile of one.
+inline bool box_meets(const std::array<double, 4>& b, const Window& w) {
+  return !(b[2] < w.x0 || b[0] > w.x1 || b[3] < w.y0 || b[1] > w.y1);
+}
+
 struct ViewPlan {
   ViewTransform view;
   Window window;
