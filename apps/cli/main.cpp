@@ -208,7 +208,7 @@ void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
   // In tiles, rows streamed to the PNG encoder: memory independent of the output size.
   std::optional<subvec::PngWriter> png;
   subvec::render_strips(image, options, [&](int, const subvec::Image8& strip) {
-    if (!png) png.emplace(a.output, size.width, size.height, strip.channels);
+    if (!png) png.emplace(a.output, size.width, size.height, strip.channels, options.threads);
     png->write_rows(strip);
   });
   png->finish();

@@ -46,6 +46,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/png_encoder_p.h"
 #include "subvec/core/error.h"
 #include "subvec/io/file.h"
 
@@ -574,49 +575,16 @@ Image8 read_image(const fs::path& path, int64_t max_pixels) {
   return image;
 }
 
-namespace {
-
-void png_write_bytes(png_structp png, png_bytep data, png_size_t n) {
-  auto* out = static_cast<std::vector<uint8_t>*>(png_get_io_ptr(png));
-  try {
-    out->insert(out->end(), data, data + n);
-  } catch (const std::bad_alloc&) {
-    png_error(png, "out of memory");
-  }
-}
-void png_flush(png_structp) {}
-
-}  // namespace
-
-std::vector<uint8_t> encode_png(const Image8& image) {
+std::vector<uint8_t> encode_png(const Image8& image, int threads) {
   if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
       image.pixels.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
     throw Error(ErrorCode::kInvalidArgument, "the image is empty or malformed");
   }
-  PngError error;
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_on_error, png_on_warning);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info) {
-    png_destroy_write_struct(&png, &info);
-    throw std::bad_alloc();
-  }
+  detail::PngEncoder encoder(image.width, image.height, image.channels, threads);
   std::vector<uint8_t> out;
-  std::vector<png_bytep> rows(image.height);
-  for (int y = 0; y < image.height; ++y) rows[y] = const_cast<png_bytep>(image.row(y));
-  // libpng reports errors by longjmp back here; only C frames and the callbacks lie between.
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    throw Error(ErrorCode::kIo, "PNG encoding failed (" + error.message + ")");
-  }
-  png_set_write_fn(png, &out, png_write_bytes, png_flush);
-  png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), 8,
-               image.channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(png, 1);  // fast: renders are written often and read once
-  png_write_info(png, info);
-  png_write_image(png, rows.data());
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
+  encoder.begin(out);
+  encoder.rows(image.pixels.data(), image.height, out);
+  encoder.end(out);
   return out;
 }
 
@@ -633,30 +601,21 @@ void write_png(const fs::path& path, const Image8& image) {
 // ---- PngWriter ---------------------------------------------------------------------------------
 
 struct PngWriter::Impl {
-  explicit Impl(const fs::path& target) : file(target) {}
+  Impl(const fs::path& target, int w, int h, int c, int threads)
+      : file(target), encoder(w, h, c, threads), width(w), height(h), channels(c) {}
   AtomicFile file;  // the temporary file, renamed onto the target by finish()
+  detail::PngEncoder encoder;
   int width = 0, height = 0, channels = 0, written = 0;
   bool done = false;
-  PngError error;
-  png_structp png = nullptr;
-  png_infop info = nullptr;
   std::vector<uint8_t> buffer;  // encoded bytes not yet written to the file
 
-  [[noreturn]] void fail(const std::string& why) {
-    throw Error(ErrorCode::kIo, "cannot write " + in_quotes(file.path()) + ": " + why);
-  }
   void flush_buffer() {
     file.write(buffer);
     buffer.clear();
   }
-  static void on_write(png_structp p, png_bytep data, png_size_t n) {
-    auto* self = static_cast<Impl*>(png_get_io_ptr(p));
-    self->buffer.insert(self->buffer.end(), data, data + n);
-  }
-  ~Impl() { png_destroy_write_struct(&png, &info); }
 };
 
-PngWriter::PngWriter(const fs::path& path, int width, int height, int channels) {
+PngWriter::PngWriter(const fs::path& path, int width, int height, int channels, int threads) {
   if (width <= 0 || height <= 0 || (channels != 3 && channels != 4) || width > (1 << 24) ||
       height > (1 << 24)) {
     throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(path) + ": size " +
@@ -664,20 +623,8 @@ PngWriter::PngWriter(const fs::path& path, int width, int height, int channels) 
                                                  std::to_string(height) + " x " +
                                                  std::to_string(channels) + " is not an image");
   }
-  impl_ = std::make_unique<Impl>(path);
-  Impl& m = *impl_;
-  m.width = width, m.height = height, m.channels = channels;
-  m.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &m.error, png_on_error, png_on_warning);
-  m.info = m.png ? png_create_info_struct(m.png) : nullptr;
-  if (!m.png || !m.info) throw std::bad_alloc();
-  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
-  png_set_write_fn(m.png, &m, Impl::on_write, png_flush);
-  // As encode_png(), so that the bytes are the same.
-  png_set_IHDR(m.png, m.info, png_uint_32(width), png_uint_32(height), 8,
-               channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(m.png, 1);
-  png_write_info(m.png, m.info);
+  impl_ = std::make_unique<Impl>(path, width, height, channels, threads);
+  impl_->encoder.begin(impl_->buffer);
 }
 
 PngWriter::~PngWriter() = default;
@@ -690,10 +637,9 @@ void PngWriter::write_rows(const Image8& rows) {
     throw Error(ErrorCode::kInvalidArgument,
                 "cannot write " + in_quotes(m.file.path()) + ": rows that do not fit the image");
   }
-  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
-  for (int y = 0; y < rows.height; ++y) png_write_row(m.png, rows.row(y));
+  m.encoder.rows(rows.pixels.data(), rows.height, m.buffer);
   m.written += rows.height;
-  if (m.buffer.size() >= (size_t(4) << 20)) m.flush_buffer();
+  m.flush_buffer();
 }
 
 void PngWriter::finish() {
@@ -703,8 +649,7 @@ void PngWriter::finish() {
                                                  std::to_string(m.written) + " of " +
                                                  std::to_string(m.height) + " rows written");
   }
-  if (setjmp(png_jmpbuf(m.png))) m.fail("PNG encoding failed (" + m.error.message + ")");
-  png_write_end(m.png, nullptr);
+  m.encoder.end(m.buffer);
   m.flush_buffer();
   m.file.commit();
   m.done = true;

@@ -24,21 +24,24 @@ std::string image_format_name(const std::vector<uint8_t>& bytes);
 // True for the five formats read_image (and so vectorize) takes.
 bool is_raster_input(const std::string& format);
 
-// The PNG file (8-bit RGB or RGBA) of an image. Throws Error(kInvalidArgument) for an empty or
-// malformed image, Error(kIo) if encoding fails.
-std::vector<uint8_t> encode_png(const Image8& image);
+// The PNG file (8-bit RGB or RGBA) of an image, compressed on `threads` threads (<= 0: all cores;
+// the bytes do not depend on it). Throws Error(kInvalidArgument) for an empty or malformed image,
+// Error(kIo) if encoding fails.
+std::vector<uint8_t> encode_png(const Image8& image, int threads = 0);
 
 // Writes a PNG (RGB or RGBA) atomically: to a temporary file beside `path`, then renamed.
 void write_png(const std::filesystem::path& path, const Image8& image);
 
 // A PNG (8-bit RGB or RGBA) written row by row, for images that are drawn in strips and never
-// held whole (render_strips): the rows go through libpng to a temporary file beside `path`,
+// held whole (render_strips): the rows are compressed (on `threads` threads, as encode_png) into a
+// temporary file beside `path`,
 // which finish() renames onto it; a writer destroyed unfinished removes its temporary file, so
 // `path` is never left partial. The bytes are write_png()'s for the same pixels. Throws
 // Error(kInvalidArgument) for a bad size or strip, Error(kIo) if writing fails.
 class PngWriter {
  public:
-  PngWriter(const std::filesystem::path& path, int width, int height, int channels);
+  PngWriter(const std::filesystem::path& path, int width, int height, int channels,
+            int threads = 0);
   ~PngWriter();
   PngWriter(const PngWriter&) = delete;
   PngWriter& operator=(const PngWriter&) = delete;
