@@ -31,7 +31,8 @@ constexpr double kAllowedOver = 0.01;
 }  // namespace
 
 LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mesh, int depth,
-                         double position_tolerance, double color_tolerance) {
+                         double position_tolerance, double color_tolerance,
+                         std::vector<double>* positions) {
   const int n = 1 << depth, fine = 2 * n;
   // Values at the parameters (i / fine, j / fine), i + j <= fine, of one face.
   struct Value {
@@ -53,6 +54,7 @@ LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mes
       double color = 0;
       for (int k = 0; k < 3; ++k)
         color = std::max(color, std::abs(m.c[k] - 0.5 * (a.c[k] + b.c[k])));
+      if (positions) positions->push_back(position);
       error.max_position = std::max(error.max_position, position);
       error.max_color = std::max(error.max_color, color);
       error.over += position > position_tolerance || color > color_tolerance;

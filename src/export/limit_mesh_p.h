@@ -18,9 +18,11 @@ struct LinearError {
 // Deviation of the limit surface of `mesh` from the piecewise-linear surface through its limit
 // points at `depth`: over every control face, the limit at the midpoint (in the face's
 // parameters) of each edge of the face's depth-`depth` triangles against the mean of the edge's
-// ends. Counts the edges whose position (image pixels) or color deviation exceeds a tolerance.
+// ends. Counts the edges whose position (image pixels) or color deviation exceeds a tolerance; with
+// `positions`, also appends each edge's position deviation there.
 LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mesh, int depth,
-                         double position_tolerance, double color_tolerance);
+                         double position_tolerance, double color_tolerance,
+                         std::vector<double>* positions = nullptr);
 
 // Checks the options and the level and returns the depth: options.depth, or the smallest that
 // meets the tolerances, up to options.max_depth and 2^24 triangles (report: depth and errors).

@@ -47,8 +47,9 @@ ViewPlan plan_view(const VectorImage& image, const ControlMesh& mesh,
 bool covers_faces(std::span<const int32_t> have, bool have_all, std::span<const int32_t> want,
                   bool want_all);
 
-// The depth rule: the smallest k in 0..8 with mean_edge_pixels / 2^k <= max_edge_pixels, lowered
-// until num_faces * 4^k <= kMaxAutoTriangles.
-int choose_depth(double mean_edge_pixels, double max_edge_pixels, int64_t num_faces);
+// The depth rule (renderer.cpp): the smallest k in 0..8 with
+// mean_edge_pixels / 2^k <= max_edge_pixels * sqrt(max(1, zoom)), zoom in output pixels per image
+// pixel, lowered until num_faces * 4^k <= kMaxAutoTriangles.
+int choose_depth(double mean_edge_pixels, double max_edge_pixels, double zoom, int64_t num_faces);
 
 }  // namespace subvec::detail

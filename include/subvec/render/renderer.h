@@ -49,15 +49,15 @@ struct RenderOptions {
   std::optional<Window> window;  // default: the whole image
   // Outputs over this many pixels are refused (Error(kLimit)): a file of a few hundred bytes may
   // declare a 65536 x 4096 image, whose render at 1x would take half a minute and gigabytes.
-  // 2^26 (8192 x 8192) of a 1.4k-vertex photograph takes 7.5-9 s and about 1 GB at the default
-  // depth through render_strips (1.6 s, 195 MB at depth 4; scripts/bench-render). At most kMaxRenderPixels.
+  // 2^26 (8192 x 8192) of a 3k-vertex photograph takes about 2-3 s and 300 MB through
+  // render_strips on 2 cores (scripts/bench-render, docs/performance.md). At most kMaxRenderPixels.
   int64_t max_pixels = int64_t{1} << 26;
   int level = 0;                 // level of detail
   Overlay overlay = Overlay::kNone;
   bool antialias = true;         // supersample pixels crossed by tears and the border
   int threads = 0;               // <= 0: all cores
   int depth = -1;                // subdivision depth 0..10; -1: from the output scale
-  double max_edge_pixels = 2.5;  // depth rule: refine until refined edges average at most this
+  double max_edge_pixels = 2.5;  // depth rule: refined edges average at most this * sqrt(zoom)
   Backend backend = Backend::kCpu;
 };
 
@@ -95,10 +95,12 @@ GpuRendererInfo gpu_renderer();
 bool is_software_renderer(std::string_view gl_renderer);
 
 // The depth rule (docs/performance.md): with L the mean control edge length, in output pixels, of
-// the faces whose limit surface may touch the window, the depth is the smallest k in 0..8 with
-// L / 2^k <= max_edge_pixels, lowered while the refined triangles would exceed 2^24. A window
-// zoomed 2^z times refines z more levels over fewer faces: it costs about what a full view of the
-// same output size costs.
+// the faces whose limit surface may touch the window, and s the zoom (output pixels per image
+// pixel), the depth is the smallest k in 0..8 with L / 2^k <= max_edge_pixels * sqrt(max(1, s)),
+// lowered while the refined triangles would exceed 2^24. The deviation of the drawn triangles from
+// the limit surface falls fourfold a level, so half a level per doubling of s holds it, in output
+// pixels, at what the 1x render has. A window zoomed 2^z times refines about z / 2 more levels,
+// over fewer faces.
 
 // The control faces and the depth of a view of one level: the renderer's visible-face selection
 // (a face is visible when the bounding box of its one-ring meets the window) and its depth rule,
@@ -137,7 +139,8 @@ Image8 render(const VectorImage& image, const RenderOptions& options);
 
 // Tiles of render_strips(): square tiles of `tile` output pixels a side (a multiple of 64, 64 to
 // 8192), drawn in horizontal strips of one tile row. 0: chosen from the refined triangles per
-// output pixel (256 to 2048: at most about 2^18 refined triangles a tile before the ring).
+// output pixel and the width (256 to 2048: at most about 2^18 refined triangles a tile before the
+// ring, and down to 1024, a strip of at most 32 MiB).
 struct TileOptions {
   int tile = 0;
 };

@@ -58,7 +58,8 @@ int depth_by_brute_force(const ControlMesh& mesh, const std::vector<int32_t>& fa
   }
   const double mean = sum / double(3 * faces.size());
   int k = 0;
-  while (k < 8 && mean / std::pow(2.0, k) > max_edge) ++k;
+  const double target = max_edge * std::sqrt(std::max(1.0, std::min(sx, sy)));
+  while (k < 8 && mean / std::pow(2.0, k) > target) ++k;
   return k;
 }
 
