@@ -20,10 +20,11 @@
 // ("Corrupt JPEG data: ...").
 //
 // OpenCV's image codecs depend on some 120 shared libraries (GDAL, GDCM, HDF5, poppler, ...), and
-// loading them cost every start of a program 0.15 s. PNG, what the tools read and write most, goes
+// loading them cost every start of a program 0.15 s. PNG, what the tools read most, is read
 // through libpng; the codecs are loaded (dlopen) when the first other image is read.
 //
-// Writing: PNG through libpng, encoded to memory, then written atomically.
+// Writing: PNG through the parallel encoder (io/png_encoder_p.h), then written atomically
+// (AtomicFile, io/file.h).
 #include "subvec/io/image_io.h"
 
 #include <dlfcn.h>
@@ -602,10 +603,9 @@ void write_png(const fs::path& path, const Image8& image) {
 
 struct PngWriter::Impl {
   Impl(const fs::path& target, int w, int h, int c, int threads)
-      : file(target), encoder(w, h, c, threads), width(w), height(h), channels(c) {}
+      : file(target), encoder(w, h, c, threads) {}
   AtomicFile file;  // the temporary file, renamed onto the target by finish()
   detail::PngEncoder encoder;
-  int width = 0, height = 0, channels = 0, written = 0;
   bool done = false;
   std::vector<uint8_t> buffer;  // encoded bytes not yet written to the file
 
@@ -631,23 +631,24 @@ PngWriter::~PngWriter() = default;
 
 void PngWriter::write_rows(const Image8& rows) {
   Impl& m = *impl_;
-  if (m.done || rows.width != m.width || rows.channels != m.channels || rows.height < 0 ||
-      rows.height > m.height - m.written ||
+  const detail::PngEncoder& e = m.encoder;
+  if (m.done || rows.width != e.width() || rows.channels != e.channels() || rows.height < 0 ||
+      rows.height > e.height() - e.rows_given() ||
       rows.pixels.size() != size_t(rows.width) * size_t(rows.height) * size_t(rows.channels)) {
     throw Error(ErrorCode::kInvalidArgument,
                 "cannot write " + in_quotes(m.file.path()) + ": rows that do not fit the image");
   }
   m.encoder.rows(rows.pixels.data(), rows.height, m.buffer);
-  m.written += rows.height;
   m.flush_buffer();
 }
 
 void PngWriter::finish() {
   Impl& m = *impl_;
-  if (m.done || m.written != m.height) {
+  if (m.done || m.encoder.rows_given() != m.encoder.height()) {
     throw Error(ErrorCode::kInvalidArgument, "cannot write " + in_quotes(m.file.path()) + ": " +
-                                                 std::to_string(m.written) + " of " +
-                                                 std::to_string(m.height) + " rows written");
+                                                 std::to_string(m.encoder.rows_given()) + " of " +
+                                                 std::to_string(m.encoder.height()) +
+                                                 " rows written");
   }
   m.encoder.end(m.buffer);
   m.flush_buffer();

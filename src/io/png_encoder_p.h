@@ -32,6 +32,11 @@ class PngEncoder {
   // After the last row: the IEND chunk.
   void end(std::vector<uint8_t>& out);
 
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int channels() const { return channels_; }
+  int rows_given() const { return rows_in_; }
+
   // Rows a piece holds for this width (about 512 KiB of filtered bytes).
   static int piece_rows(int width, int channels);
 

@@ -10,9 +10,9 @@
 //
 // Why sqrt(s). What the edge length stands for is the error of drawing the limit surface as flat
 // triangles: a chord of length h deviates from a curve of bounded curvature by O(h^2), and colors
-// are interpolated linearly over the same chords, so the deviation falls fourfold per level (the
-// shared photographs, scripts/bench-render: the median, 90th and 99th percentile edge deviation
-// fall 4.0-4.5 times a level from depth 3). Zooming by s multiplies a position deviation, in output
+// are interpolated linearly over the same chords, so the deviation falls fourfold per level
+// (measured against the exact limit on chelsea: the median, 90th and 99th percentile edge deviation
+// fall 4.0-4.5 times a level from depth 3; docs/performance.md, "The depth rule"). Zooming by s multiplies a position deviation, in output
 // pixels, by s and leaves a color deviation as it is; so half a level per doubling of s, which is
 // what sqrt(s) gives, keeps both deviations at or below those of the render at 1x. Refining a whole
 // level per doubling (edges of 2.5 output pixels at any zoom) drew 8192^2 renders of a 512-class
