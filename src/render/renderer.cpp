@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 
 #include "core/messages_p.h"
@@ -71,6 +72,44 @@ std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh,
     const auto &a = star[t[0]], &b = star[t[1]], &c = star[t[2]];
     boxes[f] = {std::min({a[0], b[0], c[0]}), std::min({a[1], b[1], c[1]}),
                 std::max({a[2], b[2], c[2]}), std::max({a[3], b[3], c[3]})};
+  }
+  return boxes;
+}
+
+std::vector<std::array<double, 4>> refined_ring_boxes(const ControlMesh& mesh,
+                                                      const MeshTopology& topology, int levels,
+                                                      int threads) {
+  // The limit patch of a control face is the union of its children's patches after `levels`
+  // steps, and each child's lies in the hull of its own one-ring of refined (not limit) points:
+  // Loop's masks, at tears, creases and corners too, have no negative weights. Per refined
+  // vertex the box of its star, per refined triangle the union over its corners, per control
+  // face the union over its children.
+  const Subdivision subdivision(mesh, topology, levels, {}, /*push_to_limit=*/false);
+  RefinedMesh r;
+  subdivision.evaluate_once(mesh.positions, mesh.colors, r, threads);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<std::array<double, 4>> star(r.num_vertices(), {kInf, kInf, -kInf, -kInf});
+  const auto grow = [](std::array<double, 4>& b, const std::array<double, 4>& o) {
+    b = {std::min(b[0], o[0]), std::min(b[1], o[1]), std::max(b[2], o[2]), std::max(b[3], o[3])};
+  };
+  for (const Tri& t : r.triangles) {
+    std::array<double, 4> b{kInf, kInf, -kInf, -kInf};
+    for (const int32_t v : t) {
+      const double x = r.positions[2 * v], y = r.positions[2 * v + 1];
+      grow(b, {x, y, x, y});
+    }
+    for (const int32_t v : t) grow(star[v], b);
+  }
+  std::vector<std::array<double, 4>> boxes(mesh.num_triangles(), {kInf, kInf, -kInf, -kInf});
+  for (int t = 0; t < r.num_triangles(); ++t) {
+    std::array<double, 4>& b = boxes[r.triangle_parent[t]];
+    for (const int32_t v : r.triangles[t]) grow(b, star[v]);
+  }
+  // The refined points are floats: widen each box by a few of their ulps.
+  for (std::array<double, 4>& b : boxes) {
+    const double pad = 1e-6 * (1 + std::max({std::abs(b[0]), std::abs(b[1]), std::abs(b[2]),
+                                             std::abs(b[3])}));
+    b = {b[0] - pad, b[1] - pad, b[2] + pad, b[3] + pad};
   }
   return boxes;
 }
@@ -271,6 +310,7 @@ namespace {
 struct LevelState {
   std::optional<MeshTopology> topology;      // from validate_level: the level is valid
   std::vector<std::array<double, 4>> boxes;  // ring boxes; empty when positions changed
+  std::vector<std::array<double, 4>> tile_boxes;  // refined ring boxes, the same; made by tiles
 };
 
 // The refinement of the last view and its limit values. A later view reuses it when it needs the
@@ -617,6 +657,19 @@ void render_strips(const VectorImage& image, const RenderOptions& options,
   if (options.overlay == Overlay::kMesh)
     mesh_overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
   const int columns = (width + tile - 1) / tile;
+  // Tiles of a whole view select their faces by boxes two levels down: the ring boxes are about
+  // three control faces wide, and every tile a face's box meets refines the face. On a 4x render
+  // of a 512-class photograph (tiles of 512) the tiles then refine 6,477 faces instead of 8,129
+  // (5,131 in the view), for a refinement of the whole level at depth 2 (one level for meshes of
+  // over 2^16 faces; none over 2^18, nor for windows, where most of the level is out of view).
+  const bool tiled = columns > 1 || height > tile;
+  const int nf = mesh.num_triangles();
+  const int box_levels = nf <= (1 << 16) ? 2 : nf <= (1 << 18) ? 1 : 0;
+  const bool refined_boxes = tiled && plan.all_faces && box_levels > 0;
+  if (refined_boxes && ls.tile_boxes.empty())
+    ls.tile_boxes = detail::refined_ring_boxes(mesh, *ls.topology, box_levels, threads);
+  const std::span<const std::array<double, 4>> tile_boxes =
+      refined_boxes ? ls.tile_boxes : ls.boxes;
   // Several tiles a strip: one per worker, each drawn on one thread; else one tile at a time on
   // all of them. Tiles own disjoint pixels, so the order does not change the output.
   const bool across = columns >= 2 && threads >= 2;
@@ -632,7 +685,7 @@ void render_strips(const VectorImage& image, const RenderOptions& options,
     }
     auto draw = [&](int column, TileWork& w, int inner) {
       const detail::PixelRect clip{column * tile, y, std::min(width, (column + 1) * tile), y + rows};
-      draw_tile(image, options, *ls.topology, ls.boxes, plan, mesh_overlay, clip, inner, w, strip);
+      draw_tile(image, options, *ls.topology, tile_boxes, plan, mesh_overlay, clip, inner, w, strip);
     };
     if (across) {
       // Worker k draws columns k, k + workers, ...
@@ -711,7 +764,10 @@ void Renderer::set_positions(int level, std::span<const Vec2> positions) {
   }
   mesh.positions.assign(positions.begin(), positions.end());
   State& s = impl_->state;
-  if (level < static_cast<int>(s.levels.size())) s.levels[level].boxes.clear();
+  if (level < static_cast<int>(s.levels.size())) {
+    s.levels[level].boxes.clear();
+    s.levels[level].tile_boxes.clear();
+  }
   if (s.cache.level == level) s.cache.positions_stale = true;
 }
 

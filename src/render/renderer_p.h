@@ -22,6 +22,14 @@ constexpr int kMaxAutoDepth = 8;
 std::vector<std::array<double, 4>> ring_boxes(const ControlMesh& mesh,
                                               const MeshTopology& topology);
 
+// The same bound after `levels` steps of refinement: per control face, the union over its
+// children of the box of their refined one-rings. Tighter (a child's ring is a quarter of the
+// size per level), at the cost of refining the whole level `levels` times; the tiles of a large
+// render select their faces by these.
+std::vector<std::array<double, 4>> refined_ring_boxes(const ControlMesh& mesh,
+                                                      const MeshTopology& topology, int levels,
+                                                      int threads);
+
 // Whether a face's ring box meets the window: the renderer's visibility rule, for a view and for
 // each tile of one.
 inline bool box_meets(const std::array<double, 4>& b, const Window& w) {
