@@ -49,7 +49,7 @@ struct RenderOptions {
   std::optional<Window> window;  // default: the whole image
   // Outputs over this many pixels are refused (Error(kLimit)): a file of a few hundred bytes may
   // declare a 65536 x 4096 image, whose render at 1x would take half a minute and gigabytes.
-  // 2^26 (8192 x 8192) of a 3k-vertex photograph takes about 2-3 s and 300 MB through
+  // 2^26 (8192 x 8192) of a 3k-vertex photograph takes about 1 s and 150 MB through
   // render_strips on 2 cores (scripts/bench-render, docs/performance.md). At most kMaxRenderPixels.
   int64_t max_pixels = int64_t{1} << 26;
   int level = 0;                 // level of detail
