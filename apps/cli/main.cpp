@@ -382,7 +382,14 @@ void run_vectorize(const VectorizeArgs& a) {
     progress.update(stage, fraction);
   };
   subvec::VectorizeReport report;
-  const subvec::VectorImage v = subvec::vectorize(image, options, &report);
+  subvec::VectorImage v;
+  try {
+    v = subvec::vectorize(image, options, &report);
+  } catch (const Error& e) {
+    // A budget that cannot be met is named after its option, as the option checks are.
+    if (e.code() != ErrorCode::kInvalidArgument) throw;
+    throw Error(e.code(), subvec_cli::with_flag_names(e.what()));
+  }
   progress.update("measuring", 1.0);
   const auto render_start = std::chrono::steady_clock::now();
   subvec::RenderOptions render_options;
@@ -418,6 +425,9 @@ void run_vectorize(const VectorizeArgs& a) {
     j["triangles"] = report.triangles;
     j["features"] = report.features;
     j["tear_vertices"] = report.tear_vertices;
+    j["budget"] = {{"target", report.target_vertices},
+                   {"feature_tolerance", report.feature_tolerance},
+                   {"features_dropped", report.features_dropped}};
     j["refine"] = {{"flips", report.refine.flips}, {"moves", report.refine.moves}};
     if (options.segment) {
       const subvec::PixelRect& r = *options.segment;
@@ -454,6 +464,10 @@ void run_vectorize(const VectorizeArgs& a) {
   std::printf("size      %d x %d pixels\n", image.width, image.height);
   std::printf("mesh      %d vertices, %d triangles, %d features (%d tear vertices)\n",
               report.vertices, report.triangles, report.features, report.tear_vertices);
+  if (report.feature_tolerance > options.max_feature_error || report.features_dropped > 0) {
+    std::printf("budget    %d vertices held: features within %g px of their curves, %d least salient dropped\n",
+                report.target_vertices, report.feature_tolerance, report.features_dropped);
+  }
   if (options.refine.rounds > 0) {
     std::printf("refined   %d edge flips, %d vertex moves\n", report.refine.flips, report.refine.moves);
   }

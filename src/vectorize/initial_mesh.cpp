@@ -43,8 +43,9 @@ std::vector<uint8_t> near_features(const std::vector<DetectedFeature>& features,
   return mask;
 }
 
-// The points to triangulate: pixel centres not `dropped` (step 1), or one point per 2x2 block away
-// from the `fine` pixels (step 2); then the border: corners and one vertex per pixel along each side.
+// The points to triangulate: pixel centres not `dropped` (step 1), or one point per step x step
+// block (2 or 4) with no `fine` pixel, at its centre, and the pixel centres of the other blocks;
+// then the border: corners and one vertex per pixel along each side.
 std::vector<Point> grid_points(int w, int h, int step, const std::vector<uint8_t>& dropped,
                                const std::vector<uint8_t>& fine) {
   std::vector<Point> points;
@@ -54,17 +55,17 @@ std::vector<Point> grid_points(int w, int h, int step, const std::vector<uint8_t
       for (int x = 0; x < w; ++x)
         if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
   } else {
-    for (int by = 0; by < h; by += 2) {
-      for (int bx = 0; bx < w; bx += 2) {
-        const bool whole = bx + 1 < w && by + 1 < h;
-        const bool coarse = whole && !fine[size_t(by) * w + bx] && !fine[size_t(by) * w + bx + 1] &&
-                            !fine[size_t(by + 1) * w + bx] && !fine[size_t(by + 1) * w + bx + 1];
+    for (int by = 0; by < h; by += step) {
+      for (int bx = 0; bx < w; bx += step) {
+        bool coarse = bx + step <= w && by + step <= h;
+        for (int y = by; coarse && y < by + step; ++y)
+          for (int x = bx; coarse && x < bx + step; ++x) coarse = !fine[size_t(y) * w + x];
         if (coarse) {
-          points.emplace_back(bx + 1.0, by + 1.0);
+          points.emplace_back(bx + 0.5 * step, by + 0.5 * step);
           continue;
         }
-        for (int y = by; y < std::min(h, by + 2); ++y)
-          for (int x = bx; x < std::min(w, bx + 2); ++x)
+        for (int y = by; y < std::min(h, by + step); ++y)
+          for (int x = bx; x < std::min(w, bx + step); ++x)
             if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
       }
     }
@@ -229,8 +230,8 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
                                const InitialMeshOptions& options) {
   const int w = image.width, h = image.height;
   if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
-  if (options.grid_step < 0 || options.grid_step > 2) {
-    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1 or 2");
+  if (options.grid_step < 0 || options.grid_step > 4 || options.grid_step == 3) {
+    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1, 2 or 4");
   }
   const int step = std::max(1, options.grid_step);
   // Grid points closer than min_grid_distance to a feature would make slivers: drop them. Pixels
@@ -238,7 +239,7 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   const double r = options.min_grid_distance;
   const std::vector<uint8_t> dropped = near_features(features, w, h, r);
   const std::vector<uint8_t> fine =
-      step == 2 ? near_features(features, w, h, std::max(options.fine_band, r)) : std::vector<uint8_t>{};
+      step >= 2 ? near_features(features, w, h, std::max(options.fine_band, r)) : std::vector<uint8_t>{};
 
   const std::vector<Point> points = grid_points(w, h, step, dropped, fine);
   CdtPlus cdt;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/cancel_p.h"
@@ -13,8 +14,10 @@
 #include "mesh/collapse_engine_p.h"
 #include "mesh/polyline_p.h"
 #include "mesh/quadric_p.h"
+#include "vectorize/levels_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
+#include "subvec/vectorize/simplify.h"
 
 namespace subvec {
 namespace {
@@ -29,16 +32,20 @@ using coarsen_detail::Kind;
 
 [[noreturn]] void invalid(const std::string& message) { detail::invalid("levels: " + message); }
 
-// Greedy half-edge collapses by quadric cost until `target` vertices remain. Kept chains stay within
-// `tolerance` of where they started; when nothing more can go, the tolerance doubles (up to
-// kMaxLoosening times) and the queue is planned afresh. Returns the collapses made, in order.
+// How far a level's collapses may loosen its chains' tolerance when nothing more can go: 8 times.
 constexpr double kMaxLoosening = 8;
-std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const LevelOptions& options) {
+
+}  // namespace
+
+namespace detail {
+
+std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double& tolerance, double max_loosening,
+                               double color_scale, int threads, const std::atomic<bool>* cancel) {
   const int nv = c.num_vertices();
   // Quadrics per merged color value, from the triangles' 5D points.
-  const double cs = options.color_scale;
+  const double cs = color_scale;
   std::vector<Quadric5> quadric = detail::color_quadrics(
-      static_cast<int>(c.triangles().size()), c.num_merged(), options.fit.threads, [&](int f, int k, Point5& p) {
+      static_cast<int>(c.triangles().size()), c.num_merged(), threads, [&](int f, int k, Point5& p) {
         const Vec2 x = c.positions()[c.triangles()[f][k]];
         const int32_t m = c.triangle_colors()[f][k];
         const auto& rgb = c.merged_colors()[m];
@@ -93,16 +100,78 @@ std::vector<EdgeVerts> coarsen(Coarsener& c, int target, double tolerance, const
     for (int32_t w : ring) ++version[w];
     for (int32_t w : ring) plan_around(w);
   };
-  const double max_tolerance = tolerance * kMaxLoosening;
+  const double max_tolerance = tolerance * max_loosening;
   for (plan_all();; plan_all()) {
-    if (!detail::run_collapses(queue, options.cancel, more, live, step)) throw Error(ErrorCode::kCancelled, "cancelled");
+    if (!detail::run_collapses(queue, cancel, more, live, step)) throw Error(ErrorCode::kCancelled, "cancelled");
     if (!more() || tolerance >= max_tolerance) break;
     tolerance *= 2;
   }
   return collapses;
 }
 
-}  // namespace
+BudgetResult hold_budget(ControlMesh& mesh, int width, int height, const Image8& photo, int target,
+                         double tolerance, double saliency_weight, double color_scale,
+                         const std::vector<int32_t>& protected_ids, int threads,
+                         const std::atomic<bool>* cancel) {
+  constexpr double kBudgetLoosening = 2;
+  BudgetResult r;
+  r.feature_tolerance = tolerance;
+  if (mesh.num_vertices() <= target) return r;
+  // The order in which features go: protected last, then by saliency, the least first (ties by id).
+  const std::vector<double> saliency = measure_saliency(mesh, photo, saliency_weight);
+  std::vector<std::pair<double, int32_t>> order;  // (rank key, id)
+  for (size_t f = 0; f < mesh.features.size(); ++f) {
+    const int32_t id = mesh.features[f].id;
+    const bool keep_last =
+        std::find(protected_ids.begin(), protected_ids.end(), id) != protected_ids.end();
+    order.push_back({keep_last ? std::numeric_limits<double>::infinity() : saliency[f], id});
+  }
+  std::sort(order.begin(), order.end());
+  size_t next = 0;  // order[next] is the next feature to drop
+  for (int pass = 0;; ++pass) {
+    std::vector<int32_t> kept;
+    for (const Feature& f : mesh.features) kept.push_back(f.id);
+    if (pass > 0) {
+      // Enough of the least salient features that their vertices cover the excess, at least one.
+      int64_t freed = 0;
+      const int64_t excess = mesh.num_vertices() - int64_t{target};
+      while (next < order.size() && (freed == 0 || freed < excess)) {
+        const int32_t id = order[next++].second;
+        const auto it = std::find_if(mesh.features.begin(), mesh.features.end(),
+                                     [&](const Feature& f) { return f.id == id; });
+        if (it == mesh.features.end()) continue;  // gone with an earlier pass's collapses
+        freed += static_cast<int64_t>(it->vertices.size());
+        kept.erase(std::find(kept.begin(), kept.end(), id));
+        r.dropped.push_back(id);
+      }
+    }
+    coarsen_detail::Coarsener c(mesh, width, height, kept);
+    // The chains start within `tolerance` of their curves and move at most t more.
+    double t = pass == 0 ? tolerance : r.feature_tolerance - tolerance;
+    coarsen(c, target, t, pass == 0 ? kBudgetLoosening : 1, color_scale, threads, cancel);
+    r.feature_tolerance = std::max(r.feature_tolerance, tolerance + t);
+    std::vector<int32_t> parents, color_merged;
+    mesh = c.result(parents, color_merged);
+    if (mesh.num_vertices() <= target) return r;
+    if (mesh.features.empty()) {
+      // Half-edge collapses keep one end of every edge where it is; the simplifier's placed
+      // collapses may still go below them.
+      SimplifyOptions o;
+      o.target_vertices = target;
+      o.color_scale = color_scale;
+      o.threads = threads;
+      o.cancel = cancel;
+      simplify(mesh, width, height, o);
+      if (mesh.num_vertices() <= target) return r;
+      throw Error(ErrorCode::kInvalidArgument,
+                  "a budget of " + std::to_string(target) +
+                      " control vertices cannot be met: the image frame needs at least " +
+                      std::to_string(mesh.num_vertices()) + " control vertices");
+    }
+  }
+}
+
+}  // namespace detail
 
 double curve_saliency(std::span<const Vec2> curve, const Image8& raster, double weight) {
   const double length = polyline_length(curve);
@@ -204,8 +273,9 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
     const int target = std::max(4, static_cast<int>(std::ceil(fine.num_vertices() * (1 - options.reduction))));
     // Kept chains may wander 1 px (max_feature_error) from the finer level's at level 1, 2 px at
     // level 2, ...: coarser levels are coarser abstractions of the same curves.
-    const double tolerance = options.max_feature_error * std::ldexp(1.0, l - 1);
-    std::vector<EdgeVerts> collapses = coarsen(c, target, tolerance, options);
+    double tolerance = options.max_feature_error * std::ldexp(1.0, l - 1);
+    std::vector<EdgeVerts> collapses = detail::coarsen(c, target, tolerance, kMaxLoosening, options.color_scale,
+                                                       options.fit.threads, options.cancel);
     std::vector<int32_t> parents, color_merged;
     ControlMesh coarse = c.result(parents, color_merged);
     ColorFitOptions fit = options.fit;

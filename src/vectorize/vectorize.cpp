@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "core/messages_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
+#include "vectorize/levels_p.h"
 
 namespace subvec {
 namespace {
@@ -33,7 +35,9 @@ void validate(const VectorizeOptions& o) {
     detail::out_of_range("vertices", "0 (use ratio) or in [4, " + std::to_string(1 << 26) + "]", o.vertices);
   }
   validate(o.features, "features.");
-  check_in("initial_mesh.grid_step", o.initial_mesh.grid_step, 0, 2);
+  if (o.initial_mesh.grid_step < 0 || o.initial_mesh.grid_step > 4 || o.initial_mesh.grid_step == 3) {
+    detail::out_of_range("initial_mesh.grid_step", "0 (automatic), 1, 2 or 4", o.initial_mesh.grid_step);
+  }
   check_in("max_feature_error", o.max_feature_error, 0.05, 100);
   validate(o.refine, "refine.");
   validate(o.fit, "fit.");
@@ -58,6 +62,7 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   VectorizeReport local;
   VectorizeReport& r = report ? *report : local;
   r = {};
+  r.target_vertices = target;
   const std::vector<VectorizeStage> stages = vectorize_stages(options.segment.has_value());
   // Each stage starts here: a cancelled job stops, and the progress callback hears of it. The long
   // stages (simplify, refine, fit, levels) also check the flag inside their loops.
@@ -95,11 +100,15 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   }
   lap("features");
   begin("mesh");
-  // Images from 512 x 512 up start from a 2-pixel grid away from the features (docs/vectorize.md,
-  // "Large images"): about the same error for a third less time; the fit still sees every pixel.
+  // Images from 512 x 512 up start from a 2-pixel grid away from the features, and from 2 MP up
+  // (at targets of at most 1/64 of the pixels) from a 4-pixel one (docs/vectorize.md, "Large
+  // images"): about the same error for a third less time, and at 4 MP 4 s less; the fit still
+  // sees every pixel.
   InitialMeshOptions mesh_options = options.initial_mesh;
   if (mesh_options.grid_step == 0) {
-    mesh_options.grid_step = pixels >= double(1 << 18) && 16.0 * target <= pixels ? 2 : 1;
+    mesh_options.grid_step = pixels >= double(1 << 21) && 64.0 * target <= pixels   ? 4
+                             : pixels >= double(1 << 18) && 16.0 * target <= pixels ? 2
+                                                                                    : 1;
   }
   ControlMesh mesh = build_initial_mesh(image, features, mesh_options);
   lap("mesh");
@@ -117,7 +126,9 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   }
 
   r.feature_targets.clear();
+  std::vector<int32_t> target_ids;
   for (const Feature& f : mesh.features) {
+    target_ids.push_back(f.id);
     std::vector<Vec2> polyline;
     for (int32_t v : f.vertices) polyline.push_back(mesh.positions[v]);
     r.feature_targets.push_back(std::move(polyline));
@@ -131,6 +142,38 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   simplify_options.threads = options.threads;
   simplify_options.cancel = options.cancel;
   r.simplify = simplify(mesh, image.width, image.height, simplify_options);
+  // The budget holds: where the features kept more vertices than the target, their chains loosen
+  // and the least salient of them go (levels_p.h), the segment's boundary last.
+  detail::BudgetResult budget;
+  try {
+    budget = detail::hold_budget(mesh, image.width, image.height, image, target,
+                                 options.max_feature_error, options.levels.saliency_weight,
+                                 simplify_options.color_scale, r.segment_feature_ids,
+                                 options.threads, options.cancel);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kInvalidArgument) throw;
+    // Named after the option that set the budget, as validate() names its fields.
+    std::string why = e.what();
+    why = why.substr(why.find(": ") + 2);  // after "a budget of N control vertices cannot be met"
+    throw Error(ErrorCode::kInvalidArgument,
+                (options.vertices > 0 ? "vertices " + std::to_string(options.vertices)
+                                      : "ratio " + detail::num(options.ratio) + " (" +
+                                            std::to_string(target) + " control vertices)") +
+                    " cannot be met: " + why);
+  }
+  r.feature_tolerance = budget.feature_tolerance;
+  r.features_dropped = static_cast<int>(budget.dropped.size());
+  if (!budget.dropped.empty()) {
+    // Keep the targets and segment ids of the features left.
+    std::map<int32_t, size_t> index;  // feature id -> its target
+    for (size_t k = 0; k < target_ids.size(); ++k) index[target_ids[k]] = k;
+    std::vector<std::vector<Vec2>> targets;
+    for (const Feature& f : mesh.features) targets.push_back(std::move(r.feature_targets[index.at(f.id)]));
+    r.feature_targets = std::move(targets);
+    std::erase_if(r.segment_feature_ids, [&](int32_t id) {
+      return std::find(budget.dropped.begin(), budget.dropped.end(), id) != budget.dropped.end();
+    });
+  }
   lap("simplify");
 
   // Stage 3b: data-dependent flips and vertex moves.

@@ -74,6 +74,12 @@ struct StageTime {
 struct VectorizeReport {
   int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;  // of level 0
   double fit_rms = 0;
+  int target_vertices = 0;  // the budget: options.vertices, or ratio x pixels (at least 4)
+  // How far level 0's feature chains may be from the detected curves, in pixels:
+  // max_feature_error, unless the vertex budget needed more (vectorize() then loosens them, up to
+  // 3 times, and drops the least salient features; features_dropped counts them).
+  double feature_tolerance = 0;
+  int features_dropped = 0;
   std::vector<StageTime> stages;  // [segment,] features, mesh, simplify, refine, fit, levels
   SimplifyStats simplify;
   RefineStats refine;
