@@ -144,6 +144,10 @@ TEST(Metrics, SsimMatchesNaiveDefinition) {
   EXPECT_NEAR(compare(a, b).ssim, naive_ssim(a, b), 1e-6);
   const Image8 c = add_noise(gradient(4, 3), 50, 3);  // smaller than the window
   EXPECT_NEAR(compare(gradient(4, 3), c).ssim, naive_ssim(gradient(4, 3), c), 1e-6);
+  // Several bands of rows (32 each), an odd width, RGBA against RGB.
+  const Image8 d = gradient(157, 101, 4);
+  const Image8 e = add_noise(gradient(157, 101), 20, 11);
+  EXPECT_NEAR(compare(d, e).ssim, naive_ssim(gradient(157, 101), e), 1e-12);
 }
 
 TEST(Metrics, AlphaIsIgnored) {
