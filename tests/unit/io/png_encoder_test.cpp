@@ -6,6 +6,7 @@
 #include "io/png_encoder_p.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <png.h>
 #include <zlib.h>
 
@@ -170,7 +171,10 @@ TEST_P(PngEncoderSizes, MatchesTheReferences) {
   EXPECT_EQ(unfilter(filtered, s.w, s.h, s.channels), im.pixels);
   // libpng decodes it to the same pixels (read_image composites RGBA over black: compare the
   // encoder's file with libpng's own file of the same pixels instead).
-  const fs::path dir = fs::temp_directory_path() / ("subvec_png_encoder_" + std::to_string(s.w));
+  // One folder per case and process: ctest runs the cases at once, and 1x1x3 and 1x1x4 share a width.
+  const fs::path dir = fs::temp_directory_path() /
+                       ("subvec_png_encoder_" + std::to_string(s.w) + "x" + std::to_string(s.h) + "x" +
+                        std::to_string(s.channels) + "_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   auto write = [&](const std::string& name, const std::vector<uint8_t>& bytes) {
     FILE* f = std::fopen((dir / name).c_str(), "wb");

@@ -2,6 +2,7 @@
 // of docs/format.md verbatim, and one test per kind of bad input, each checking that the message
 // names the problem.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <random>
@@ -142,7 +143,8 @@ TEST(SvecJson, OptionalKeysHaveTheirDefaults) {
 }
 
 TEST(SvecJson, AcceptsAByteOrderMarkWhenReadFromAFile) {
-  const auto path = std::filesystem::temp_directory_path() / "subvec_bom_test.svec.json";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("subvec_bom_test_" + std::to_string(::getpid()) + ".svec.json");
   const std::string text = "\xEF\xBB\xBF" + square_text();
   {
     std::ofstream out(path, std::ios::binary);

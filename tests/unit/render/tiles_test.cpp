@@ -1,6 +1,7 @@
 // render_strips (tiles, rows streamed) against render() (one piece): the same bytes at the same
 // depth, whatever the tile size or thread count, across tears, the border, overlays and strokes.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
@@ -135,7 +136,7 @@ TEST(RenderStrips, ARefusedRenderCallsNoSink) {
 }
 
 TEST(PngWriter, StreamedRowsAreWritePngsBytes) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "subvec_png_writer";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("subvec_png_writer_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   RenderOptions o;
   o.window = Window{-10, -10, 300, 200};  // RGBA
