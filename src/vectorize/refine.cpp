@@ -365,22 +365,31 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
     const double cv[3] = {color[w.side].r, color[w.side].g, color[w.side].b};
     const double c1[3] = {w.c1.r, w.c1.g, w.c1.b}, c2[3] = {w.c2.r, w.c2.g, w.c2.b};
     const int col = 2 + 3 * w.side;
+    // The wedge's sums, then added to the system (w0 is the same in the three channels).
+    double xx = 0, xy = 0, yy = 0, ww = 0, rx = 0, ry = 0;
+    double xw[3] = {0, 0, 0}, yw[3] = {0, 0, 0}, rw[3] = {0, 0, 0};
     for_each_pixel(x, p1, p2, image, 0, [&](int px, int py, double w0, double w1, double w2) {
-      const Vec2 s{px + 0.5, py + 0.5};
-      const double g1x = 0.5 * (s.y - p2.y), g1y = 0.5 * (p2.x - s.x);
-      const double g2x = 0.5 * (p1.y - s.y), g2y = 0.5 * (s.x - p1.x);
+      const double sx = px + 0.5, sy = py + 0.5;
+      const double g1x = 0.5 * (sy - p2.y), g1y = 0.5 * (p2.x - sx);
+      const double g2x = 0.5 * (p1.y - sy), g2y = 0.5 * (sx - p1.x);
       const uint8_t* target = pixel_at(image, px, py);
+      ww += w0 * w0;
       for (int ch = 0; ch < 3; ++ch) {
         const double f = w0 * cv[ch] + w1 * c1[ch] + w2 * c2[ch];
         const double r = f - target[ch];
         const double jx = (c1[ch] * g1x + c2[ch] * g2x - f * ax) * inv;
         const double jy = (c1[ch] * g1y + c2[ch] * g2y - f * ay) * inv;
         // Jacobian row (jx, jy, and w0 in this side's and channel's color column).
-        jtj(0, 0) += jx * jx, jtj(0, 1) += jx * jy, jtj(1, 1) += jy * jy;
-        jtj(0, col + ch) += jx * w0, jtj(1, col + ch) += jy * w0, jtj(col + ch, col + ch) += w0 * w0;
-        jtr(0) += jx * r, jtr(1) += jy * r, jtr(col + ch) += w0 * r;
+        xx += jx * jx, xy += jx * jy, yy += jy * jy;
+        xw[ch] += jx * w0, yw[ch] += jy * w0;
+        rx += jx * r, ry += jy * r, rw[ch] += w0 * r;
       }
     });
+    jtj(0, 0) += xx, jtj(0, 1) += xy, jtj(1, 1) += yy, jtr(0) += rx, jtr(1) += ry;
+    for (int ch = 0; ch < 3; ++ch) {
+      jtj(0, col + ch) += xw[ch], jtj(1, col + ch) += yw[ch], jtj(col + ch, col + ch) += ww;
+      jtr(col + ch) += rw[ch];
+    }
   }
   if (!(before > 0)) return false;
   jtj.triangularView<Eigen::StrictlyLower>() = jtj.transpose().triangularView<Eigen::StrictlyLower>();
