@@ -132,7 +132,9 @@ struct ViewMesh {
 // Errors as render(). `options.threads` evaluates; overlay, antialias and backend are not used.
 ViewMesh view_mesh(const VectorImage& image, const RenderOptions& options);
 
-// Draws the image as described by `options`; RGB, or RGBA when the window leaves the image.
+// Draws the image as described by `options`; RGB, or RGBA when the window leaves the image. On
+// the CPU a view of over 2^20 refined triangles is drawn in tiles (render_strips(), the same
+// bytes), so that its memory is the output's and a bounded refinement, not the whole view's.
 // Throws Error(kInvalidArgument) for a bad level, size, window or depth, Error(kLimit) for an
 // output over the size limits, Error(kInvalidMesh) when the level fails validate_level().
 Image8 render(const VectorImage& image, const RenderOptions& options);

@@ -1,8 +1,10 @@
-// render_strips (tiles, rows streamed) against render() (one piece): the same bytes at the same
-// depth, whatever the tile size or thread count, across tears, the border, overlays and strokes.
+// render_strips (tiles, rows streamed) against the one-piece render (Renderer, which never tiles):
+// the same bytes at the same depth, whatever the tile size or thread count, across tears, the
+// border, overlays and strokes; and render(), which tiles large views, against the same.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -108,7 +110,7 @@ TEST(RenderStrips, EqualsTheOnePieceRenderForEveryTileSizeAndThreadCount) {
   const VectorImage& image = image512();
   for (const Case& c : cases()) {
     SCOPED_TRACE(c.name);
-    const Image8 reference = render(image, c.options);
+    const Image8 reference = Renderer(image).render(c.options);
     ASSERT_GT(reference.width, 0);
     for (const int tile : {64, 192, 1024}) {
       for (const int threads : {1, 3}) {
@@ -120,6 +122,20 @@ TEST(RenderStrips, EqualsTheOnePieceRenderForEveryTileSizeAndThreadCount) {
         EXPECT_EQ(first_difference(reference, tiled), "");
       }
     }
+  }
+}
+
+TEST(RenderStrips, ALargeOneOffRenderIsDrawnInTilesWithTheOnePieceBytes) {
+  const VectorImage& image = image512();
+  for (const bool window : {false, true}) {
+    SCOPED_TRACE(window ? "window" : "whole image");
+    RenderOptions o;
+    o.width = window ? 1200 : 2600;
+    if (window) o.window = Window{-20, 40, 400, 300}, o.depth = 5;
+    // Over render()'s one-piece bound of 2^20 refined triangles, so that it tiles.
+    const ViewFaces view = view_faces(image, o);
+    ASSERT_GT(double(view.faces.size()) * std::ldexp(1.0, 2 * view.depth), double(1 << 20));
+    EXPECT_EQ(first_difference(Renderer(image).render(o), render(image, o)), "");
   }
 }
 
