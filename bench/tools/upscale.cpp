@@ -1,7 +1,8 @@
-// subvec_upscale: a bicubic upscale of a photograph, the input of the large-image vectorization
-// benchmark (scripts/bench-vectorize).
+// subvec_upscale: a bicubic upscale of a photograph, or a centred crop of it, the inputs of the
+// large-image vectorization benchmarks (scripts/bench-vectorize).
 //
-//   subvec_upscale IN OUT.png FACTOR
+//   subvec_upscale IN OUT.png FACTOR          FACTOR 1..16 times the size, bicubic
+//   subvec_upscale IN OUT.png crop W H        the W x H pixels at the centre
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -14,7 +15,20 @@
 
 int main(int argc, char** argv) {
   try {
-    if (argc != 4) throw subvec::Error(subvec::ErrorCode::kInvalidArgument, "usage: subvec_upscale IN OUT.png FACTOR");
+    const char* usage = "usage: subvec_upscale IN OUT.png FACTOR | subvec_upscale IN OUT.png crop W H";
+    if (argc == 6 && std::string(argv[3]) == "crop") {
+      const subvec::Image8 in = subvec::read_image(argv[1]);
+      const int w = std::stoi(argv[4]), h = std::stoi(argv[5]);
+      if (w < 2 || h < 2 || w > in.width || h > in.height)
+        throw subvec::Error(subvec::ErrorCode::kInvalidArgument, "crop W H must be 2.. the image's size");
+      const int x0 = (in.width - w) / 2, y0 = (in.height - h) / 2;
+      subvec::Image8 out(w, h, in.channels);
+      for (int y = 0; y < h; ++y)
+        std::copy_n(in.row(y0 + y) + size_t(x0) * in.channels, size_t(w) * in.channels, out.row(y));
+      subvec::write_png(argv[2], out);
+      return 0;
+    }
+    if (argc != 4) throw subvec::Error(subvec::ErrorCode::kInvalidArgument, usage);
     const int factor = std::stoi(argv[3]);
     if (factor < 1 || factor > 16) throw subvec::Error(subvec::ErrorCode::kInvalidArgument, "FACTOR must be 1..16");
     const subvec::Image8 in = subvec::read_image(argv[1]);
