@@ -244,7 +244,7 @@ std::vector<uint8_t> tear_band(const SegmentGrid& grid, int width, int height, d
 // average of the non-band pixels within fill_radius on its own side of the tears (no tear segment
 // between them). In parallel, image rows apart.
 struct FilledTargets {
-  std::vector<std::array<double, 3>> color;
+  std::vector<std::array<float, 3>> color;  // the precision of a PixelRow's target
   std::vector<uint8_t> ok;  // 0: nothing on this side nearby, the pixel is left out
 };
 
@@ -252,7 +252,7 @@ FilledTargets fill_band(const FitSystem& system, const Image8& image, const Segm
                         const std::vector<uint8_t>& band, const ColorFitOptions& options) {
   const int width = system.width, height = system.height;
   const int r = static_cast<int>(std::ceil(options.fill_radius));
-  FilledTargets filled{std::vector<std::array<double, 3>>(size_t(width) * height),
+  FilledTargets filled{std::vector<std::array<float, 3>>(size_t(width) * height),
                        std::vector<uint8_t>(size_t(width) * height, 0)};
   const int parts = std::min(detail::resolve_threads(options.threads), height);
   detail::parallel_for(parts, parts, [&](int part) {
@@ -283,7 +283,7 @@ FilledTargets fill_band(const FitSystem& system, const Image8& image, const Segm
           }
         }
         if (wsum == 0) continue;
-        for (int k = 0; k < 3; ++k) filled.color[size_t(y) * width + x][k] = sum[k] / wsum;
+        for (int k = 0; k < 3; ++k) filled.color[size_t(y) * width + x][k] = static_cast<float>(sum[k] / wsum);
         filled.ok[size_t(y) * width + x] = 1;
       }
     }
@@ -382,6 +382,8 @@ void set_pixel_targets(FitSystem& system, const Image8& image, const ColorFitOpt
   const std::vector<uint8_t> band = tear_band(grid, width, height, options.band);
   const FilledTargets filled = fill_band(system, image, grid, band, options);
   // Targets: the pixel, or for band pixels the hole-filled color; the rows in pixel order.
+  system.rows.reserve(size_t(std::count_if(system.located.begin(), system.located.end(),
+                                           [](const Location& l) { return l.triangle >= 0; })));
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * width + x;
@@ -389,7 +391,7 @@ void set_pixel_targets(FitSystem& system, const Image8& image, const ColorFitOpt
       std::array<double, 3> target = pixel(image, x, y);
       if (band[i]) {
         if (!filled.ok[i]) continue;
-        target = filled.color[i];
+        target = {filled.color[i][0], filled.color[i][1], filled.color[i][2]};
         ++stats.filled;
       }
       system.rows.push_back({static_cast<int32_t>(i), {float(target[0]), float(target[1]), float(target[2])}});
