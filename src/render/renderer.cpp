@@ -569,14 +569,21 @@ constexpr double kOnePieceTriangles = double(1 << 20);
 }  // namespace
 
 Image8 render(const VectorImage& image, const RenderOptions& options) {
+  return detail::render_one_off(image, options, kOnePieceTriangles);
+}
+
+Image8 detail::render_one_off(const VectorImage& image, const RenderOptions& options,
+                              double one_piece_triangles, bool* tiled) {
   State state;
   state.one_frame = true;
   Image8 out;
+  if (tiled) *tiled = false;
   if (options.backend == Backend::kCpu && image.width >= 1 && image.height >= 1) {
     LevelState& ls = level_state(image, state, options.level);
     const detail::ViewPlan plan =
         detail::plan_view(image, image.levels[options.level], ls.boxes, options);
-    if (double(plan.faces.size()) * std::ldexp(1.0, 2 * plan.depth) > kOnePieceTriangles) {
+    if (double(plan.faces.size()) * std::ldexp(1.0, 2 * plan.depth) > one_piece_triangles) {
+      if (tiled) *tiled = true;
       out = Image8(plan.view.width, plan.view.height, plan.channels);
       render_strips_with(image, state, options, [&](int y0, const Image8& strip) {
         std::copy(strip.pixels.begin(), strip.pixels.end(), out.row(y0));

@@ -60,4 +60,9 @@ bool covers_faces(std::span<const int32_t> have, bool have_all, std::span<const 
 // pixel, lowered until num_faces * 4^k <= kMaxAutoTriangles.
 int choose_depth(double mean_edge_pixels, double max_edge_pixels, double zoom, int64_t num_faces);
 
+// render(): a CPU view of more than `one_piece_triangles` refined triangles (render() passes
+// 2^20) is drawn in tiles by render_strips(), which `tiled` reports; any other in one piece.
+Image8 render_one_off(const VectorImage& image, const RenderOptions& options, double one_piece_triangles,
+                      bool* tiled = nullptr);
+
 }  // namespace subvec::detail

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <string>
 
+#include "render/renderer_p.h"
 #include "subvec/core/error.h"
 #include "subvec/io/image_io.h"
 #include "subvec/render/renderer.h"
@@ -126,17 +127,29 @@ TEST(RenderStrips, EqualsTheOnePieceRenderForEveryTileSizeAndThreadCount) {
 }
 
 TEST(RenderStrips, ALargeOneOffRenderIsDrawnInTilesWithTheOnePieceBytes) {
+  // render() tiles views of over 2^20 refined triangles; the same rule with a bound of 2^16, so
+  // that views of a few hundred pixels cross it (2^20 took 2,600 px: 20 s, minutes under ASan).
   const VectorImage& image = image512();
+  constexpr double kBound = double(1 << 16);
   for (const bool window : {false, true}) {
     SCOPED_TRACE(window ? "window" : "whole image");
     RenderOptions o;
-    o.width = window ? 1200 : 2600;
-    if (window) o.window = Window{-20, 40, 400, 300}, o.depth = 5;
-    // Over render()'s one-piece bound of 2^20 refined triangles, so that it tiles.
+    o.width = window ? 300 : 700;
+    if (window) o.window = Window{-20, 40, 400, 300}, o.depth = 4;
     const ViewFaces view = view_faces(image, o);
-    ASSERT_GT(double(view.faces.size()) * std::ldexp(1.0, 2 * view.depth), double(1 << 20));
-    EXPECT_EQ(first_difference(Renderer(image).render(o), render(image, o)), "");
+    ASSERT_GT(double(view.faces.size()) * std::ldexp(1.0, 2 * view.depth), kBound);
+    bool tiled = false;
+    const Image8 out = detail::render_one_off(image, o, kBound, &tiled);
+    EXPECT_TRUE(tiled);
+    EXPECT_EQ(first_difference(Renderer(image).render(o), out), "");
+    // Under the bound: one piece.
+    detail::render_one_off(image, o, double(view.faces.size()) * std::ldexp(1.0, 2 * view.depth), &tiled);
+    EXPECT_FALSE(tiled);
   }
+  // render() itself is that rule at 2^20: the 512-class image at 1x stays in one piece.
+  bool tiled = true;
+  EXPECT_EQ(first_difference(detail::render_one_off(image, {}, double(1 << 20), &tiled), render(image, {})), "");
+  EXPECT_FALSE(tiled);
 }
 
 TEST(RenderStrips, ARefusedRenderCallsNoSink) {
