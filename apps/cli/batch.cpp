@@ -60,7 +60,7 @@ struct BatchArgs {
   VectorizeParams vectorize;
   subvec::VectorizeOptions options;  // vectorize_options(vectorize), validated before any work
   const std::atomic<bool>* cancel = nullptr;  // Ctrl+C
-  int64_t max_pixels = int64_t{1} << 23;
+  int64_t max_pixels = 0;  // --max-pixels (add_limit_options)
   bool render_png = false;
 };
 
@@ -249,7 +249,7 @@ void run_batch(BatchArgs& a) {
         process(item, a);
       } catch (const Error& e) {
         if (e.code() == ErrorCode::kCancelled) break;
-        item.error = one_line(e.what());
+        item.error = one_line(with_flag_names(e.what()));  // e.g. the memory check
       } catch (const std::bad_alloc&) {
         item.error = "out of memory";
       } catch (const std::exception& e) {
@@ -323,10 +323,7 @@ void add_batch_command(CLI::App& app) {
   add_vertex_count_options(batch, ba.vectorize);
   add_quality_options(batch, ba.vectorize);
   add_level_options(batch, ba.vectorize, /*levels_only=*/true);
-  batch
-      ->add_option("--max-pixels", ba.max_pixels,
-                   "Refuse (fail) larger images (default 8388608, about 12 GB of memory each)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  add_limit_options(batch, ba.vectorize, ba.max_pixels);
   batch->add_flag("--render-png", ba.render_png,
                   "Also write NAME.png: the vectorized image rendered at its own size");
   batch->footer(

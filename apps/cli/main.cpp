@@ -356,9 +356,7 @@ void run_compare(const std::string& reference, const std::string& test, bool jso
 
 struct VectorizeArgs {
   std::string input, output;
-  // 2^23 pixels: a 4K UHD frame (3840 x 2160) fits. Vectorizing takes about 1.5 KB of memory per
-  // pixel (the dense mesh has a vertex per pixel), so the default stays near 12 GB.
-  int64_t max_pixels = int64_t{1} << 23;
+  int64_t max_pixels = 0;  // --max-pixels (add_limit_options)
   bool json = false;
   subvec_cli::VectorizeParams params;  // shared with batch (vectorize_options.h)
 };
@@ -386,8 +384,9 @@ void run_vectorize(const VectorizeArgs& a) {
   try {
     v = subvec::vectorize(image, options, &report);
   } catch (const Error& e) {
-    // A budget that cannot be met is named after its option, as the option checks are.
-    if (e.code() != ErrorCode::kInvalidArgument) throw;
+    // A budget that cannot be met and the memory check are named after their options, as the
+    // option checks are.
+    if (e.code() != ErrorCode::kInvalidArgument && e.code() != ErrorCode::kLimit) throw;
     throw Error(e.code(), subvec_cli::with_flag_names(e.what()));
   }
   progress.update("measuring", 1.0);
@@ -425,6 +424,10 @@ void run_vectorize(const VectorizeArgs& a) {
     j["triangles"] = report.triangles;
     j["features"] = report.features;
     j["tear_vertices"] = report.tear_vertices;
+    j["dense_vertices"] = report.dense_vertices;
+    // The library's estimate (what --max-memory is checked against) and this process's peak.
+    j["memory"] = {{"estimate_bytes", subvec::estimate_vectorize_bytes(image.width, image.height, options)},
+                   {"peak_bytes", subvec_cli::peak_resident_bytes()}};
     j["budget"] = {{"target", report.target_vertices},
                    {"feature_tolerance", report.feature_tolerance},
                    {"features_dropped", report.features_dropped}};
@@ -576,10 +579,7 @@ void add_vectorize_command(CLI::App& app) {
   vectorize->add_option("-o,--output", va.output, "Output vector image (.svec or .svec.json)")
       ->required();
   subvec_cli::add_vectorize_options(vectorize, va.params);
-  vectorize
-      ->add_option("--max-pixels", va.max_pixels,
-                   "Refuse larger images (default 8388608, about 12 GB of memory)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  subvec_cli::add_limit_options(vectorize, va.params, va.max_pixels);
   vectorize->add_flag("--json", va.json, "Print the summary as JSON");
   // In a callback, like every command that runs a job: a range the library refuses
   // (vectorize_options()) is then a usage error, reported as CLI11's are.

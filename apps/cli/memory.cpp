@@ -3,6 +3,9 @@
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/resource.h>
+#endif
 #if defined(__GLIBC__)
 #include <malloc.h>
 #include <sys/mman.h>
@@ -41,6 +44,20 @@ void tune_memory() {
   if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
   std::free(block);  // to the heap's free top, which stays under the trim threshold
 #endif
+#endif
+}
+
+int64_t peak_resident_bytes() {
+#if defined(__unix__) || defined(__APPLE__)
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+#if defined(__APPLE__)
+  return int64_t(usage.ru_maxrss);  // bytes there
+#else
+  return int64_t(usage.ru_maxrss) * 1024;  // KB on Linux
+#endif
+#else
+  return 0;
 #endif
 }
 

@@ -14,9 +14,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace subvec_cli {
 
 void tune_memory();
+
+// The process's peak resident size so far (getrusage), in bytes; 0 where it cannot tell.
+int64_t peak_resident_bytes();
 
 }  // namespace subvec_cli

@@ -40,6 +40,7 @@ constexpr FlagName kFlagNames[] = {
     {"levels.saliency_weight", "--saliency-weight"},
     {"levels.reduction", "--level-reduction"},
     {"threads", "--threads"},
+    {"max_memory", "--max-memory"},
 };
 
 // "ID=L" with integers; returns an error message or "" and fills id and level. Which levels
@@ -171,6 +172,21 @@ void add_level_options(CLI::App* command, VectorizeParams& params, bool levels_o
             return parse_feature_level(text, id, level);
           },
           "ID=L", "feature-level"));
+}
+
+void add_limit_options(CLI::App* command, VectorizeParams& params, int64_t& max_pixels) {
+  max_pixels = subvec::kDefaultMaxInputPixels;
+  command
+      ->add_option("--max-pixels", max_pixels,
+                   "Refuse larger images (default " + std::to_string(max_pixels) +
+                       ", 2^25: a 24 MP photograph is read; what it may cost is --max-memory)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  command
+      ->add_option("--max-memory", params.options.max_memory,
+                   "Refuse an image whose estimated peak memory is larger (6G, 800MB, bytes; default "
+                   "0: the memory available when the job starts)")
+      ->transform(CLI::AsSizeValue(/*kb_is_1000=*/true))
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 50));
 }
 
 void add_vectorize_options(CLI::App* command, VectorizeParams& params) {

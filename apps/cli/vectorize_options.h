@@ -32,6 +32,10 @@ void add_quality_options(CLI::App* command, VectorizeParams& params);
 // Adds --levels and, unless `levels_only`, --saliency-weight, --level-reduction and --feature-level.
 void add_level_options(CLI::App* command, VectorizeParams& params, bool levels_only = false);
 
+// Adds --max-pixels (into `max_pixels`, which starts at subvec::kDefaultMaxInputPixels: the
+// reader's limit) and --max-memory (the library's max_memory; sizes such as 6G or 800MB).
+void add_limit_options(CLI::App* command, VectorizeParams& params, int64_t& max_pixels);
+
 // Everything `subvec vectorize` takes that shapes the document: the above, --segment and --threads.
 void add_vectorize_options(CLI::App* command, VectorizeParams& params);
 

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "server.h"
+#include "subvec/core/error.h"
 #include "vectorize_options.h"
 
 namespace subvec_serve {
@@ -27,7 +28,13 @@ void run_serve(ServeOptions& options, const subvec_cli::VectorizeParams& params)
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   EditorServer server(options);
-  server.start();
+  try {
+    server.start();
+  } catch (const subvec::Error& e) {
+    // The memory check of a raster input, named after its flag as `subvec vectorize` names it.
+    if (e.code() != subvec::ErrorCode::kLimit) throw;
+    throw subvec::Error(e.code(), subvec_cli::with_flag_names(e.what()));
+  }
   std::cout << "subvec: editing " << options.input.string() << " at " << server.url()
             << "  (Ctrl+C stops)" << std::endl;
   std::thread waiter([&server, signals] {
@@ -69,8 +76,7 @@ void add_serve_command(CLI::App& app) {
                     "Address to listen on (default 127.0.0.1: this machine only)");
   // A raster input is vectorized as `subvec vectorize` does it, with the same options.
   subvec_cli::add_vectorize_options(serve, params);
-  serve->add_option("--max-pixels", options.max_pixels, "Raster input: refuse larger images")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 30));
+  subvec_cli::add_limit_options(serve, params, options.max_pixels);  // for a raster input
   serve->footer(
       "Examples:\n"
       "  subvec serve examples/01-disk.svec.json              # then open the printed URL\n"

@@ -289,6 +289,7 @@ void EditorServer::start() {
     // starts; vectorize in the background, until done or until the server stops.
     subvec::validate(s.options.vectorize);
     auto image = std::make_shared<subvec::Image8>(subvec::read_image(in, s.options.max_pixels));
+    subvec::check_vectorize_memory(image->width, image->height, s.options.vectorize);
     s.stage = "vectorizing";
     s.worker = std::thread([&s, image] {
       subvec::VectorizeOptions vo = s.options.vectorize;

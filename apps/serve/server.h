@@ -29,7 +29,7 @@ struct ServeOptions {
   // Vectorization of a raster input: the document `subvec vectorize` makes with the same options,
   // levels included (its progress and cancel flag are the server's own).
   subvec::VectorizeOptions vectorize;
-  int64_t max_pixels = int64_t{1} << 23;
+  int64_t max_pixels = subvec::kDefaultMaxInputPixels;
 };
 
 class EditorServer {

@@ -31,7 +31,7 @@ import time
 IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".webp", ".tif", ".tiff", ".bmp")
 COLUMNS = ["image", "output", "width", "height", "vertices", "triangles", "mae", "seconds",
            "status", "error"]
-MAX_PIXELS = 1 << 23  # as `subvec batch --max-pixels`
+MAX_PIXELS = 1 << 25  # as `subvec batch --max-pixels` (subvec::kDefaultMaxInputPixels)
 _UMASK = os.umask(0)  # read once (the call sets it), so outputs get the usual mode, as the CLI's
 os.umask(_UMASK)
 

@@ -684,7 +684,7 @@ void def_vectorize(py::module_& m) {
   m.def(
       "vectorize",
       [](const py::object& image, double ratio, int vertices, int levels, int refine, int relocate,
-         int l1_iterations, int threads) {
+         int l1_iterations, int threads, int64_t max_memory) {
         subvec::VectorizeOptions options;
         options.ratio = ratio;
         options.vertices = vertices;
@@ -693,6 +693,7 @@ void def_vectorize(py::module_& m) {
         options.fit.relocate_iterations = relocate;
         options.fit.l1_iterations = l1_iterations;
         options.threads = threads;
+        options.max_memory = max_memory;
         try {
           subvec::validate(options);
         } catch (const Error& e) {
@@ -705,7 +706,7 @@ void def_vectorize(py::module_& m) {
       "image"_a, py::kw_only(), "ratio"_a = d.ratio, "vertices"_a = d.vertices,
       "levels"_a = d.levels.levels, "refine"_a = d.refine.rounds,
       "relocate"_a = d.fit.relocate_iterations, "l1_iterations"_a = d.fit.l1_iterations,
-      "threads"_a = d.threads);
+      "threads"_a = d.threads, "max_memory"_a = d.max_memory);
 }
 
 // Files, bytes and raster images.

@@ -131,9 +131,11 @@ class VectorImage:
                   sparse: Literal["scipy", "arrays"] = "scipy") -> Refined: ...
 
 def vectorize(image: npt.ArrayLike, *, ratio: float = ..., vertices: int = ..., levels: int = ...,
-              refine: int = ..., relocate: int = ..., l1_iterations: int = ..., threads: int = ...) -> VectorImage:
+              refine: int = ..., relocate: int = ..., l1_iterations: int = ..., threads: int = ...,
+              max_memory: int = ...) -> VectorImage:
     """H x W x 3 uint8, or float32/float64 in [0, 1], to a vector image of the same size, with its
-    levels of abstraction. Defaults and ranges are the library's (subvec::VectorizeOptions)."""
+    levels of abstraction. Defaults and ranges are the library's (subvec::VectorizeOptions);
+    max_memory (bytes, 0: the memory available) refuses an image whose estimated peak is larger."""
 def load(path: _Path) -> VectorImage: ...
 def from_bytes(data: bytes) -> VectorImage: ...
 def read_image(path: _Path, *, max_pixels: int = ...) -> npt.NDArray[np.uint8]: ...

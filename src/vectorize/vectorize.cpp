@@ -13,6 +13,7 @@
 #include "core/cancel_p.h"
 #include "core/messages_p.h"
 #include "subvec/core/error.h"
+#include "subvec/core/memory.h"
 #include "subvec/mesh/topology.h"
 #include "vectorize/levels_p.h"
 
@@ -25,6 +26,21 @@ constexpr VectorizeStage kStages[] = {{"features", 0.0}, {"mesh", 0.02}, {"simpl
 constexpr VectorizeStage kSegmentStages[] = {{"segment", 0.0}, {"features", 0.08}, {"mesh", 0.1},
                                              {"simplify", 0.3}, {"refine", 0.7},   {"fit", 0.8},
                                              {"levels", 0.9}};
+
+// The budget: options.vertices, or ratio x pixels; at least 4 (the corners).
+int target_vertex_count(const VectorizeOptions& options, double pixels) {
+  return std::max(4, options.vertices > 0 ? options.vertices : static_cast<int>(std::lround(options.ratio * pixels)));
+}
+
+// estimate_vectorize_bytes(): bytes of the process (binary, libraries, thread stacks), of each pixel
+// (the image, the features' and the fit's per-pixel arrays), of each dense mesh vertex with its
+// quadrics, and of each refined triangle and control vertex of the fit. Fitted to the peak
+// resident sizes of `subvec vectorize` from 0.26 to 16 MP and ratios 0.003 to 0.1, and raised
+// until the estimate bounds every one (docs/performance.md, "Memory"). The simplified meshes' mean
+// edges measured up to kEdgeShare times the equilateral one (ratio 0.06 on 1 MP: the fit refined
+// one level deeper than equilateral triangles would).
+constexpr double kProcessBytes = 80e6, kPerPixel = 90, kPerDenseVertex = 440, kPerRefinedTriangle = 650,
+                 kPerControlVertex = 500, kBandShare = 0.6, kEdgeShare = 1.4142;
 
 }  // namespace
 
@@ -43,11 +59,57 @@ void validate(const VectorizeOptions& o) {
   validate(o.fit, "fit.");
   validate(o.levels, "levels.");
   check_in("threads", o.threads, 0, 1024);
+  if (o.max_memory < 0) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "max_memory must be 0 (the memory available) or a byte count, got " + std::to_string(o.max_memory));
+  }
+}
+
+int automatic_grid_step(int64_t pixels, int target_vertices) {
+  const double p = double(pixels);
+  return p >= double(1 << 21) && 64.0 * target_vertices <= p   ? 4
+         : p >= double(1 << 18) && 16.0 * target_vertices <= p ? 2
+                                                                : 1;
+}
+
+int64_t estimate_vectorize_bytes(int width, int height, const VectorizeOptions& options) {
+  const double pixels = double(width) * height;
+  // Simplification cannot add vertices: a budget over the dense mesh's keeps it whole.
+  const double target = std::min<double>(target_vertex_count(options, pixels), pixels);
+  const int step = options.initial_mesh.grid_step > 0 ? options.initial_mesh.grid_step
+                                                      : automatic_grid_step(int64_t(pixels), int(target));
+  // The two peaks: the dense mesh while it is simplified, and the color fit. The dense mesh has a
+  // vertex per grid block and one per pixel in the features' band, which is not known before the
+  // features are: taken as kBandShare of the pixels (the most feature-rich of the photographs
+  // measured, OneStandsOut, keeps about 60 % of them).
+  const double dense = pixels / (step * step) + kBandShare * pixels * (1 - 1.0 / (step * step));
+  // The fit's refined triangles: twice the target at the depth rule's depth (default_fit_depth(),
+  // which measures the real mesh's mean edge) for a mean edge of kEdgeShare times that of
+  // equilateral triangles of the image's mean area.
+  double edge = kEdgeShare * std::sqrt(2 * pixels / (std::sqrt(3.0) * target));
+  int depth = 0;
+  while (edge > kFitEdgePixels && depth < 5) edge /= 2, ++depth;
+  if (options.fit.depth >= 0) depth = options.fit.depth;
+  const double refined = 2.0 * target * std::pow(4.0, depth);
+  const double mesh_peak = kPerDenseVertex * dense;
+  const double fit_peak = kPerRefinedTriangle * refined + kPerControlVertex * target;
+  return static_cast<int64_t>(kProcessBytes + kPerPixel * pixels + std::max(mesh_peak, fit_peak));
 }
 
 std::vector<VectorizeStage> vectorize_stages(bool segment) {
   return segment ? std::vector<VectorizeStage>(std::begin(kSegmentStages), std::end(kSegmentStages))
                  : std::vector<VectorizeStage>(std::begin(kStages), std::end(kStages));
+}
+
+void check_vectorize_memory(int width, int height, const VectorizeOptions& options) {
+  const int64_t need = estimate_vectorize_bytes(width, height, options);
+  const int64_t room = options.max_memory > 0 ? options.max_memory : available_memory_bytes();
+  if (need <= room) return;
+  throw Error(ErrorCode::kLimit, "max_memory is " + format_bytes(room) +
+                                     (options.max_memory > 0 ? "" : " (the memory available now)") +
+                                     ", and vectorizing this " + std::to_string(width) + "x" +
+                                     std::to_string(height) + " image needs an estimated " +
+                                     format_bytes(need));
 }
 
 VectorImage vectorize(const Image8& image, const VectorizeOptions& options, VectorizeReport* report) {
@@ -57,8 +119,8 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
                                                  std::to_string(image.height) + " pixels is too small to vectorize");
   }
   const double pixels = double(image.width) * image.height;
-  const int target = std::max(4, options.vertices > 0 ? options.vertices
-                                                      : static_cast<int>(std::lround(options.ratio * pixels)));
+  const int target = target_vertex_count(options, pixels);
+  check_vectorize_memory(image.width, image.height, options);  // before the first large allocation
   VectorizeReport local;
   VectorizeReport& r = report ? *report : local;
   r = {};
@@ -105,12 +167,9 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   // images"): about the same error for a third less time, and at 4 MP 4 s less; the fit still
   // sees every pixel.
   InitialMeshOptions mesh_options = options.initial_mesh;
-  if (mesh_options.grid_step == 0) {
-    mesh_options.grid_step = pixels >= double(1 << 21) && 64.0 * target <= pixels   ? 4
-                             : pixels >= double(1 << 18) && 16.0 * target <= pixels ? 2
-                                                                                    : 1;
-  }
+  if (mesh_options.grid_step == 0) mesh_options.grid_step = automatic_grid_step(int64_t(pixels), target);
   ControlMesh mesh = build_initial_mesh(image, features, mesh_options);
+  r.dense_vertices = mesh.num_vertices();
   lap("mesh");
   if (num_boundary > 0) {
     // The mesh features whose vertices are the boundary's points (the dense mesh keeps positions).

@@ -41,6 +41,17 @@ def test_vectorize_then_render_reproduces_the_photo(disk):
     assert np.abs(pixels.astype(int) - 128).mean() > 20
 
 
+def test_vectorize_refuses_an_image_over_max_memory(disk):
+    photo, _ = disk
+    # The library's estimate against the keyword, before any work: its error class and words.
+    with pytest.raises(subvec.LimitError, match=r"^max_memory is 10 MB, and vectorizing this 96x72 "
+                       r"image needs an estimated \d+ MB$"):
+        subvec.vectorize(photo, max_memory=10_000_000)
+    with pytest.raises(subvec.InvalidArgumentError, match="max_memory must be 0"):
+        subvec.vectorize(photo, max_memory=-1)
+    assert subvec.vectorize(photo, levels=1, max_memory=1 << 40).width == 96
+
+
 def test_float_input_in_0_1_equals_uint8_input(disk):
     photo, image = disk
     as_float = subvec.vectorize(photo.astype(np.float32) / 255, ratio=0.05, levels=1)

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -23,6 +24,11 @@
 #include "subvec/vectorize/simplify.h"
 
 namespace subvec {
+
+// The largest raster the front ends read for vectorizing unless told otherwise (their
+// --max-pixels): 2^25 pixels, so a 24 MP photograph (6000 x 4000) and a 32 MP one are read. What
+// an image may cost is vectorize()'s memory check (VectorizeOptions::max_memory), not this.
+inline constexpr int64_t kDefaultMaxInputPixels = int64_t{1} << 25;
 
 struct VectorizeOptions {
   double ratio = 0.01;   // control vertices as a fraction of the pixel count
@@ -41,6 +47,10 @@ struct VectorizeOptions {
   // `subvec vectorize` writes. Their color refit keeps its own options (levels.fit), not `fit`.
   LevelOptions levels;
   int threads = 0;       // 0: all cores; the result does not depend on it
+  // The memory the job may plan for, in bytes: an image whose estimate_vectorize_bytes() is larger
+  // is refused with Error(kLimit) before the job's first large allocation. 0: the memory available
+  // when the job starts (available_memory_bytes(), core/memory.h).
+  int64_t max_memory = 0;
   // Called with a stage name and the fraction of the whole job done (0..1), at the start of each
   // stage of vectorize_stages() and with "done" and 1 at the end.
   std::function<void(const std::string& stage, double fraction)> progress;
@@ -75,6 +85,7 @@ struct VectorizeReport {
   int vertices = 0, triangles = 0, features = 0, tear_vertices = 0;  // of level 0
   double fit_rms = 0;
   int target_vertices = 0;  // the budget: options.vertices, or ratio x pixels (at least 4)
+  int dense_vertices = 0;   // of the dense mesh that simplification starts from
   // How far level 0's feature chains may be from the detected curves, in pixels:
   // max_feature_error, unless the vertex budget needed more (vectorize() then loosens them, up to
   // 3 times, and drops the least salient features; features_dropped counts them).
@@ -92,9 +103,26 @@ struct VectorizeReport {
   std::vector<int32_t> segment_feature_ids;
 };
 
+// The grid the dense mesh starts from when options.initial_mesh.grid_step is 0 (automatic): 4
+// pixels for images of 2^21 pixels or more at targets of at most 1/64 of the pixels, else 2 from
+// 2^18 pixels at targets of at most 1/16, else 1 (docs/vectorize.md, "Large images").
+int automatic_grid_step(int64_t pixels, int target_vertices);
+
+// The peak memory of vectorizing a width x height image with `options`, in bytes: an upper bound
+// of the peak resident size of `subvec vectorize` (image, job, closing render and comparison),
+// from the pixels, the dense mesh's grid and the fit's refined triangles, calibrated on measured
+// peaks from 0.25 to 16 MP (docs/performance.md, "Memory"). Options are not validated.
+int64_t estimate_vectorize_bytes(int width, int height, const VectorizeOptions& options);
+
+// Throws Error(kLimit) when estimate_vectorize_bytes() exceeds options.max_memory (or, at 0, the
+// memory available now), in one line that starts with "max_memory" and gives both figures.
+// vectorize() calls it before its first large allocation; a front end that decodes the image
+// long before the job starts may call it first.
+void check_vectorize_memory(int width, int height, const VectorizeOptions& options);
+
 // Vectorizes an RGB image into a vector image of the same size with options.levels.levels
-// levels. Throws Error(kInvalidArgument) for options out of range (validate()) and
-// Error(kCancelled) when options.cancel is set.
+// levels. Throws Error(kInvalidArgument) for options out of range (validate()), Error(kLimit)
+// when the estimate exceeds the memory it may use (check_vectorize_memory()) and Error(kCancelled) when options.cancel is set.
 VectorImage vectorize(const Image8& image, const VectorizeOptions& options = {}, VectorizeReport* report = nullptr);
 
 }  // namespace subvec

@@ -17,8 +17,11 @@
 #include <string>
 #include <vector>
 
+#include "subvec/core/memory.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
+#include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
 
 namespace subvec {
 namespace {
@@ -547,6 +550,60 @@ TEST_F(Cli, VectorizeTheExamplePhotograph) {
   ASSERT_EQ(subvec("render " + q(out) + " -o " + q(dir_ / "mesh.png") + " --scale 4 --overlay mesh")
                 .status,
             0);
+}
+
+// Full-size photographs (issue 24): a 20 MP image (5472 x 3648, a 1-inch sensor's) is read by
+// default and refused by --max-memory below its estimate, with the estimate, before any work.
+TEST_F(Cli, ATwentyMegapixelImageIsReadAndRefusedOnlyByItsMemoryEstimate) {
+  EXPECT_GE(subvec::kDefaultMaxInputPixels, int64_t{6000} * 4000);  // a 24 MP photograph too
+  const fs::path photo = dir_ / "20mp.png", out = dir_ / "out.svec";
+  subvec::Image8 img(5472, 3648, 3);
+  for (int y = 0; y < img.height; ++y) std::fill_n(img.row(y), 3 * img.width, static_cast<uint8_t>(y));
+  subvec::write_png(photo, img);
+  const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(out) + " --max-memory 2GB");
+  expect_failure(r, "subvec: --max-memory is 2.0 GB, and vectorizing this 5472x3648 image needs an estimated ");
+  EXPECT_EQ(r.err.find("over the limit"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // The estimate named is the library's, and batch refuses the image with the same words.
+  const int64_t estimate = subvec::estimate_vectorize_bytes(5472, 3648, {});
+  EXPECT_GT(estimate, int64_t{2'000'000'000});
+  EXPECT_NE(r.err.find(subvec::format_bytes(estimate)), std::string::npos) << r.err;
+  fs::create_directories(dir_ / "in");
+  fs::rename(photo, dir_ / "in" / "20mp.png");
+  const CliResult b = subvec("batch " + q(dir_ / "in") + " -o " + q(dir_ / "batch") + " --max-memory 2GB");
+  EXPECT_EQ(b.status, 1);
+  EXPECT_NE(b.err.find("--max-memory is 2.0 GB"), std::string::npos) << b.err;
+  EXPECT_FALSE(fs::exists(dir_ / "batch" / "20mp.svec"));
+  // A lower --max-pixels is still the reader's limit, checked first.
+  expect_failure(subvec("vectorize " + q(dir_ / "in" / "20mp.png") + " -o " + q(out) + " --max-pixels 19000000"),
+                 "5472x3648 pixels is over the limit of 19000000 pixels (--max-pixels raises the limit)");
+  expect_failure(subvec("vectorize " + q(dir_ / "in" / "20mp.png") + " -o " + q(out) + " --max-memory lots"),
+                 "--max-memory");
+}
+
+// The estimate bounds the measured peak (the JSON's `memory`), without being far above it, on a
+// 1 MP crop of the most feature-rich photograph, whose band of pixel-resolution mesh around the
+// features is the estimate's largest unknown (scripts/bench-scaling's runs are the others:
+// docs/performance.md, "Memory").
+TEST_F(Cli, TheMemoryEstimateBoundsThePeak) {
+  const fs::path large = subvec::test::shared_photos() / ".." / "images-large";
+  if (const auto why = subvec::test::skip_shared_photos(large / "OneStandsOut.jpg")) GTEST_SKIP() << *why;
+  for (const char* name : {"OneStandsOut.jpg"}) {
+    SCOPED_TRACE(name);
+    const subvec::Image8 whole = subvec::read_image(large / name);
+    subvec::Image8 crop(1280, 800, 3);
+    const int x0 = (whole.width - crop.width) / 2, y0 = (whole.height - crop.height) / 2;
+    for (int y = 0; y < crop.height; ++y) std::copy_n(whole.row(y0 + y) + 3 * x0, 3 * crop.width, crop.row(y));
+    const fs::path photo = dir_ / "crop.png";
+    subvec::write_png(photo, crop);
+    const CliResult r = subvec("vectorize " + q(photo) + " -o " + q(dir_ / "crop.svec") + " --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const double estimate = j["memory"]["estimate_bytes"].get<double>(), peak = j["memory"]["peak_bytes"].get<double>();
+    EXPECT_EQ(estimate, double(subvec::estimate_vectorize_bytes(1280, 800, {})));
+    EXPECT_GE(estimate, peak);
+    EXPECT_LE(estimate, 2 * peak);
+  }
 }
 
 TEST_F(Cli, VectorizeSegmentBadRectangles) {
