@@ -379,6 +379,7 @@ void run_vectorize(const VectorizeArgs& a) {
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
+  subvec_cli::reserve_memory(subvec::estimate_vectorize_bytes(image.width, image.height, options));
   subvec::VectorizeReport report;
   subvec::VectorImage v;
   try {

@@ -2,7 +2,6 @@
 
 #include <cstdint>
 #include <cstdlib>
-#include <limits>
 #if defined(__unix__) || defined(__APPLE__)
 #include <sys/resource.h>
 #endif
@@ -26,24 +25,45 @@ namespace subvec_cli {
 #endif
 #endif
 
-void tune_memory() {
-#if SUBVEC_TUNE_MEMORY
-  constexpr size_t kReserve = size_t(1) << 30;
+namespace {
+
+size_t reserved = 0;  // bytes of heap advised for huge pages so far
+
+// Grows the heap to hold a free block of `bytes` and advises it for huge pages.
+void grow_reserve(size_t bytes) {
+#if SUBVEC_TUNE_MEMORY && defined(MADV_HUGEPAGE)
   constexpr uintptr_t kHugePage = uintptr_t(2) << 20;
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
-  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());  // above the reserve: it stays
-  mallopt(M_TOP_PAD, 64 << 20);
-  mallopt(M_ARENA_MAX, 1);
-#if defined(MADV_HUGEPAGE)
   mallopt(M_MMAP_MAX, 0);  // the reserve must come from the heap, not from a mapping of its own
-  void* block = std::malloc(kReserve);
+  void* block = std::malloc(bytes);
   mallopt(M_MMAP_MAX, 65536);  // glibc's default
   if (block == nullptr) return;
   const uintptr_t begin = (reinterpret_cast<uintptr_t>(block) + kHugePage - 1) & ~(kHugePage - 1);
-  const uintptr_t end = (reinterpret_cast<uintptr_t>(block) + kReserve) & ~(kHugePage - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(block) + bytes) & ~(kHugePage - 1);
   if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
   std::free(block);  // to the heap's free top, which stays under the trim threshold
+  reserved = bytes;
+#else
+  (void)bytes;
 #endif
+}
+
+}  // namespace
+
+void tune_memory() {
+#if SUBVEC_TUNE_MEMORY
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts
+  mallopt(M_TRIM_THRESHOLD, -1);  // never: the reserve stays, however large (mallopt(3))
+  mallopt(M_TOP_PAD, 64 << 20);
+  mallopt(M_ARENA_MAX, 1);
+  grow_reserve(size_t(1) << 30);
+#endif
+}
+
+void reserve_memory(int64_t bytes) {
+#if SUBVEC_TUNE_MEMORY
+  if (bytes > 0 && size_t(bytes) > reserved) grow_reserve(size_t(bytes));
+#else
+  (void)bytes;
 #endif
 }
 

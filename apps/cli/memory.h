@@ -20,6 +20,11 @@ namespace subvec_cli {
 
 void tune_memory();
 
+// After tune_memory(): grows the reserve to `bytes` when it is smaller, so that a job expected to
+// need more than the first reserve (vectorizing a large photograph: its estimate) gets huge
+// pages too. Address space only, as the first reserve; it fails quietly.
+void reserve_memory(int64_t bytes);
+
 // The process's peak resident size so far (getrusage), in bytes; 0 where it cannot tell.
 int64_t peak_resident_bytes();
 
