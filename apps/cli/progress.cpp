@@ -43,6 +43,7 @@ void ProgressLine::update(const std::string& stage, double fraction) {
     const std::lock_guard<std::mutex> lock(mutex_);
     stage_ = stage;
     fraction_ = fraction;
+    fraction_at_ = std::chrono::duration<double>(Clock::now() - start_).count();
     changed_ = true;
   }
   wake_.notify_all();
@@ -76,7 +77,13 @@ std::string ProgressLine::text(double elapsed) const {
   if (!counting_) {
     std::snprintf(buf, sizeof buf, " %3d%%, %.0f s", static_cast<int>(std::lround(100 * fraction_)),
                   std::floor(elapsed));
-    return out + ": " + stage_ + buf;
+    out += ": " + stage_ + buf;
+    if (fraction_ > 0 && fraction_ < 1) {
+      const double left = fraction_at_ / fraction_ - elapsed;
+      std::snprintf(buf, sizeof buf, ", ETA %.0f s", std::max(1.0, std::ceil(left)));
+      out += buf;
+    }
+    return out;
   }
   constexpr int kBar = 24;
   const int filled = total_ ? kBar * done_ / total_ : kBar;

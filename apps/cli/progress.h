@@ -2,8 +2,9 @@
 // stderr is a terminal. A thread redraws it a few times a second and whenever it changes, and
 // finish() (or the destructor) erases it, so the terminal keeps the summary alone and pipes and
 // logs get nothing. Two modes:
-// - stages: "subvec: LABEL: STAGE NN%, T s" (update() sets the stage), drawn only once the run has
-//   taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that);
+// - stages: "subvec: LABEL: STAGE NN%, T s, ETA S s" (update() sets the stage), drawn only once the
+//   run has taken a second (SUBVEC_PROGRESS_DELAY=SECONDS changes that); the time left is the
+//   time to the stage's start over its fraction, less the time since (no ETA at 0 % and 100 %);
 // - done/total: "subvec: LABEL [####....] D/TOTAL UNIT (N TALLY, ...), T s, ETA S s" (advance()
 //   counts one item done), drawn from the start; the estimated time left is the mean time per
 //   item done so far times the items left.
@@ -53,6 +54,7 @@ class ProgressLine {
   // Stages.
   std::string stage_ = "reading";
   double fraction_ = 0;
+  double fraction_at_ = 0;  // seconds into the run when fraction_ was set
   // Done/total.
   int total_ = 0, done_ = 0;
   std::string unit_;

@@ -20,12 +20,14 @@
 namespace subvec {
 namespace {
 
-// The stages of the job and the share of the whole run time done when each starts.
-constexpr VectorizeStage kStages[] = {{"features", 0.0}, {"mesh", 0.02}, {"simplify", 0.25},
-                                      {"refine", 0.7},   {"fit", 0.8},   {"levels", 0.9}};
-constexpr VectorizeStage kSegmentStages[] = {{"segment", 0.0}, {"features", 0.08}, {"mesh", 0.1},
-                                             {"simplify", 0.3}, {"refine", 0.7},   {"fit", 0.8},
-                                             {"levels", 0.9}};
+// The stages of the job and the share of the whole job done when each starts: the stage times of
+// `--json` at the defaults, about the same from the 512-class photographs to 4 MP (docs/
+// performance.md); the CLI's progress line makes its estimate of the time left from them.
+constexpr VectorizeStage kStages[] = {{"features", 0.0}, {"mesh", 0.04}, {"simplify", 0.14},
+                                      {"refine", 0.38},  {"fit", 0.62},  {"levels", 0.81}};
+constexpr VectorizeStage kSegmentStages[] = {{"segment", 0.0},   {"features", 0.08}, {"mesh", 0.12},
+                                             {"simplify", 0.21}, {"refine", 0.43},   {"fit", 0.65},
+                                             {"levels", 0.83}};
 
 // The budget: options.vertices, or ratio x pixels; at least 4 (the corners).
 int target_vertex_count(const VectorizeOptions& options, double pixels) {
