@@ -379,7 +379,9 @@ void run_vectorize(const VectorizeArgs& a) {
   options.progress = [&](const std::string& stage, double fraction) {
     progress.update(stage, fraction);
   };
-  subvec_cli::reserve_memory(subvec::estimate_vectorize_bytes(image.width, image.height, options));
+  // The library's estimate (what --max-memory is checked against): the heap reserve and --json.
+  const int64_t estimate = subvec::estimate_vectorize_bytes(image.width, image.height, options);
+  subvec_cli::reserve_memory(estimate);
   subvec::VectorizeReport report;
   subvec::VectorImage v;
   try {
@@ -426,9 +428,7 @@ void run_vectorize(const VectorizeArgs& a) {
     j["features"] = report.features;
     j["tear_vertices"] = report.tear_vertices;
     j["dense_vertices"] = report.dense_vertices;
-    // The library's estimate (what --max-memory is checked against) and this process's peak.
-    j["memory"] = {{"estimate_bytes", subvec::estimate_vectorize_bytes(image.width, image.height, options)},
-                   {"peak_bytes", subvec_cli::peak_resident_bytes()}};
+    j["memory"] = {{"estimate_bytes", estimate}, {"peak_bytes", subvec_cli::peak_resident_bytes()}};
     j["budget"] = {{"target", report.target_vertices},
                    {"feature_tolerance", report.feature_tolerance},
                    {"features_dropped", report.features_dropped}};

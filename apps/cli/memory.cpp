@@ -60,11 +60,7 @@ void tune_memory() {
 }
 
 void reserve_memory(int64_t bytes) {
-#if SUBVEC_TUNE_MEMORY
-  if (bytes > 0 && size_t(bytes) > reserved) grow_reserve(size_t(bytes));
-#else
-  (void)bytes;
-#endif
+  if (bytes > 0 && size_t(bytes) > reserved) grow_reserve(size_t(bytes));  // a no-op without glibc
 }
 
 int64_t peak_resident_bytes() {

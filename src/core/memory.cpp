@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <sstream>
+#include <string>
 #if defined(__unix__) || defined(__APPLE__)
 #include <unistd.h>
 #endif

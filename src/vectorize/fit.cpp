@@ -382,8 +382,7 @@ void set_pixel_targets(FitSystem& system, const Image8& image, const ColorFitOpt
   const std::vector<uint8_t> band = tear_band(grid, width, height, options.band);
   const FilledTargets filled = fill_band(system, image, grid, band, options);
   // Targets: the pixel, or for band pixels the hole-filled color; the rows in pixel order.
-  system.rows.reserve(size_t(std::count_if(system.located.begin(), system.located.end(),
-                                           [](const Location& l) { return l.triangle >= 0; })));
+  system.rows.reserve(system.located.size());  // at most a row per pixel
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * width + x;
@@ -563,9 +562,12 @@ int default_fit_depth(const ControlMesh& mesh) {
       ++count;
     }
   }
-  double mean = count ? total / count : 0;
+  return fit_depth_for_mean_edge(count ? total / count : 0);
+}
+
+int fit_depth_for_mean_edge(double mean_edge_pixels) {
   int depth = 0;
-  while (mean > kFitEdgePixels && depth < 5) mean /= 2, ++depth;
+  while (mean_edge_pixels > kFitEdgePixels && depth < 5) mean_edge_pixels /= 2, ++depth;
   return depth;
 }
 

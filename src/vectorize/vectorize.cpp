@@ -88,10 +88,9 @@ int64_t estimate_vectorize_bytes(int width, int height, const VectorizeOptions& 
   // The fit's refined triangles: twice the target at the depth rule's depth (default_fit_depth(),
   // which measures the real mesh's mean edge) for a mean edge of kEdgeShare times that of
   // equilateral triangles of the image's mean area.
-  double edge = kEdgeShare * std::sqrt(2 * pixels / (std::sqrt(3.0) * target));
-  int depth = 0;
-  while (edge > kFitEdgePixels && depth < 5) edge /= 2, ++depth;
-  if (options.fit.depth >= 0) depth = options.fit.depth;
+  const int depth = options.fit.depth >= 0
+                        ? options.fit.depth
+                        : fit_depth_for_mean_edge(kEdgeShare * std::sqrt(2 * pixels / (std::sqrt(3.0) * target)));
   const double refined = 2.0 * target * std::pow(4.0, depth);
   const double mesh_peak = kPerDenseVertex * dense;
   const double fit_peak = kPerRefinedTriangle * refined + kPerControlVertex * target;

@@ -67,7 +67,10 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
 // (docs/vectorize.md, "Fit depth").
 inline constexpr double kFitEdgePixels = 5.0;
 
-// The fit's depth rule: smallest k whose refined edges average <= kFitEdgePixels.
+// The fit's depth rule: smallest k in 0..5 with mean_edge_pixels / 2^k <= kFitEdgePixels.
+int fit_depth_for_mean_edge(double mean_edge_pixels);
+
+// The rule for `mesh`: fit_depth_for_mean_edge() of its mean control edge.
 int default_fit_depth(const ControlMesh& mesh);
 
 }  // namespace subvec

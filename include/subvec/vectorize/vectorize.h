@@ -122,7 +122,8 @@ void check_vectorize_memory(int width, int height, const VectorizeOptions& optio
 
 // Vectorizes an RGB image into a vector image of the same size with options.levels.levels
 // levels. Throws Error(kInvalidArgument) for options out of range (validate()), Error(kLimit)
-// when the estimate exceeds the memory it may use (check_vectorize_memory()) and Error(kCancelled) when options.cancel is set.
+// when the estimate exceeds the memory it may use (check_vectorize_memory()) and
+// Error(kCancelled) when options.cancel is set.
 VectorImage vectorize(const Image8& image, const VectorizeOptions& options = {}, VectorizeReport* report = nullptr);
 
 }  // namespace subvec
