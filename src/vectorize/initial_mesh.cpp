@@ -30,45 +30,60 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_
 using CdtPlus = CGAL::Constrained_triangulation_plus_2<Cdt>;
 using Point = Kernel::Point_2;
 
-// Pixels whose centre lies closer than r to a feature's polyline.
-std::vector<uint8_t> near_features(const std::vector<DetectedFeature>& features, int w, int h, double r) {
-  std::vector<uint8_t> mask(size_t(w) * h, 0);
+// Pixels whose centre lies closer than r to a feature's polyline; with `corners`, the (w + 1) x
+// (h + 1) pixel corners instead.
+std::vector<uint8_t> near_features(const std::vector<DetectedFeature>& features, int w, int h, double r,
+                                   bool corners = false) {
+  // A pixel corner (x, y) is the centre of pixel (x, y) of the grid shifted by half a pixel.
+  const double shift = corners ? 0.5 : 0.0;
+  const int mw = corners ? w + 1 : w, mh = corners ? h + 1 : h;
+  std::vector<uint8_t> mask(size_t(mw) * mh, 0);
   for (const DetectedFeature& f : features) {
     for (size_t i = 0; i + 1 < f.points.size(); ++i) {
       const Vec2 a = f.points[i], b = f.points[i + 1];
-      detail::for_pixels_near_segment(a.x, a.y, b.x, b.y, r, w, h,
-                                      [&](int x, int y) { mask[size_t(y) * w + x] = 1; });
+      detail::for_pixels_near_segment(a.x + shift, a.y + shift, b.x + shift, b.y + shift, r, mw, mh,
+                                      [&](int x, int y) { mask[size_t(y) * mw + x] = 1; });
     }
   }
   return mask;
 }
 
-// The points to triangulate: pixel centres not `dropped` (step 1), or one point per step x step
-// block (2 or 4) with no `fine` pixel, at its centre, and the pixel centres of the other blocks;
-// then the border: corners and one vertex per pixel along each side.
+// The points to triangulate: pixel centres not `dropped` (step 1); or a quadtree of step x step
+// blocks (2, 4 or 8), where a block with no `fine` pixel and whose centre (a pixel corner) is not
+// `dropped_corner` is one point at its centre, and any other block is its four quarters, down to
+// the pixel centres. Then the border: corners and one vertex per pixel along each side.
+// `block_at` gets the size of the block centred at each pixel corner ((w + 1) x (h + 1); 0: none).
 std::vector<Point> grid_points(int w, int h, int step, const std::vector<uint8_t>& dropped,
-                               const std::vector<uint8_t>& fine) {
+                               const std::vector<uint8_t>& fine, const std::vector<uint8_t>& dropped_corner,
+                               std::vector<uint8_t>& block_at) {
   std::vector<Point> points;
-  points.reserve(size_t(w) * h + 2 * size_t(w + h) + 4);
+  points.reserve(step == 1 ? size_t(w) * h + 2 * size_t(w + h) + 4 : size_t(w) * h / 8);
   if (step == 1) {
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
         if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
   } else {
-    for (int by = 0; by < h; by += step) {
-      for (int bx = 0; bx < w; bx += step) {
-        bool coarse = bx + step <= w && by + step <= h;
-        for (int y = by; coarse && y < by + step; ++y)
-          for (int x = bx; coarse && x < bx + step; ++x) coarse = !fine[size_t(y) * w + x];
-        if (coarse) {
-          points.emplace_back(bx + 0.5 * step, by + 0.5 * step);
-          continue;
-        }
-        for (int y = by; y < std::min(h, by + step); ++y)
-          for (int x = bx; x < std::min(w, bx + step); ++x)
-            if (!dropped[size_t(y) * w + x]) points.emplace_back(x + 0.5, y + 0.5);
+    block_at.assign(size_t(w + 1) * (h + 1), 0);
+    const auto block = [&](auto&& self, int bx, int by, int s) -> void {
+      if (bx >= w || by >= h) return;
+      if (s == 1) {
+        if (!dropped[size_t(by) * w + bx]) points.emplace_back(bx + 0.5, by + 0.5);
+        return;
       }
-    }
+      const int half = s / 2;
+      bool coarse = bx + s <= w && by + s <= h && !dropped_corner[size_t(by + half) * (w + 1) + bx + half];
+      for (int y = by; coarse && y < by + s; ++y)
+        for (int x = bx; coarse && x < bx + s; ++x) coarse = !fine[size_t(y) * w + x];
+      if (coarse) {
+        points.emplace_back(bx + half, by + half);
+        block_at[size_t(by + half) * (w + 1) + bx + half] = static_cast<uint8_t>(s);
+        return;
+      }
+      self(self, bx, by, half), self(self, bx + half, by, half);
+      self(self, bx, by + half, half), self(self, bx + half, by + half, half);
+    };
+    for (int by = 0; by < h; by += step)
+      for (int bx = 0; bx < w; bx += step) block(block, bx, by, step);
   }
   points.emplace_back(0, 0), points.emplace_back(w, 0), points.emplace_back(w, h), points.emplace_back(0, h);
   for (int x = 0; x < w; ++x) points.emplace_back(x + 0.5, 0), points.emplace_back(x + 0.5, h);
@@ -183,8 +198,24 @@ void add_features(const CdtPlus& cdt, const std::vector<CdtPlus::Constraint_id>&
   }
 }
 
-// Each color value sampled at its vertex, or on its side of the tears.
-void sample_colors(const Image8& image, int num_colors, double side_offset, ControlMesh& mesh) {
+// The mean color of the s x s pixels from (x0, y0).
+std::array<double, 3> block_mean(const Image8& image, int x0, int y0, int s) {
+  std::array<double, 3> sum{};
+  const int c = image.channels;
+  for (int y = y0; y < y0 + s; ++y) {
+    const uint8_t* row = image.row(y);
+    for (int x = x0; x < x0 + s; ++x)
+      for (int k = 0; k < 3; ++k) sum[k] += row[c * x + k];
+  }
+  for (double& v : sum) v /= double(s) * s;
+  return sum;
+}
+
+// Each color value sampled at its vertex (bilinearly), or on its side of the tears; a block
+// centre of the coarse grid (block_at, from grid_points()) takes its block's mean, so that the
+// quadrics see every pixel.
+void sample_colors(const Image8& image, int num_colors, double side_offset, const std::vector<uint8_t>& block_at,
+                   ControlMesh& mesh) {
   std::vector<Vec2> toward(num_colors, Vec2{0, 0});
   std::vector<int32_t> owner(num_colors, -1);
   std::vector<int> sectors(mesh.num_vertices(), 0);
@@ -219,7 +250,10 @@ void sample_colors(const Image8& image, int num_colors, double side_offset, Cont
       const double len = std::hypot(toward[ci].x, toward[ci].y);
       if (len > 0) p.x += side_offset * toward[ci].x / len, p.y += side_offset * toward[ci].y / len;
     }
-    const auto rgb = sample_bilinear(image, p.x, p.y);
+    const int s = block_at.empty() || sectors[v] > 1 || p.x != std::floor(p.x) || p.y != std::floor(p.y)
+                      ? 0
+                      : block_at[size_t(p.y) * (image.width + 1) + size_t(p.x)];
+    const auto rgb = s > 0 ? block_mean(image, int(p.x) - s / 2, int(p.y) - s / 2, s) : sample_bilinear(image, p.x, p.y);
     mesh.colors[ci] = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
   }
 }
@@ -230,25 +264,29 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
                                const InitialMeshOptions& options) {
   const int w = image.width, h = image.height;
   if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
-  if (options.grid_step < 0 || options.grid_step > 4 || options.grid_step == 3) {
-    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1, 2 or 4");
+  if (options.grid_step < 0 || options.grid_step > 8 || (options.grid_step & (options.grid_step - 1))) {
+    throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1, 2, 4 or 8");
   }
   const int step = std::max(1, options.grid_step);
-  // Grid points closer than min_grid_distance to a feature would make slivers: drop them. Pixels
-  // near a feature keep the fine grid when the grid is coarse elsewhere.
+  // Grid points closer than min_grid_distance to a feature would make slivers: drop them, and
+  // split the blocks whose centre they would be. Blocks with a pixel within fine_band of a feature
+  // are split too.
   const double r = options.min_grid_distance;
   const std::vector<uint8_t> dropped = near_features(features, w, h, r);
-  const std::vector<uint8_t> fine =
-      step >= 2 ? near_features(features, w, h, std::max(options.fine_band, r)) : std::vector<uint8_t>{};
-
-  const std::vector<Point> points = grid_points(w, h, step, dropped, fine);
+  std::vector<uint8_t> fine, dropped_corner;
+  if (step >= 2) {
+    fine = options.fine_band > r ? near_features(features, w, h, options.fine_band) : dropped;
+    dropped_corner = near_features(features, w, h, r, true);
+  }
+  std::vector<uint8_t> block_at;
+  const std::vector<Point> points = grid_points(w, h, step, dropped, fine, dropped_corner, block_at);
   CdtPlus cdt;
   cdt.insert(points.begin(), points.end());
   const std::vector<CdtPlus::Constraint_id> ids = insert_features(cdt, features, w, h);
   ControlMesh mesh = mesh_of(cdt);
   const int num_colors = number_colors(cdt, ids, mesh);
   add_features(cdt, ids, w, h, mesh);
-  sample_colors(image, num_colors, options.side_offset, mesh);
+  sample_colors(image, num_colors, options.side_offset, block_at, mesh);
   return mesh;
 }
 

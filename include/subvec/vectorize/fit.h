@@ -26,9 +26,10 @@ struct ColorFitOptions {
   double fill_radius = 3.0;   // how far hole filling looks for same-side pixels
   double regularization = 1e-6;  // relative Tikhonov weight toward the current colors
   // Reweighted refits toward the least-absolute-deviations fit (pixel target only; 0: plain least
-  // squares, the default: each costs about a third of the fit, docs/vectorize.md). Each weighs a
-  // pixel by 1 / max(its mean absolute residual, l1_floor).
-  int l1_iterations = 0;
+  // squares). Each weighs a pixel by 1 / max(its mean absolute residual, l1_floor) and costs a
+  // second assembly and factorization; the default one lowers the MAE of every shared photograph
+  // (docs/vectorize.md, "Large images").
+  int l1_iterations = 1;
   double l1_floor = 1.0;  // 0-255 scale
   // Damped Gauss-Newton steps that move the smooth control vertices (not those of features, creases,
   // the border or corners) to lower the squared pixel error, each kept only when the refit colors

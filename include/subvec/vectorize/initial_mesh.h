@@ -16,13 +16,13 @@ namespace subvec {
 struct InitialMeshOptions {
   double min_grid_distance = 0.5;  // grid vertices closer than this to a feature are dropped, px
   double side_offset = 0.75;       // tear-side colors are sampled this far into each side, px
-  // 1: a vertex at every pixel centre. 2 (or 4): away from the features, one vertex per 2 x 2
-  // (4 x 4) block at its centre (for 2 a pixel corner, whose bilinear color is the block's mean);
-  // blocks with a pixel within `fine_band` of a feature keep their pixel centres. 0: automatic in
-  // vectorize() (4 for images of 2^21 pixels or more when the target is at most 1/64 of the
-  // pixels, else 2 from 2^18 pixels (512 x 512) when it is at most 1/16, else 1); here, 1.
+  // 1: a vertex at every pixel centre. 2, 4 or 8: away from the features, a quadtree of blocks
+  // from step x step pixels down: a block is one vertex at its centre (a pixel corner; for 2 x 2 its
+  // bilinear color is the block's mean) unless it has a pixel within `fine_band` of a feature or
+  // its centre is within min_grid_distance of one; then it is its four quarters, down to the pixel
+  // centres. 0: automatic in vectorize() (automatic_grid_step(), vectorize.h); here, 1.
   int grid_step = 0;
-  double fine_band = 3.0;
+  double fine_band = 0.5;
 };
 
 // Returns a valid single-level mesh (validate_level holds) over the image domain.

@@ -103,9 +103,9 @@ struct VectorizeReport {
   std::vector<int32_t> segment_feature_ids;
 };
 
-// The grid the dense mesh starts from when options.initial_mesh.grid_step is 0 (automatic): 4
-// pixels for images of 2^21 pixels or more at targets of at most 1/64 of the pixels, else 2 from
-// 2^18 pixels at targets of at most 1/16, else 1 (docs/vectorize.md, "Large images").
+// The grid the dense mesh starts from when options.initial_mesh.grid_step is 0 (automatic): 8
+// pixels for images of 2^21 pixels or more at targets of at most 1/64 of the pixels, else 4 from
+// 2^17 pixels at targets of at most 1/16, else 1 (docs/vectorize.md, "Large images").
 int automatic_grid_step(int64_t pixels, int target_vertices);
 
 // The peak memory of vectorizing a width x height image with `options`, in bytes: an upper bound

@@ -2,10 +2,12 @@
 // shared photographs (../shared/images, skipped with a message when absent).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <string>
 #include <vector>
 #include <utility>
@@ -99,19 +101,32 @@ TEST(InitialMesh, ColorValuesAreTheTopologysOnAPhotograph) {
   EXPECT_EQ(num_colors, mesh.num_colors());
 }
 
+// Distance from p to the polyline.
+double polyline_distance(const Vec2& p, const std::vector<Vec2>& line) {
+  double best = 1e30;
+  for (size_t i = 0; i + 1 < line.size(); ++i) {
+    const Vec2 a = line[i], b = line[i + 1];
+    const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+    const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0;
+    best = std::min(best, std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy));
+  }
+  return best;
+}
+
 TEST(InitialMesh, CoarseGridKeepsPixelCentresNearFeaturesOnly) {
   const Image8 img = disk_image(96, 96, 47.7, 48.2, 25.3);
   const auto features = detect_features(img);
   InitialMeshOptions fine, coarse;
   fine.grid_step = 1;
   coarse.grid_step = 2;
+  coarse.fine_band = 3;
   const ControlMesh a = build_initial_mesh(img, features, fine);
   const ControlMesh b = build_initial_mesh(img, features, coarse);
   validate_level(b, 96, 96);
   ASSERT_EQ(b.features.size(), 1u);
   EXPECT_EQ(b.features[0].vertices.size(), a.features[0].vertices.size());
   // Interior vertices: pixel centres (x.5, y.5) within the band of the circle, block centres
-  // (whole coordinates) at least 2.5 px away from it, and far fewer of them than with step 1.
+  // (whole coordinates) at least 2.2 px away from it, and far fewer of them than with step 1.
   int centres = 0, corners = 0;
   for (const Vec2& p : b.positions) {
     if (p.x <= 0 || p.y <= 0 || p.x >= 96 || p.y >= 96) continue;
@@ -144,29 +159,73 @@ TEST(InitialMesh, CoarseGridKeepsPixelCentresNearFeaturesOnly) {
     }
   }
   EXPECT_GT(checked, 0);
-  // Step 4: valid, the same feature chain, and fewer vertices again.
-  InitialMeshOptions coarser;
-  coarser.grid_step = 4;
-  const ControlMesh c = build_initial_mesh(img, features, coarser);
-  validate_level(c, 96, 96);
-  ASSERT_EQ(c.features.size(), 1u);
-  EXPECT_EQ(c.features[0].vertices.size(), a.features[0].vertices.size());
-  EXPECT_LT(c.num_vertices(), b.num_vertices() * 8 / 10);
-  InitialMeshOptions bad;
-  bad.grid_step = 3;
-  EXPECT_THROW(build_initial_mesh(img, features, bad), Error);
-}
-
-// Distance from p to the polyline.
-double polyline_distance(const Vec2& p, const std::vector<Vec2>& line) {
-  double best = 1e30;
-  for (size_t i = 0; i + 1 < line.size(); ++i) {
-    const Vec2 a = line[i], b = line[i + 1];
-    const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-    const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0;
-    best = std::min(best, std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy));
+  // Steps 4 and 8 with the default band: a quadtree whose blocks shrink toward the circle. Every
+  // interior vertex off the circle is a pixel centre or the centre of an aligned block of 2, 4 or
+  // 8 pixels that stays clear of the circle (no pixel centre in it within the band, the centre
+  // itself at least min_grid_distance from the detected polyline), and each coarser step has fewer vertices.
+  int previous = b.num_vertices();
+  for (const int step : {4, 8}) {
+    SCOPED_TRACE(step);
+    InitialMeshOptions coarser;
+    coarser.grid_step = step;
+    const ControlMesh c = build_initial_mesh(img, features, coarser);
+    validate_level(c, 96, 96);
+    ASSERT_EQ(features.size(), 1u);
+    ASSERT_EQ(c.features.size(), 1u);
+    EXPECT_EQ(c.features[0].vertices.size(), a.features[0].vertices.size());
+    EXPECT_LT(c.num_vertices(), previous * 8 / 10);
+    previous = c.num_vertices();
+    std::set<int32_t> on_feature(c.features[0].vertices.begin(), c.features[0].vertices.end());
+    std::array<int, 4> sizes{};  // block centres of 2, 4, 8 px; pixel centres
+    for (int32_t v = 0; v < c.num_vertices(); ++v) {
+      const Vec2 p = c.positions[v];
+      if (on_feature.count(v) || p.x <= 0 || p.y <= 0 || p.x >= 96 || p.y >= 96) continue;
+      const auto distance = [&](double x, double y) { return polyline_distance({x, y}, features[0].points); };
+      if (p.x - std::floor(p.x) == 0.5 && p.y - std::floor(p.y) == 0.5) {
+        EXPECT_GE(distance(p.x, p.y), coarser.min_grid_distance - 1e-9);
+        ++sizes[3];
+        continue;
+      }
+      // The largest aligned block this centre can be of.
+      int s = 0;
+      for (int t = step; t >= 2 && !s; t /= 2)
+        if (std::fmod(p.x - t / 2, t) == 0 && std::fmod(p.y - t / 2, t) == 0) s = t;
+      ASSERT_GT(s, 0) << p.x << ", " << p.y;
+      ++sizes[s == 2 ? 0 : s == 4 ? 1 : 2];
+      EXPECT_GE(distance(p.x, p.y), coarser.min_grid_distance) << p.x << ", " << p.y;
+      for (double y = p.y - s / 2 + 0.5; y < p.y + s / 2; ++y)
+        for (double x = p.x - s / 2 + 0.5; x < p.x + s / 2; ++x)
+          ASSERT_GE(distance(x, y), coarser.fine_band) << p.x << ", " << p.y << " (block of " << s << ")";
+    }
+    EXPECT_GT(sizes[0], 0);
+    EXPECT_GT(sizes[1], 0);
+    if (step == 8) {
+      EXPECT_GT(sizes[2], 0);
+    }
   }
-  return best;
+  // A feature along the pixel edges x = 30 passes no pixel centre closer than 0.5 px, but through
+  // the centre of every 4 x 4 block of columns 28..31: those blocks are split, and no grid point
+  // lands on the feature.
+  DetectedFeature edge;
+  for (int y = 6; y <= 90; ++y) edge.points.push_back({30.0, y + 0.5});
+  edge.length = 84;
+  InitialMeshOptions on_edges;
+  on_edges.grid_step = 4;
+  const ControlMesh e = build_initial_mesh(img, {edge}, on_edges);
+  validate_level(e, 96, 96);
+  ASSERT_EQ(e.features.size(), 1u);
+  std::set<int32_t> edge_vertices(e.features[0].vertices.begin(), e.features[0].vertices.end());
+  EXPECT_EQ(edge_vertices.size(), edge.points.size());
+  for (int32_t v = 0; v < e.num_vertices(); ++v) {
+    if (edge_vertices.count(v)) continue;
+    EXPECT_GE(polyline_distance(e.positions[v], edge.points), on_edges.min_grid_distance)
+        << e.positions[v].x << ", " << e.positions[v].y;
+  }
+  for (const int bad_step : {3, 6, 16, -1}) {
+    InitialMeshOptions bad;
+    bad.grid_step = bad_step;
+    EXPECT_THROW(build_initial_mesh(img, features, bad), Error) << bad_step;
+  }
 }
 
 // The limit feature curves of a mesh as refined polylines (depth 4), one list of segments each.
@@ -501,9 +560,11 @@ TEST(Vectorize, CoarseGridMatchesThePixelGridOnAnUpscaledPhotograph) {
   options.initial_mesh.grid_step = 2;
   const double coarse = check_vectorization(img, options, "upscale, step 2");
   EXPECT_LT(coarse, fine * 1.03) << "step 1: " << fine << ", step 2: " << coarse;
-  options.initial_mesh.grid_step = 4;
-  const double coarser = check_vectorization(img, options, "upscale, step 4");
-  EXPECT_LT(coarser, fine * 1.03) << "step 1: " << fine << ", step 4: " << coarser;
+  for (const int step : {4, 8}) {
+    options.initial_mesh.grid_step = step;
+    const double coarser = check_vectorization(img, options, ("upscale, step " + std::to_string(step)).c_str());
+    EXPECT_LT(coarser, fine * 1.03) << "step 1: " << fine << ", step " << step << ": " << coarser;
+  }
 }
 
 // A bilinear upscale by an integer factor (pixel centres mapped onto pixel centres).
