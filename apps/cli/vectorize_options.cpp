@@ -107,7 +107,7 @@ void add_quality_options(CLI::App* command, VectorizeParams& params) {
       ->add_option("--grid-step", o.initial_mesh.grid_step,
                    "Dense mesh away from features: 1 a vertex per pixel, 2, 4 or 8 a quadtree of blocks "
                    "from 2x2, 4x4 or 8x8 pixels down to pixels at the features, 0 automatic (default: "
-                   "4 from 2^17 pixels at ratios up to 1/16; 8 from 2^21 pixels at ratios up to 1/64)")
+                   "from 2^17 pixels, 4 at ratios up to 1/64 (8 from 2^21 pixels), 2 up to 1/16)")
       ->check(integer());
 
   // The feature detector (FeatureOptions, features.h) and the simplifier's feature bound.

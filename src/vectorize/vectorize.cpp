@@ -69,9 +69,9 @@ void validate(const VectorizeOptions& o) {
 
 int automatic_grid_step(int64_t pixels, int target_vertices) {
   const double p = double(pixels);
-  return p >= double(1 << 21) && 64.0 * target_vertices <= p   ? 8
-         : p >= double(1 << 17) && 16.0 * target_vertices <= p ? 4
-                                                                : 1;
+  if (p < double(1 << 17) || 16.0 * target_vertices > p) return 1;
+  if (64.0 * target_vertices > p) return 2;
+  return p >= double(1 << 21) ? 8 : 4;
 }
 
 int64_t estimate_vectorize_bytes(int width, int height, const VectorizeOptions& options) {
@@ -163,9 +163,9 @@ VectorImage vectorize(const Image8& image, const VectorizeOptions& options, Vect
   }
   lap("features");
   begin("mesh");
-  // Images from 2^17 pixels up start from a quadtree of 4-pixel blocks away from the features, and
-  // from 2 MP up (at targets of at most 1/64 of the pixels) of 8-pixel ones (docs/vectorize.md,
-  // "Large images"): about the same error in half the time; the fit still sees every pixel.
+  // Images from 2^17 pixels up start from a quadtree of 4-pixel blocks away from the features (2 at
+  // targets over 1/64 of the pixels), and from 2 MP up of 8-pixel ones (docs/vectorize.md, "Large
+  // images"): about the same error in half the time; the fit still sees every pixel.
   InitialMeshOptions mesh_options = options.initial_mesh;
   if (mesh_options.grid_step == 0) mesh_options.grid_step = automatic_grid_step(int64_t(pixels), target);
   ControlMesh mesh = build_initial_mesh(image, features, mesh_options);

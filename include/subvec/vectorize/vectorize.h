@@ -103,9 +103,10 @@ struct VectorizeReport {
   std::vector<int32_t> segment_feature_ids;
 };
 
-// The grid the dense mesh starts from when options.initial_mesh.grid_step is 0 (automatic): 8
-// pixels for images of 2^21 pixels or more at targets of at most 1/64 of the pixels, else 4 from
-// 2^17 pixels at targets of at most 1/16, else 1 (docs/vectorize.md, "Large images").
+// The grid the dense mesh starts from when options.initial_mesh.grid_step is 0 (automatic), for
+// images of 2^17 pixels or more: at targets of at most 1/64 of the pixels 4 (8 from 2^21 pixels),
+// at targets of at most 1/16 of them 2; else, and for smaller images, 1 (docs/vectorize.md,
+// "Large images").
 int automatic_grid_step(int64_t pixels, int target_vertices);
 
 // The peak memory of vectorizing a width x height image with `options`, in bytes: an upper bound
