@@ -208,15 +208,20 @@ Rows lower_normal(const Rows& m, const SparseMatrix& s, const Rows& st, int thre
   });
 }
 
-// Solves (lower triangle, as lower_normal gives it) x = rhs.
+// Solves (lower triangle, as lower_normal gives it) x = rhs, analysing the pattern only when it is
+// not the one `solver` last analysed.
 template <class Rhs>
-Rhs solve_lower(const Rows& lower, const Rhs& rhs, const char* what) {
+Rhs solve_lower(const Rows& lower, const Rhs& rhs, NormalSolver& solver, const char* what) {
   const int c = lower.num_rows();
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>> normal(
       c, c, static_cast<int32_t>(lower.columns.size()), lower.offsets.data(), lower.columns.data(), lower.values.data());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>, Eigen::Lower> solver(normal);
-  if (solver.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, std::string(what) + ": normal equations are singular");
-  return Rhs(solver.solve(rhs));
+  if (solver.offsets != lower.offsets || solver.columns != lower.columns) {
+    solver.ldlt.analyzePattern(normal);
+    solver.offsets = lower.offsets, solver.columns = lower.columns;
+  }
+  solver.ldlt.factorize(normal);
+  if (solver.ldlt.info() != Eigen::Success) throw Error(ErrorCode::kInvalidMesh, std::string(what) + ": normal equations are singular");
+  return Rhs(solver.ldlt.solve(rhs));
 }
 
 // The tear segments of the limit mesh, for the band and for same-side tests.
@@ -459,7 +464,7 @@ Eigen::MatrixX3d solve_colors(const FitSystem& system, const std::vector<Color>&
     rhs(i, 1) += lambda * start[i].g;
     rhs(i, 2) += lambda * start[i].b;
   }
-  return Eigen::MatrixX3d(solve_lower(lower, rhs, "color fit"));
+  return Eigen::MatrixX3d(solve_lower(lower, rhs, system.solver, "color fit"));
 }
 
 double squared_error(const FitSystem& system, const Eigen::MatrixX3d& values) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
 
 #include "subvec/core/image.h"
 #include "subvec/mesh/topology.h"
@@ -51,6 +52,14 @@ inline double predict(const Location& loc, const Tri& v, const Eigen::MatrixX3d&
 }
 
 // The fit's state over one subdivision of the mesh.
+// The factorization of the normal equations, kept between the solves of one system: a reweighted
+// solve has the same sparsity, so the fill-reducing ordering and the symbolic analysis are done
+// once (the numbers, and so the solution, are those of a fresh factorization).
+struct NormalSolver {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int32_t>, Eigen::Lower> ldlt;
+  std::vector<int32_t> offsets, columns;  // the analysed pattern
+};
+
 struct FitSystem {
   FitSystem(const ControlMesh& mesh, const MeshTopology& topology, int width, int height, int depth);
 
@@ -66,6 +75,7 @@ struct FitSystem {
   std::vector<std::array<double, 6>> blocks;  // B'WB per refined triangle, packed 00 01 02 11 12 22
   std::vector<double> diagonal;                // B'WB as a diagonal (refined-vertex target)
   std::vector<std::array<double, 3>> btt;      // B'Wt per refined value
+  mutable NormalSolver solver;                 // solve_colors()' factorization
 };
 
 // Stage 1: the fitted points. Pixel target: every located pixel centre, the band along the tears
