@@ -51,7 +51,6 @@ inline double predict(const Location& loc, const Tri& v, const Eigen::MatrixX3d&
   return (1.0 - loc.b1 - loc.b2) * values(v[0], k) + loc.b1 * values(v[1], k) + loc.b2 * values(v[2], k);
 }
 
-// The fit's state over one subdivision of the mesh.
 // The factorization of the normal equations, kept between the solves of one system: a reweighted
 // solve has the same sparsity, so the fill-reducing ordering and the symbolic analysis are done
 // once (the numbers, and so the solution, are those of a fresh factorization).
@@ -60,6 +59,7 @@ struct NormalSolver {
   std::vector<int32_t> offsets, columns;  // the analysed pattern
 };
 
+// The fit's state over one subdivision of the mesh.
 struct FitSystem {
   FitSystem(const ControlMesh& mesh, const MeshTopology& topology, int width, int height, int depth);
 

@@ -264,7 +264,7 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
                                const InitialMeshOptions& options) {
   const int w = image.width, h = image.height;
   if (w < 1 || h < 1) throw Error(ErrorCode::kInvalidArgument, "empty image");
-  if (options.grid_step < 0 || options.grid_step > 8 || (options.grid_step & (options.grid_step - 1))) {
+  if (!valid_grid_step(options.grid_step)) {
     throw Error(ErrorCode::kInvalidArgument, "initial mesh: grid step must be 0 (automatic), 1, 2, 4 or 8");
   }
   const int step = std::max(1, options.grid_step);
@@ -273,11 +273,12 @@ ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFe
   // are split too.
   const double r = options.min_grid_distance;
   const std::vector<uint8_t> dropped = near_features(features, w, h, r);
-  std::vector<uint8_t> fine, dropped_corner;
+  std::vector<uint8_t> wider_band, dropped_corner;
   if (step >= 2) {
-    fine = options.fine_band > r ? near_features(features, w, h, options.fine_band) : dropped;
+    if (options.fine_band > r) wider_band = near_features(features, w, h, options.fine_band);
     dropped_corner = near_features(features, w, h, r, true);
   }
+  const std::vector<uint8_t>& fine = wider_band.empty() ? dropped : wider_band;
   std::vector<uint8_t> block_at;
   const std::vector<Point> points = grid_points(w, h, step, dropped, fine, dropped_corner, block_at);
   CdtPlus cdt;

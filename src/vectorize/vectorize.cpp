@@ -53,8 +53,8 @@ void validate(const VectorizeOptions& o) {
     detail::out_of_range("vertices", "0 (use ratio) or in [4, " + std::to_string(1 << 26) + "]", o.vertices);
   }
   validate(o.features, "features.");
-  if (const int step = o.initial_mesh.grid_step; step < 0 || step > 8 || (step & (step - 1))) {
-    detail::out_of_range("initial_mesh.grid_step", "0 (automatic), 1, 2, 4 or 8", step);
+  if (!valid_grid_step(o.initial_mesh.grid_step)) {
+    detail::out_of_range("initial_mesh.grid_step", "0 (automatic), 1, 2, 4 or 8", o.initial_mesh.grid_step);
   }
   check_in("max_feature_error", o.max_feature_error, 0.05, 100);
   validate(o.refine, "refine.");

@@ -25,6 +25,9 @@ struct InitialMeshOptions {
   double fine_band = 0.5;
 };
 
+// Whether `step` is a grid step InitialMeshOptions accepts: 0 (automatic), 1, 2, 4 or 8.
+constexpr bool valid_grid_step(int step) { return step >= 0 && step <= 8 && (step & (step - 1)) == 0; }
+
 // Returns a valid single-level mesh (validate_level holds) over the image domain.
 ControlMesh build_initial_mesh(const Image8& image, const std::vector<DetectedFeature>& features,
                                const InitialMeshOptions& options = {});
