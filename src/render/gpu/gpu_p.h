@@ -41,6 +41,25 @@ std::string gpu_probe(bool* no_display = nullptr);
 // The GL_RENDERER string of the context gpu_probe() created ("" when none could be).
 std::string gpu_probe_renderer();
 
+// Where the GPU time of the last frame went, in milliseconds, for profiling (bench/gpu_bench.cpp's
+// GpuPasses, scripts/gpu-check's report). The passes are timed by GL timestamp queries, summed over
+// the frame's tiles; `read_back` and `frame` are wall-clock times on the calling thread.
+struct GpuPassTimes {
+  double stencils = 0;   // the stencil products of the edits since the previous frame (compute)
+  double centres = 0;    // the refined triangles drawn at the pixel centres
+  double samples = 0;    // ... and at the 4x4 subsamples (frames with tears to anti-alias)
+  double mark = 0;       // marking the pixels that tears cross (compute)
+  double resolve = 0;    // resolving the samples into packed bytes (compute)
+  double read_back = 0;  // copying the packed bytes into the output rows, after the GPU finished
+  double frame = 0;      // the whole draw call
+  int tiles = 0;
+};
+
+// Profiling is off by default: the queries make every frame wait for the GPU at its end. Turned on
+// for the process; the times are those of the last frame any rasterizer drew while it was on.
+void set_gpu_profiling(bool on);
+GpuPassTimes gpu_pass_times();
+
 // One EGL context with its programs and buffers. Not thread-safe; each call makes the context
 // current on the calling thread.
 class GpuRasterizer {

@@ -12,10 +12,14 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <initializer_list>
+#include <limits>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -350,6 +354,57 @@ GLuint link(std::initializer_list<GLuint> shaders, const char* name) {
 
 GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
+// ---- Profiling (gpu_p.h: GpuPassTimes) ----------------------------------------------------------
+
+std::atomic<bool> profiling{false};
+std::mutex last_pass_times_mutex;
+GpuPassTimes last_pass_times;
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// GL_TIME_ELAPSED queries around the passes of a frame (one at a time: they do not nest), summed
+// per pass by add_to(), which waits for the results. A pass cannot take longer on the GPU than the
+// wall time since it was issued; a result over that is the driver's error (llvmpipe leaves the
+// start of a frame's first query unset), and that pass's time is NaN.
+class PassClock {
+ public:
+  void start() {
+    used_ = 0;
+    passes_.clear();
+    started_ = std::chrono::steady_clock::now();
+  }
+  void begin(double GpuPassTimes::*pass) {
+    if (used_ == queries_.size()) {
+      queries_.push_back(0);
+      glGenQueries(1, &queries_.back());
+    }
+    passes_.push_back(pass);
+    glBeginQuery(GL_TIME_ELAPSED, queries_[used_++]);
+  }
+  void end() { glEndQuery(GL_TIME_ELAPSED); }
+  void add_to(GpuPassTimes& times) {
+    std::vector<GLuint64> ns(used_);
+    for (size_t i = 0; i < used_; ++i) glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &ns[i]);
+    const double bound = milliseconds_since(started_);
+    for (size_t i = 0; i < used_; ++i) {
+      const double ms = double(ns[i]) * 1e-6;
+      times.*passes_[i] += ms <= bound ? ms : std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  void release() {
+    glDeleteQueries(GLsizei(queries_.size()), queries_.data());
+    queries_.clear();
+  }
+
+ private:
+  std::vector<GLuint> queries_;
+  size_t used_ = 0;
+  std::vector<double GpuPassTimes::*> passes_;
+  std::chrono::steady_clock::time_point started_;
+};
+
 // Rows of one stencil matrix on the GPU, applied in dispatches whose index / weight ranges fit
 // one shader storage binding.
 struct StencilBuffers {
@@ -376,6 +431,7 @@ class GlRasterizer final : public GpuRasterizer {
         glDeleteFramebuffers(1, &t->framebuffer);
       }
       glDeleteVertexArrays(1, &vao_);
+      clock_.release();
       for (GLuint p : {stencil2_, stencil3_, draw_, resolve_, mark_}) glDeleteProgram(p);
       eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     }
@@ -496,6 +552,8 @@ class GlRasterizer final : public GpuRasterizer {
       out = Image8(width, height, channels);
     }
     Current current(*this);
+    const bool profile = profiling.load(std::memory_order_relaxed);
+    const auto start = std::chrono::steady_clock::now();
     // Pixels to supersample: those crossed by tears, and by the border when the window leaves the
     // image (RGBA), as on the CPU.
     const int mark_edges = antialias ? num_tear_edges_ + (channels == 4 ? num_border_edges_ : 0) : 0;
@@ -521,16 +579,26 @@ class GlRasterizer final : public GpuRasterizer {
     glEnable(GL_CULL_FACE);  // the CPU draws no back-facing (folded) triangle either
     glCullFace(GL_BACK);
     glFrontFace(GL_CCW);
+    if (profile) clock_.start();
     for (int ty = 0; ty < height; ty += tile_h) {
       for (int tx = 0; tx < width; tx += tile_w) {
         const int w = std::min(tile_w, width - tx), h = std::min(tile_h, height - ty);
+        if (profile) clock_.begin(&GpuPassTimes::centres);
         draw_triangles(centres_, view, tx, ty, w, h, 1);
+        if (profile) clock_.end();
         if (supersample) {
+          if (profile) clock_.begin(&GpuPassTimes::samples);
           draw_triangles(samples_, view, tx, ty, w, h, 4);
+          if (profile) {
+            clock_.end();
+            clock_.begin(&GpuPassTimes::mark);
+          }
           mark(view, tx, ty, w, h, mark_edges);
+          if (profile) clock_.end();
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         // Resolve.
+        if (profile) clock_.begin(&GpuPassTimes::resolve);
         const int pixels = w * h;
         glUseProgram(resolve_);
         glActiveTexture(GL_TEXTURE0);
@@ -547,6 +615,12 @@ class GlRasterizer final : public GpuRasterizer {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, marks_);
         glDispatchCompute(GLuint((pixels + 255) / 256), 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        std::chrono::steady_clock::time_point read_start;
+        if (profile) {
+          clock_.end();
+          glFinish();
+          read_start = std::chrono::steady_clock::now();
+        }
         // Read back: straight into the output when the tile spans whole rows.
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, resolved_);
         const size_t tile_row = size_t(w) * channels;
@@ -562,8 +636,19 @@ class GlRasterizer final : public GpuRasterizer {
           }
         }
         check_gl("drawing a frame");
+        if (profile) {
+          pending_.read_back += milliseconds_since(read_start);
+          ++pending_.tiles;
+        }
       }
     }
+    if (profile) {
+      clock_.add_to(pending_);
+      pending_.frame = milliseconds_since(start);
+      const std::lock_guard<std::mutex> lock(last_pass_times_mutex);
+      last_pass_times = pending_;
+    }
+    pending_ = GpuPassTimes{};
   }
 
   void read_positions(std::vector<float>& out) override {
@@ -660,6 +745,11 @@ class GlRasterizer final : public GpuRasterizer {
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, control);
     glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(std::max<size_t>(values.size(), 1) * 8),
                  values.data(), GL_DYNAMIC_DRAW);
+    const bool profile = profiling.load(std::memory_order_relaxed);
+    if (profile) {
+      clock_.start();
+      clock_.begin(&GpuPassTimes::stencils);
+    }
     glUseProgram(program);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b.offsets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, control);
@@ -675,6 +765,10 @@ class GlRasterizer final : public GpuRasterizer {
       glDispatchCompute(GLuint((c.end_row - c.first_row + 63) / 64), 1, 1);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (profile) {
+      clock_.end();
+      clock_.add_to(pending_);
+    }
     check_gl("evaluating the stencils");
   }
 
@@ -785,6 +879,8 @@ class GlRasterizer final : public GpuRasterizer {
   int num_vertices_ = 0, num_colors_ = 0;
   std::vector<uint8_t> staging_;
   std::string renderer_;
+  PassClock clock_;        // profiling only
+  GpuPassTimes pending_;   // the times of the frame being drawn (and of the edits before it)
 
  public:
   std::string renderer() const override { return renderer_; }
@@ -831,5 +927,12 @@ std::string gpu_probe(bool* no_display) {
 }
 
 std::string gpu_probe_renderer() { return probe().second; }
+
+void set_gpu_profiling(bool on) { profiling.store(on, std::memory_order_relaxed); }
+
+GpuPassTimes gpu_pass_times() {
+  const std::lock_guard<std::mutex> lock(last_pass_times_mutex);
+  return last_pass_times;
+}
 
 }  // namespace subvec::detail

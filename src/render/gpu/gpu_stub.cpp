@@ -16,4 +16,7 @@ std::string gpu_probe(bool* no_display) {
 
 std::string gpu_probe_renderer() { return {}; }
 
+void set_gpu_profiling(bool) {}
+GpuPassTimes gpu_pass_times() { return {}; }
+
 }  // namespace subvec::detail
