@@ -14,6 +14,7 @@
 #include "render/gpu/gpu_p.h"
 #include "subvec/io/image_io.h"
 #include "subvec/render/renderer.h"
+#include "support/paths.h"
 
 namespace subvec {
 namespace {
@@ -37,7 +38,7 @@ class GpuCli : public ::testing::Test {
   // Runs `[env] subvec <args>` (arguments without quotes needed) and keeps stderr.
   CliRun run_subvec(const std::string& env, const std::string& args) {
     const fs::path err = dir_ / ".stderr";
-    const std::string command = env + " '" + std::string(SUBVEC_CLI) + "' " + args + " 2>'" +
+    const std::string command = env + " '" + test::cli_path() + "' " + args + " 2>'" +
                                 err.string() + "'";
     const int raw = std::system(command.c_str());
     CliRun r;
@@ -48,7 +49,7 @@ class GpuCli : public ::testing::Test {
   }
 
   std::string example() const {
-    return (fs::path(SUBVEC_SOURCE_DIR) / "examples" / "03-junction.svec.json").string();
+    return (test::source_dir() / "examples" / "03-junction.svec.json").string();
   }
 
   fs::path dir_;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -18,6 +19,9 @@
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
 #include "subvec/vectorize/vectorize.h"
+#include "support/frame_difference.h"
+#include "support/paths.h"
+#include "support/shared_photos.h"
 #include "support/synthetic.h"
 
 namespace subvec {
@@ -34,25 +38,12 @@ namespace fs = std::filesystem;
     ASSERT_TRUE(why.empty()) << "an EGL display exists but GPU rendering fails: " << why; \
   } while (0)
 
-struct Difference {
-  double mae = 0;  // mean absolute difference over every channel value (alpha included)
-  int max = 0;     // largest channel difference
-};
-
-Difference difference(const Image8& a, const Image8& b) {
+// The sizes must agree; frame_difference() makes frames that don't as far apart as can be.
+test::FrameDifference difference(const Image8& a, const Image8& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
   EXPECT_EQ(a.channels, b.channels);
-  Difference d;
-  if (a.pixels.size() != b.pixels.size() || a.pixels.empty()) return {255, 255};
-  int64_t sum = 0;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const int e = std::abs(int(a.pixels[i]) - int(b.pixels[i]));
-    sum += e;
-    d.max = std::max(d.max, e);
-  }
-  d.mae = double(sum) / double(a.pixels.size());
-  return d;
+  return test::frame_difference(a, b);
 }
 
 // Renders `options` on both backends and checks the acceptance bounds.
@@ -63,7 +54,7 @@ void expect_match(const VectorImage& image, RenderOptions options, const std::st
   Renderer renderer(image);
   const Image8 gpu = renderer.render(options);
   EXPECT_EQ(renderer.last_backend(), Backend::kGpu) << what;
-  const Difference d = difference(cpu, gpu);
+  const test::FrameDifference d = difference(cpu, gpu);
   EXPECT_LE(d.mae, 0.5) << what;
   EXPECT_LE(d.max, 8) << what;
   std::printf("  %-44s %4dx%-4d %dch  MAE %.4f  max %d\n", what.c_str(), cpu.width, cpu.height,
@@ -90,7 +81,26 @@ void expect_match_in_views(const VectorImage& image, const std::string& name) {
   expect_match(image, o, name + " 2x, no anti-aliasing");
 }
 
-fs::path source_dir() { return fs::path(SUBVEC_SOURCE_DIR); }
+using test::source_dir;
+
+// Names the OpenGL context the tests run on, once, before them (a bundle run on another machine,
+// scripts/gpu-check, reports it).
+class ContextReport : public ::testing::Environment {
+ public:
+  void SetUp() override {
+    bool no_display = false;
+    const std::string why = detail::gpu_probe(&no_display);
+    if (why.empty()) {
+      const GpuRendererInfo gl = gpu_renderer();
+      std::printf("OpenGL renderer: %s (%s)\n", gl.name.c_str(),
+                  gl.software ? "software" : "hardware");
+    } else {
+      std::printf("OpenGL: no context (%s)\n", why.c_str());
+    }
+  }
+};
+const ::testing::Environment* const context_report =
+    ::testing::AddGlobalTestEnvironment(new ContextReport);
 
 TEST(GpuRender, MatchesTheCpuOnTheExamples) {
   REQUIRE_GPU();
@@ -125,7 +135,7 @@ TEST(GpuRender, MatchesTheCpuOnTheVectorizedButterfly) {
 
 TEST(GpuRender, MatchesTheCpuOnASharedPhotographVectorizedHere) {
   REQUIRE_GPU();
-  const fs::path path = source_dir() / ".." / "shared" / "images" / "rocket.png";
+  const fs::path path = test::shared_photos() / "rocket.png";
   if (!fs::exists(path)) GTEST_SKIP() << "no " << path << ": shared photographs not present";
   // A 160 x 128 crop around the rocket keeps the vectorization to about a second.
   const Image8 photo = read_image(path);
@@ -170,7 +180,7 @@ TEST(GpuRender, EditsMatchTheCpu) {
   cpu.set_colors(0, colors);
   gpu.set_colors(0, colors);
   a = cpu.render(c), b = gpu.render(o);
-  Difference d = difference(a, b);
+  test::FrameDifference d = difference(a, b);
   EXPECT_LE(d.mae, 0.5);
   EXPECT_LE(d.max, 8);
 
@@ -217,6 +227,48 @@ TEST(GpuRasterizer, LimitValuesMatchTheCpuStencils) {
     worst_color = std::max(worst_color, std::abs(colors[i] - cpu.colors[i]));
   EXPECT_LT(worst_position, 1e-3f);
   EXPECT_LT(worst_color, 1e-3f);
+}
+
+// Profiling (GL timer queries around each pass, detail::set_gpu_profiling) changes no pixel, times
+// every pass of the last frame within its wall time (or gives NaN, a time the driver got wrong),
+// counts the tiles, and stops with the switch.
+TEST(GpuRasterizer, ProfiledFramesAreTheSameFramesAndAreTimed) {
+  REQUIRE_GPU();
+  const VectorImage image = read_svec(source_dir() / "examples" / "02-open-tear.svec.json");
+  RenderOptions o;
+  o.backend = Backend::kGpu;
+  o.window = Window{0, 0, 128, 6};
+  o.width = 4500;  // two column tiles
+  Renderer renderer(image);
+  const Image8 plain = renderer.render(o);
+  std::vector<Color> colors = image.levels[0].colors;
+  for (Color& c : colors) c = {c.b, c.r, c.g};
+  renderer.set_colors(0, colors);
+  const Image8 edited = renderer.render(o);
+  renderer.set_colors(0, image.levels[0].colors);
+
+  detail::set_gpu_profiling(true);
+  EXPECT_EQ(renderer.render(o).pixels, plain.pixels);
+  renderer.set_colors(0, colors);
+  const Image8 profiled = renderer.render(o);
+  const detail::GpuPassTimes t = detail::gpu_pass_times();
+  detail::set_gpu_profiling(false);
+  EXPECT_EQ(profiled.pixels, edited.pixels);
+  EXPECT_EQ(renderer.last_backend(), Backend::kGpu);
+  EXPECT_EQ(t.tiles, 2);
+  EXPECT_GT(t.frame, 0.0);
+  EXPECT_GE(t.read_back, 0.0);
+  EXPECT_LE(t.read_back, t.frame);
+  EXPECT_TRUE(std::isnan(t.stencils) || t.stencils >= 0.0);  // before the draw, outside `frame`
+  for (double pass : {t.centres, t.samples, t.mark, t.resolve}) {
+    if (!std::isnan(pass)) {
+      EXPECT_GE(pass, 0.0);
+      EXPECT_LE(pass, t.frame);
+    }
+  }
+  // Off again: a frame leaves the last profiled frame's times as they were.
+  renderer.render(o);
+  EXPECT_EQ(detail::gpu_pass_times().frame, t.frame);
 }
 
 TEST(GpuRender, BadOptionsFailAsOnTheCpu) {

@@ -11,11 +11,11 @@
 #include <optional>
 #include <string>
 
+#include "support/paths.h"
+
 namespace subvec::test {
 
-inline std::filesystem::path shared_photos() {
-  return std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
-}
+inline std::filesystem::path shared_photos() { return source_dir() / ".." / "shared" / "images"; }
 
 // Why a test on the shared photographs (`path`: the folder or a file in it) cannot run here, or
 // nothing when it can. A test starts with
