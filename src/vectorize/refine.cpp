@@ -2,7 +2,8 @@
 //
 // Both work on one measure, the squared error of a triangle's linear color interpolation over the
 // pixel centres inside it (a centre on an edge counts in both triangles; every comparison counts
-// it the same way before and after, so the total over all faces falls with every accepted step).
+// it the same way before and after, so the total over all faces falls with every accepted step),
+// summed from the moments of the triangle's pixels (pixel_moments_p.h).
 //
 // A flip pass evaluates every candidate edge against the pass's starting mesh (in parallel: the
 // evaluations only read), then applies the flips in order of gain, skipping any whose triangles an
@@ -23,6 +24,7 @@
 #include "core/messages_p.h"
 #include "core/parallel_p.h"
 #include "mesh/collapse_p.h"
+#include "vectorize/pixel_moments_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 
@@ -31,61 +33,23 @@ namespace {
 
 using detail::signed_area;
 
-// Calls fn(x, y, w0, w1, w2) for every pixel centre (x + 0.5, y + 0.5) of the image inside the
-// triangle (p0, p1, p2) of either orientation, with its barycentric weights. Returns false, and
-// visits nothing, when the triangle's area is at most `min_area`. Each row visits only the span
-// the three weights allow (one pixel of slack each side), stepping the weights along the row.
-template <class Fn>
-bool for_each_pixel(Vec2 p0, Vec2 p1, Vec2 p2, const Image8& image, double min_area, const Fn& fn) {
-  const double area = signed_area(p0, p1, p2);
-  if (!(std::abs(area) > min_area)) return false;
-  const double inv = 1 / area;
-  const int x0 = std::max(0, static_cast<int>(std::ceil(std::min({p0.x, p1.x, p2.x}) - 0.5)));
-  const int x1 = std::min(image.width - 1, static_cast<int>(std::floor(std::max({p0.x, p1.x, p2.x}) - 0.5)));
-  const int y0 = std::max(0, static_cast<int>(std::ceil(std::min({p0.y, p1.y, p2.y}) - 0.5)));
-  const int y1 = std::min(image.height - 1, static_cast<int>(std::floor(std::max({p0.y, p1.y, p2.y}) - 0.5)));
-  // d w / d x along a row.
-  const double d0 = 0.5 * (p1.y - p2.y) * inv, d1 = 0.5 * (p2.y - p0.y) * inv, d2 = -d0 - d1;
-  for (int y = y0; y <= y1; ++y) {
-    const Vec2 start{x0 + 0.5, y + 0.5};
-    const double s0 = signed_area(start, p1, p2) * inv, s1 = signed_area(p0, start, p2) * inv, s2 = 1 - s0 - s1;
-    // w_i(x) = s_i + (x - x0) d_i >= 0 for all three.
-    double lo = x0, hi = x1;
-    bool empty = false;
-    for (const auto& [s, d] : {std::pair{s0, d0}, std::pair{s1, d1}, std::pair{s2, d2}}) {
-      if (d > 0) lo = std::max(lo, x0 - s / d - 1);
-      else if (d < 0) hi = std::min(hi, x0 - s / d + 1);
-      else if (s < 0) empty = true;
-    }
-    if (empty || lo > hi) continue;
-    const int xa = std::max(x0, static_cast<int>(std::ceil(lo))), xb = std::min(x1, static_cast<int>(std::floor(hi)));
-    double w0 = s0 + (xa - x0) * d0, w1 = s1 + (xa - x0) * d1;
-    for (int x = xa; x <= xb; ++x, w0 += d0, w1 += d1) {
-      const double w2 = 1 - w0 - w1;
-      if (w0 >= 0 && w1 >= 0 && w2 >= 0) fn(x, y, w0, w1, w2);
-    }
-  }
-  return true;
-}
-
-const uint8_t* pixel_at(const Image8& image, int x, int y) { return image.row(y) + x * image.channels; }
-
-// The interpolation error of one triangle with corner colors c0, c1, c2; a negative value when it
-// is thinner than `min_area`.
+// The interpolation error of one triangle with corner colors c0, c1, c2 over the pixel centres
+// inside it (pixel_moments_p.h); a negative value when it is thinner than `min_area`.
 double triangle_error(const Image8& image, Vec2 p0, Vec2 p1, Vec2 p2, Color c0, Color c1, Color c2,
                       double min_area) {
-  double sum = 0;
-  // The interpolated color is linear: c0 + (c1 - c0) w1 + (c2 - c0) w2.
-  const double r1 = c1.r - c0.r, g1 = c1.g - c0.g, b1 = c1.b - c0.b;
-  const double r2 = c2.r - c0.r, g2 = c2.g - c0.g, b2 = c2.b - c0.b;
-  const bool thick = for_each_pixel(p0, p1, p2, image, min_area, [&](int x, int y, double, double w1, double w2) {
-    const uint8_t* px = pixel_at(image, x, y);
-    const double er = c0.r + w1 * r1 + w2 * r2 - px[0];
-    const double eg = c0.g + w1 * g1 + w2 * g2 - px[1];
-    const double eb = c0.b + w1 * b1 + w2 * b2 - px[2];
-    sum += er * er + eg * eg + eb * eb;
-  });
-  return thick ? sum : -1;
+  detail::PixelMoments m;
+  if (!detail::pixel_moments(image, p0, p1, p2, p0, min_area, m)) return -1;
+  if (m.n == 0) return 0;
+  // The interpolated color is affine: c0 + (c1 - c0) w1 + (c2 - c0) w2; the error is
+  // Σ f² - 2 Σ f t + Σ t² per channel, and no less than zero whatever the rounding.
+  const auto w = detail::barycentric(p0, p1, p2, p0);
+  const std::array<double, 3> k0{c0.r, c0.g, c0.b}, k1{c1.r, c1.g, c1.b}, k2{c2.r, c2.g, c2.b};
+  double sum = m.tt;
+  for (int ch = 0; ch < 3; ++ch) {
+    const detail::Affine f = detail::Affine{k0[ch], 0, 0} + w[1] * (k1[ch] - k0[ch]) + w[2] * (k2[ch] - k0[ch]);
+    sum += m.sum(f, f) - 2 * m.sum_t(f, ch);
+  }
+  return std::max(0.0, sum);
 }
 
 // 4 sqrt(3) area / (sum of squared edge lengths): 1 for an equilateral triangle, 0 for a flat one.
@@ -360,35 +324,30 @@ bool move_vertex(ControlMesh& mesh, const MeshTopology& topo, const Image8& imag
   Eigen::VectorXd jtr = Eigen::VectorXd::Zero(n);
   for (const Wedge& w : ring) {
     const Vec2 p1 = w.p1, p2 = w.p2;
+    // Every term below is affine in the pixel centre s (about x) or the pixel's color times one,
+    // so the wedge's sums come from its pixels' moments.
+    detail::PixelMoments m;
+    detail::pixel_moments(image, x, p1, p2, x, 0, m);
+    if (m.n == 0) continue;
     const double inv = 1 / signed_area(x, p1, p2);
     const double ax = 0.5 * (p1.y - p2.y), ay = 0.5 * (p2.x - p1.x);
+    const auto [w0, w1, w2] = detail::barycentric(x, p1, p2, x);
+    // The gradients of a1 = area(x, s, p2) and a2 = area(x, p1, s) in x.
+    const detail::Affine g1x{0.5 * (x.y - p2.y), 0, 0.5}, g1y{0.5 * (p2.x - x.x), -0.5, 0};
+    const detail::Affine g2x{0.5 * (p1.y - x.y), 0, -0.5}, g2y{0.5 * (x.x - p1.x), 0.5, 0};
     const double cv[3] = {color[w.side].r, color[w.side].g, color[w.side].b};
     const double c1[3] = {w.c1.r, w.c1.g, w.c1.b}, c2[3] = {w.c2.r, w.c2.g, w.c2.b};
     const int col = 2 + 3 * w.side;
-    // The wedge's sums, then added to the system (w0 is the same in the three channels).
-    double xx = 0, xy = 0, yy = 0, ww = 0, rx = 0, ry = 0;
-    double xw[3] = {0, 0, 0}, yw[3] = {0, 0, 0}, rw[3] = {0, 0, 0};
-    for_each_pixel(x, p1, p2, image, 0, [&](int px, int py, double w0, double w1, double w2) {
-      const double sx = px + 0.5, sy = py + 0.5;
-      const double g1x = 0.5 * (sy - p2.y), g1y = 0.5 * (p2.x - sx);
-      const double g2x = 0.5 * (p1.y - sy), g2y = 0.5 * (sx - p1.x);
-      const uint8_t* target = pixel_at(image, px, py);
-      ww += w0 * w0;
-      for (int ch = 0; ch < 3; ++ch) {
-        const double f = w0 * cv[ch] + w1 * c1[ch] + w2 * c2[ch];
-        const double r = f - target[ch];
-        const double jx = (c1[ch] * g1x + c2[ch] * g2x - f * ax) * inv;
-        const double jy = (c1[ch] * g1y + c2[ch] * g2y - f * ay) * inv;
-        // Jacobian row (jx, jy, and w0 in this side's and channel's color column).
-        xx += jx * jx, xy += jx * jy, yy += jy * jy;
-        xw[ch] += jx * w0, yw[ch] += jy * w0;
-        rx += jx * r, ry += jy * r, rw[ch] += w0 * r;
-      }
-    });
-    jtj(0, 0) += xx, jtj(0, 1) += xy, jtj(1, 1) += yy, jtr(0) += rx, jtr(1) += ry;
+    const double ww = m.sum(w0, w0);
     for (int ch = 0; ch < 3; ++ch) {
-      jtj(0, col + ch) += xw[ch], jtj(1, col + ch) += yw[ch], jtj(col + ch, col + ch) += ww;
-      jtr(col + ch) += rw[ch];
+      // Jacobian row (jx, jy, and w0 in this side's and channel's color column); residual f - t.
+      const detail::Affine f = w0 * cv[ch] + w1 * c1[ch] + w2 * c2[ch];
+      const detail::Affine jx = (g1x * c1[ch] + g2x * c2[ch] - f * ax) * inv;
+      const detail::Affine jy = (g1y * c1[ch] + g2y * c2[ch] - f * ay) * inv;
+      jtj(0, 0) += m.sum(jx, jx), jtj(0, 1) += m.sum(jx, jy), jtj(1, 1) += m.sum(jy, jy);
+      jtr(0) += m.sum(jx, f) - m.sum_t(jx, ch), jtr(1) += m.sum(jy, f) - m.sum_t(jy, ch);
+      jtj(0, col + ch) += m.sum(jx, w0), jtj(1, col + ch) += m.sum(jy, w0), jtj(col + ch, col + ch) += ww;
+      jtr(col + ch) += m.sum(w0, f) - m.sum_t(w0, ch);
     }
   }
   if (!(before > 0)) return false;
