@@ -39,8 +39,19 @@ Strips make_strips(const RefinedMesh& mesh);
 struct TearBand {
   std::array<Vec2, 4> corners;  // the edge's ends, then their offsets into the side
   std::array<double, 3> color{0, 0, 0};
+  EdgeVerts edge{-1, -1};  // the refined tear edge, as listed in mesh.tear_edges
+  int side = 0;
 };
 std::vector<TearBand> tear_bands(const RefinedMesh& mesh, double width);
+
+// The bands as drawn: runs of consecutive bands on one side of a tear whose colors are within
+// `color_tolerance` levels of the run's first become one polygon (the tear's points, then the
+// offsets back, where two bands meet the mean of their corners) in the run's mean color.
+struct TearHint {
+  std::vector<Vec2> polygon;
+  std::array<double, 3> color{0, 0, 0};
+};
+std::vector<TearHint> tear_hints(const RefinedMesh& mesh, double width, double color_tolerance);
 
 // Numbers for text formats: fixed notation, at most `decimals` decimals, no trailing zeros.
 std::string fixed(double v, int decimals);

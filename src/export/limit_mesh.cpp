@@ -1,17 +1,21 @@
-// The depth rule of the vector exports. Drawing the limit surface as flat-sided triangles (PDF's
-// Gouraud shading interpolates colors linearly too) errs by the distance between the surface and
-// its chords; refining one level more divides that by about four where the surface is smooth, but
-// only by two at its singular points (tear corners, junctions, extraordinary vertices), so the rule
-// asks the tolerances of all but 1% of the refined edges rather than of every one. It measures the
-// error instead of estimating it: for depth k it evaluates the exact limit (LimitEvaluator:
-// OpenSubdiv's Loop patches) at the parametric midpoints of the refined edges of every control face
-// and compares with the mean of the edge's ends, which are the refined vertices' limit values.
+// The mesh the vector exports draw. Drawing the limit surface as flat-sided triangles errs by the
+// distance between the surface and its chords and, in color, by what linear (PDF's Gouraud
+// shading) or constant (SVG) color misses of the surface's. Both are measured, not estimated: the
+// exact limit (LimitEvaluator: OpenSubdiv's Loop patches) at the parametric midpoints of a face's
+// refined edges against what the triangles draw there. Each control face gets the smallest depth
+// that meets the tolerances, so flat regions take a few triangles and steep ramps and tear corners
+// many, and the faces are stitched where their depths differ (adaptive_limit_mesh).
 #include "export/limit_mesh_p.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <unordered_map>
+
+#include "core/parallel_p.h"
+#include "render/renderer_p.h"
+#include "subvec/render/renderer.h"
 
 #include "core/messages_p.h"
 #include "subvec/core/error.h"
@@ -24,9 +28,139 @@ using detail::invalid;
 using detail::num;
 
 constexpr int64_t kMaxTriangles = int64_t{1} << 24;
-// The tolerance may be exceeded at this fraction of the refined edges: at the few singular points
-// of the limit surface (corners of tears, junctions) the error only halves per level.
-constexpr double kAllowedOver = 0.01;
+
+// A face's limit values on the grid of parameters (i / n, j / n), i + j <= n.
+struct Value {
+  double x, y, c[3];
+};
+struct FaceGrid {
+  int n = 0;
+  std::vector<Value> values;
+  Value& at(int i, int j) { return values[size_t(j) * (n + 1) + i]; }
+  const Value& at(int i, int j) const { return values[size_t(j) * (n + 1) + i]; }
+};
+
+Value evaluate(const LimitEvaluator& evaluator, int face, double u, double v) {
+  const LimitEvaluator::Sample s = evaluator.evaluate(face, u, v);
+  return {s.position.x, s.position.y, {s.color[0], s.color[1], s.color[2]}};
+}
+
+// The grid at n = 2 * previous.n, reusing the previous grid's values (or all evaluated).
+FaceGrid finer_grid(const LimitEvaluator& evaluator, int face, const FaceGrid& previous) {
+  FaceGrid grid;
+  grid.n = previous.n ? 2 * previous.n : 1;
+  grid.values.resize(size_t(grid.n + 1) * (grid.n + 1));
+  for (int j = 0; j <= grid.n; ++j) {
+    for (int i = 0; i + j <= grid.n; ++i) {
+      grid.at(i, j) = previous.n && i % 2 == 0 && j % 2 == 0
+                          ? previous.at(i / 2, j / 2)
+                          : evaluate(evaluator, face, double(i) / grid.n, double(j) / grid.n);
+    }
+  }
+  return grid;
+}
+
+double midpoint_deviation(const Value& a, const Value& b, const Value& m) {
+  return std::hypot(m.x - 0.5 * (a.x + b.x), m.y - 0.5 * (a.y + b.y));
+}
+
+// The errors of a face drawn at depth d, from its limit values at 2^(d+1) (`fine`). A chord's
+// distance from the limit shows as such only where the surface has an edge in the image: on the
+// face's sides that are tears or the image border (bit k of `sharp_sides`: side k, from corner k).
+// Elsewhere the image shows colors, and a point of the surface drawn `delta` away from where it
+// belongs errs by the color's slope times delta, which is added to the color error.
+struct FaceError {
+  double position = 0, color = 0;
+  int64_t pieces = 0, over = 0;
+};
+FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int sharp_sides) {
+  const int n = fine.n / 2;
+  FaceError error;
+  auto at = [&](int i, int j) -> const Value& { return fine.at(i, j); };
+  // Is the edge (i0, j0)-(i1, j1) (grid units at depth d) on a sharp side of the face?
+  auto sharp = [&](int i0, int j0, int i1, int j1) {
+    return ((sharp_sides & 1) && j0 == 0 && j1 == 0) || ((sharp_sides & 2) && i0 + j0 == n && i1 + j1 == n) ||
+           ((sharp_sides & 4) && i0 == 0 && i1 == 0);
+  };
+  auto length = [](const Value& a, const Value& b) { return std::hypot(a.x - b.x, a.y - b.y); };
+  // The slope of each channel at the fine grid point (i, j), levels per pixel: the gradient of the
+  // linear color over the fine triangle from (i, j) to its next grid points.
+  auto slope = [&](int i, int j, double* out) {
+    const int s = i + j < fine.n ? 1 : -1;
+    const Value &p = at(i, j), &q = at(i + s, j), &r = at(i, j + s);
+    const double ax = q.x - p.x, ay = q.y - p.y, bx = r.x - p.x, by = r.y - p.y;
+    const double det = ax * by - ay * bx;
+    if (!(std::abs(det) > 1e-9 * (ax * ax + ay * ay + bx * bx + by * by))) {
+      out[0] = out[1] = out[2] = 0;
+      return;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const double dq = q.c[k] - p.c[k], dr = r.c[k] - p.c[k];
+      out[k] = std::hypot((dq * by - dr * ay) / det, (dr * ax - dq * bx) / det);
+    }
+  };
+  // The color error at the midpoint (fine grid point (i, j)) of an edge whose flat or linear color
+  // there is `drawn`, drawn `delta` away from where it belongs.
+  auto color_error = [&](int i, int j, const double* drawn, double delta) {
+    const Value& m = at(i, j);
+    double g[3] = {0, 0, 0}, e = 0;
+    if (delta > 0) slope(i, j, g);
+    for (int k = 0; k < 3; ++k) e = std::max(e, std::abs(m.c[k] - drawn[k]) + g[k] * delta);
+    return e;
+  };
+  auto record = [&](double position, double color, double longest) {
+    error.position = std::max(error.position, position);
+    error.color = std::max(error.color, color);
+    ++error.pieces;
+    error.over += (position > tolerance.position || color > tolerance.color) &&
+                  longest > tolerance.small;
+  };
+  if (tolerance.shading == Shading::kGouraud) {
+    auto edge = [&](int i0, int j0, int i1, int j1) {
+      const Value &a = at(2 * i0, 2 * j0), &b = at(2 * i1, 2 * j1), &m = at(i0 + i1, j0 + j1);
+      double mean[3];
+      for (int k = 0; k < 3; ++k) mean[k] = 0.5 * (a.c[k] + b.c[k]);
+      const double delta = midpoint_deviation(a, b, m);
+      record(sharp(i0, j0, i1, j1) ? delta : 0, color_error(i0 + i1, j0 + j1, mean, delta),
+             length(a, b));
+    };
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i + j < n; ++i) {
+        edge(i, j, i + 1, j);
+        edge(i, j, i, j + 1);
+        edge(i + 1, j, i, j + 1);
+      }
+    }
+    return error;
+  }
+  // Flat: a triangle (corners p, q, r in grid units at depth d) against its mean color at its
+  // corners and edge midpoints.
+  auto triangle = [&](std::array<int, 2> p, std::array<int, 2> q, std::array<int, 2> r) {
+    const std::array<std::array<int, 2>, 3> c = {p, q, r};
+    double mean[3] = {0, 0, 0};
+    for (const auto& k : c)
+      for (int ch = 0; ch < 3; ++ch) mean[ch] += at(2 * k[0], 2 * k[1]).c[ch] / 3;
+    double position = 0, color = 0, longest = 0;
+    for (int e = 0; e < 3; ++e) {
+      const auto &s = c[e], &t = c[(e + 1) % 3];
+      const Value &a = at(2 * s[0], 2 * s[1]), &b = at(2 * t[0], 2 * t[1]);
+      const Value& m = at(s[0] + t[0], s[1] + t[1]);
+      const double delta = midpoint_deviation(a, b, m);
+      if (sharp(s[0], s[1], t[0], t[1])) position = std::max(position, delta);
+      color = std::max({color, color_error(2 * s[0], 2 * s[1], mean, 0),
+                        color_error(s[0] + t[0], s[1] + t[1], mean, delta)});
+      longest = std::max(longest, length(a, b));
+    }
+    record(position, color, longest);
+  };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i + j < n; ++i) {
+      triangle({i, j}, {i + 1, j}, {i, j + 1});
+      if (i + j + 1 < n) triangle({i + 1, j}, {i + 1, j + 1}, {i, j + 1});
+    }
+  }
+  return error;
+}
 
 }  // namespace
 
@@ -71,7 +205,188 @@ LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mes
   return error;
 }
 
-int export_depth(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
+std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
+                                 const MeshTopology& topology, const FaceTolerance& tolerance,
+                                 int max_depth, LinearError* error) {
+  const int faces = mesh.num_triangles();
+  std::vector<uint8_t> depths(faces, 0);
+  std::vector<FaceError> errors(faces);
+  parallel_for(faces, 0, [&](int f) {
+    int sharp_sides = 0;
+    for (int k = 0; k < 3; ++k) {
+      const EdgeTag tag = topology.edge_tags[topology.face_edges[f][k]];
+      if (tag == EdgeTag::kTear || tag == EdgeTag::kBorder) sharp_sides |= 1 << k;
+    }
+    FaceGrid fine = finer_grid(evaluator, f, finer_grid(evaluator, f, {}));  // n = 2: depth 0
+    for (int depth = 0;; ++depth) {
+      errors[f] = face_error(fine, tolerance, sharp_sides);
+      if (errors[f].over == 0 || depth >= max_depth) {
+        depths[f] = static_cast<uint8_t>(depth);
+        break;
+      }
+      fine = finer_grid(evaluator, f, fine);
+    }
+  });
+  if (error) {
+    *error = {};
+    for (const FaceError& e : errors) {
+      error->max_position = std::max(error->max_position, e.position);
+      error->max_color = std::max(error->max_color, e.color);
+      error->edges += e.pieces;
+      error->over += e.over;
+    }
+  }
+  return depths;
+}
+
+RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& topology,
+                                const LimitEvaluator& evaluator, std::span<const uint8_t> depths) {
+  const int faces = mesh.num_triangles();
+  // An edge is sampled at the finer depth of its faces.
+  std::vector<uint8_t> edge_depth(topology.num_edges(), 0);
+  for (int f = 0; f < faces; ++f)
+    for (const int32_t e : topology.face_edges[f])
+      edge_depth[e] = std::max(edge_depth[e], depths[f]);
+
+  RefinedMesh out;
+  out.depth = faces ? *std::max_element(depths.begin(), depths.end()) : 0;
+  // Shared vertices: a control vertex's limit point, or a point on a control edge at the dyadic
+  // parameter t = k / 2^16 from its lower-numbered end (depth <= 16). Shared color values: a
+  // corner's color index, or such a point on one side of the edge (both sides but across tears).
+  std::vector<int32_t> corner_vertex(mesh.num_vertices(), -1), corner_color(mesh.num_colors(), -1);
+  std::unordered_map<uint64_t, int32_t> edge_vertex, edge_color;
+  auto new_vertex = [&](const Value& v) {
+    out.positions.push_back(static_cast<float>(v.x));
+    out.positions.push_back(static_cast<float>(v.y));
+    return out.num_vertices() - 1;
+  };
+  auto new_color = [&](const Value& v) {
+    for (int k = 0; k < 3; ++k) out.colors.push_back(static_cast<float>(v.c[k]));
+    return out.num_colors() - 1;
+  };
+  constexpr int kKeyBits = 16;
+  struct Point {
+    int32_t vertex, color;
+  };
+  // The point of face f at parameters (u, v) = (i, j) / 2^depth; `side` is the face's edge k that
+  // it lies on (-1 inside), `t` its parameter along that edge from corner k, as a multiple of 2^-16.
+  auto point = [&](int f, int depth, int i, int j) -> Point {
+    const Tri& v = mesh.triangles[f];
+    const Tri& c = mesh.triangle_colors[f];
+    const int n = 1 << depth;
+    const int corner = i == 0 && j == 0 ? 0 : i == n && j == 0 ? 1 : i == 0 && j == n ? 2 : -1;
+    if (corner >= 0) {
+      int32_t& vertex = corner_vertex[v[corner]];
+      int32_t& color = corner_color[c[corner]];
+      if (vertex < 0 || color < 0) {
+        const Value value = evaluate(evaluator, f, double(i) / n, double(j) / n);
+        if (vertex < 0) vertex = new_vertex(value);
+        if (color < 0) color = new_color(value);
+      }
+      return {vertex, color};
+    }
+    const int side = j == 0 ? 0 : i + j == n ? 1 : i == 0 ? 2 : -1;
+    if (side < 0) {
+      const Value value = evaluate(evaluator, f, double(i) / n, double(j) / n);
+      return {new_vertex(value), new_color(value)};
+    }
+    const int step = side == 0 ? i : side == 1 ? j : n - j;  // along the edge from corner `side`
+    const int32_t a = v[side], b = v[(side + 1) % 3];
+    const int32_t e = topology.face_edges[f][side];
+    const uint64_t t = uint64_t(a < b ? step : n - step) << (kKeyBits - depth);
+    const uint64_t key = (uint64_t(e) << (kKeyBits + 1)) | (t << 1);
+    const bool tear = topology.edge_tags[e] == EdgeTag::kTear;
+    const uint64_t color_key = key | uint64_t(tear && topology.edge_faces[e][0] != f);
+    const auto vertex = edge_vertex.find(key);
+    const auto color = edge_color.find(color_key);
+    if (vertex != edge_vertex.end() && color != edge_color.end()) return {vertex->second, color->second};
+    const Value value = evaluate(evaluator, f, double(i) / n, double(j) / n);
+    const int32_t p = vertex != edge_vertex.end() ? vertex->second : edge_vertex[key] = new_vertex(value);
+    const int32_t q = color != edge_color.end() ? color->second : edge_color[color_key] = new_color(value);
+    return {p, q};
+  };
+  auto triangle = [&](int f, const Point& a, const Point& b, const Point& c) {
+    out.triangles.push_back({a.vertex, b.vertex, c.vertex});
+    out.triangle_colors.push_back({a.color, b.color, c.color});
+    out.triangle_parent.push_back(f);
+  };
+
+  std::vector<Point> grid;
+  for (int f = 0; f < faces; ++f) {
+    const int d = depths[f], n = 1 << d;
+    // The face's grid points, each made once.
+    grid.assign(size_t(n + 1) * (n + 1), Point{-1, -1});
+    auto at = [&](int i, int j) -> const Point& {
+      Point& p = grid[size_t(j) * (n + 1) + i];
+      if (p.vertex < 0) p = point(f, d, i, j);
+      return p;
+    };
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i + j < n; ++i) {
+        if (i + j + 1 < n) triangle(f, at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+        // The upward triangle (i, j), (i + 1, j), (i, j + 1), with the extra points of the finer
+        // edges it lies on, in order around it, at the depth of that edge.
+        const std::array<std::array<int, 2>, 3> corners = {{{i, j}, {i + 1, j}, {i, j + 1}}};
+        std::vector<Point> polygon;
+        std::array<bool, 3> split = {false, false, false};
+        for (int s = 0; s < 3; ++s) {
+          const auto &p = corners[s], &q = corners[(s + 1) % 3];
+          polygon.push_back(at(p[0], p[1]));
+          // Which face edge the side (p, q) lies on, if any.
+          const int side = s == 0 && j == 0 ? 0 : s == 1 && i + j + 1 == n ? 1 : s == 2 && i == 0 ? 2 : -1;
+          if (side < 0) continue;
+          const int e = edge_depth[topology.face_edges[f][side]];
+          if (e <= d) continue;
+          split[s] = true;
+          const int m = 1 << (e - d);
+          for (int k = 1; k < m; ++k)
+            polygon.push_back(point(f, e, p[0] * m + k * (q[0] - p[0]), p[1] * m + k * (q[1] - p[1])));
+        }
+        const int splits = split[0] + split[1] + split[2];
+        if (splits == 0) {
+          triangle(f, polygon[0], polygon[1], polygon[2]);
+        } else if (splits == 1) {
+          // Fan from the corner opposite the split side: the corner after it, going round.
+          const int s = split[0] ? 0 : split[1] ? 1 : 2;
+          // Only side s has extra points, so corner s is polygon[s], and from it the polygon runs
+          // along the split side to the opposite corner, last.
+          std::rotate(polygon.begin(), polygon.begin() + s, polygon.end());
+          const Point apex = polygon.back();
+          for (size_t k = 0; k + 2 < polygon.size(); ++k) triangle(f, apex, polygon[k], polygon[k + 1]);
+        } else {
+          // Fan from the triangle's centre.
+          const Value value = evaluate(evaluator, f, (i + 1.0 / 3) / n, (j + 1.0 / 3) / n);
+          const Point centre{new_vertex(value), new_color(value)};
+          for (size_t k = 0; k < polygon.size(); ++k)
+            triangle(f, centre, polygon[k], polygon[(k + 1) % polygon.size()]);
+        }
+      }
+    }
+  }
+
+  // The refined edges along the control mesh's sharp edges.
+  for (int e = 0; e < topology.num_edges(); ++e) {
+    const EdgeTag tag = topology.edge_tags[e];
+    if (tag == EdgeTag::kSmooth) continue;
+    std::vector<EdgeVerts>& list = tag == EdgeTag::kTear     ? out.tear_edges
+                                   : tag == EdgeTag::kCrease ? out.crease_edges
+                                                             : out.border_edges;
+    const auto [a, b] = topology.edges[e];
+    const int m = 1 << edge_depth[e];
+    int32_t previous = corner_vertex[a];
+    for (int k = 1; k <= m; ++k) {
+      const int32_t next =
+          k == m ? corner_vertex[b]
+                 : edge_vertex.at((uint64_t(e) << (kKeyBits + 1)) |
+                                  (uint64_t(k) << (kKeyBits - edge_depth[e]) << 1));
+      list.push_back({previous, next});
+      previous = next;
+    }
+  }
+  return out;
+}
+
+double check_export_options(const VectorImage& image, const ExportOptions& options) {
   const int levels = static_cast<int>(image.levels.size());
   if (options.level < 0 || options.level >= levels) {
     invalid("level " + std::to_string(options.level) + " is out of range (the image has " +
@@ -100,42 +415,52 @@ int export_depth(const VectorImage& image, const ExportOptions& options, ExportR
   if (options.depth > 8) invalid("depth " + std::to_string(options.depth) + " is over 8");
   if (options.max_depth < 0 || options.max_depth > 8)
     invalid("max depth " + std::to_string(options.max_depth) + " is out of range (0 to 8)");
+  return scale;
+}
 
+RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
+                        ExportReport& report) {
+  const double scale = check_export_options(image, options);
   const ControlMesh& mesh = image.levels[options.level];
   const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
   const int64_t faces = mesh.num_triangles();
-  int depth = options.depth;
-  if (depth >= 0) {
-    if (faces << (2 * depth) > kMaxTriangles) {
-      throw Error(ErrorCode::kLimit, "depth " + std::to_string(depth) + " over " +
+  const LimitEvaluator evaluator(mesh, topology);
+  std::vector<uint8_t> depths;
+  if (options.depth >= 0) {
+    if (faces << (2 * options.depth) > kMaxTriangles) {
+      throw Error(ErrorCode::kLimit, "depth " + std::to_string(options.depth) + " over " +
                                          std::to_string(faces) +
                                          " faces would make more than 2^24 triangles");
     }
+    depths.assign(faces, static_cast<uint8_t>(options.depth));
   } else {
-    const LimitEvaluator evaluator(mesh, topology);
-    for (depth = 0;; ++depth) {
-      const LinearError e = linear_error(evaluator, mesh, depth, options.tolerance / scale,
-                                         options.color_tolerance);
-      report.max_position_error = e.max_position * scale;
-      report.max_color_error = e.max_color;
-      report.over_tolerance = e.edges ? double(e.over) / double(e.edges) : 0;
-      if (report.over_tolerance <= kAllowedOver || depth >= options.max_depth ||
-          (faces << (2 * (depth + 1))) > kMaxTriangles)
-        break;
+    FaceTolerance tolerance;
+    tolerance.shading = shading;
+    tolerance.position = options.tolerance / scale;
+    tolerance.color = shading == Shading::kFlat ? options.flat_color_tolerance
+                                                : options.color_tolerance;
+    tolerance.small = 1 / scale;
+    // No face goes deeper than `subvec render` refines the whole image at this scale (its depth
+    // rule, which also keeps the triangles under 2^24): the renderer is the reference.
+    double edge_sum = 0;
+    for (const Tri& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 &a = mesh.positions[t[k]], &b = mesh.positions[t[(k + 1) % 3]];
+        edge_sum += std::hypot(a.x - b.x, a.y - b.y) * scale;
+      }
     }
+    const int max_depth = std::min(
+        options.max_depth, choose_depth(faces ? edge_sum / double(3 * faces) : 0,
+                                        RenderOptions{}.max_edge_pixels, scale, faces));
+    LinearError error;
+    depths = face_depths(evaluator, mesh, topology, tolerance, max_depth, &error);
+    report.max_position_error = error.max_position * scale;
+    report.max_color_error = error.max_color;
+    report.over_tolerance = error.edges ? double(error.over) / double(error.edges) : 0;
   }
-  report.depth = depth;
-  return depth;
-}
-
-RefinedMesh export_limit_mesh(const VectorImage& image, int level, int depth,
-                              ExportReport& report) {
-  const ControlMesh& mesh = image.levels[level];
-  const MeshTopology topology = MeshTopology::build(mesh, image.width, image.height);
-  const Subdivision subdivision(mesh, topology, depth);
-  RefinedMesh refined;
-  subdivision.evaluate(mesh.positions, mesh.colors, refined);
-  report.depth = depth;
+  RefinedMesh refined = adaptive_limit_mesh(mesh, topology, evaluator, depths);
+  report.depth = refined.depth;
+  report.min_depth = depths.empty() ? 0 : *std::min_element(depths.begin(), depths.end());
   report.triangles = refined.num_triangles();
   return refined;
 }

@@ -99,17 +99,22 @@ std::string stream_object(std::string dict, const std::string& data) {
   return dict + " /Length " + std::to_string(data.size()) + " >>\nstream\n" + data + "\nendstream";
 }
 
+// Consecutive tear bands whose colors are this close (levels) are drawn as one (export_p.h).
+constexpr double kHintColorTolerance = 1.0;
+
 // The tear hints and strokes drawn over the shadings, in image pixels.
 std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const ExportOptions& options, double s) {
   std::string content;
   if (options.tear_hints) {
-    for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
-      for (const double c : band.color)
-        content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
+    // Coordinates to a hundredth of an output unit, colors to a quarter of a level.
+    const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 100) - 1e-9)), 1, 9);
+    for (const detail::TearHint& hint : detail::tear_hints(mesh, 1.0 / s, kHintColorTolerance)) {
+      for (const double c : hint.color)
+        content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 3) + " ";
       content += "rg";
-      for (int k = 0; k < 4; ++k) {
-        content += " " + detail::fixed(band.corners[k].x, 3) + " " +
-                   detail::fixed(band.corners[k].y, 3) + (k == 0 ? " m" : " l");
+      for (size_t k = 0; k < hint.polygon.size(); ++k) {
+        content += " " + detail::fixed(hint.polygon[k].x, decimals) + " " +
+                   detail::fixed(hint.polygon[k].y, decimals) + (k == 0 ? " m" : " l");
       }
       content += " h f\n";
     }
@@ -167,7 +172,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport local;
   ExportReport& r = report ? *report : local;
   const RefinedMesh mesh =
-      detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
+      detail::export_mesh(image, options, detail::Shading::kGouraud, r);
   const double w = image.width, h = image.height, s = export_scale(options, image.width);
 
   // The shading streams.
@@ -177,7 +182,13 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   // with /BM /Lighten (the maximum of (r,0,0), (0,g,0), (0,0,b) is (r,g,b)), in two layers (below).
   const bool channels = options.pdf_target == PdfTarget::kPoppler;
   const detail::Strips strips = detail::make_strips(mesh);
-  constexpr double kCoordinateMax = double((1 << 24) - 1);
+  // Coordinates in 16 bits where their step is within an eighth of the position tolerance (pages
+  // up to about 1000 units at the default), else 24; colors in 8 bits, which measured the same in
+  // every viewer as 16 (docs/export.md); the poppler target's channel parameters in 16, since
+  // Splash interpolates them per pixel.
+  const int cbits = std::max(w, h) * s / 65535 <= options.tolerance / 8 ? 16 : 24;
+  const int kbits = channels ? 16 : 8;
+  const double kCoordinateMax = double((1 << cbits) - 1);
   // Writes strips of the mesh as a shading's data; channel -1 writes all three components.
   auto stream = [&](const detail::Strips& part, int channel) {
     std::vector<uint8_t> data;
@@ -189,13 +200,13 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       const auto [t, k] = part.corners[i];
       const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
       put(part.flags[i], 1);
-      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), 3);
+      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), cbits / 8);
       put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
-          3);
+          cbits / 8);
       for (int ch = 0; ch < 3; ++ch) {
         if (channel >= 0 && ch != channel) continue;
         const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
-        put(uint64_t(std::lround(value * 65535.0)), 2);
+        put(uint64_t(std::lround(value * double((1 << kbits) - 1))), kbits / 8);
       }
     }
     return deflate(data);
@@ -209,8 +220,9 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   };
   const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
   auto shading = [&](const std::string& data, int channel, double offset) {
-    std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate 24"
-                       " /BitsPerComponent 16 /BitsPerFlag 8 " + decode;
+    std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate " + std::to_string(cbits) +
+                       " /BitsPerComponent " + std::to_string(kbits) + " /BitsPerFlag 8 " + decode;
+
     if (channel < 0) {
       dict += " 0 1 0 1 0 1]";
     } else {

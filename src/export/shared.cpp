@@ -58,13 +58,25 @@ Strips make_strips(const RefinedMesh& mesh) {
     }
     for (;;) {
       // Continue across (b, c) (flag 1) or (a, c) (flag 2). The shared edge keeps its direction
-      // in the previous triangle only up to orientation, so try both directions.
-      std::array<int32_t, 2> d = across(v[1], v[2]);
-      if (d[0] < 0) d = across(v[2], v[1]);
+      // in the previous triangle only up to orientation, so try both directions. Where both are
+      // open, take the triangle with fewer open neighbours, so as to leave none of them alone.
+      std::array<int32_t, 2> d1 = across(v[1], v[2]);
+      if (d1[0] < 0) d1 = across(v[2], v[1]);
+      std::array<int32_t, 2> d2 = across(v[0], v[2]);
+      if (d2[0] < 0) d2 = across(v[2], v[0]);
+      auto open_neighbours = [&](std::array<int32_t, 2> c) {
+        int n = 0;
+        for (int k = 0; k < 3; ++k) {
+          const std::array<int32_t, 2> p{c[0], k}, q{c[0], (k + 1) % 3};
+          const int32_t a = across(p, q)[0], b = across(q, p)[0];
+          n += (a >= 0 && a != c[0]) || (b >= 0 && b != c[0]);
+        }
+        return n;
+      };
       uint8_t flag = 1;
-      if (d[0] < 0) {
-        d = across(v[0], v[2]);
-        if (d[0] < 0) d = across(v[2], v[0]);
+      std::array<int32_t, 2> d = d1;
+      if (d1[0] < 0 || (d2[0] >= 0 && open_neighbours(d2) < open_neighbours(d1))) {
+        d = d2;
         flag = 2;
       }
       if (d[0] < 0) break;
@@ -159,6 +171,8 @@ std::vector<TearBand> tear_bands(const RefinedMesh& mesh, double width) {
       // mean of what the band covers where the color changes fast next to the tear.
       const double toward_third = height > 0 ? std::min(1.0, 0.5 * width / height) : 0.0;
       TearBand band;
+      band.edge = e;
+      band.side = side;
       for (int ch = 0; ch < 3; ++ch) {
         double edge = 0;
         for (int k = 0; k < 3; ++k)
@@ -176,6 +190,38 @@ std::vector<TearBand> tear_bands(const RefinedMesh& mesh, double width) {
     }
   }
   return bands;
+}
+
+std::vector<TearHint> tear_hints(const RefinedMesh& mesh, double width, double color_tolerance) {
+  const std::vector<TearBand> bands = tear_bands(mesh, width);
+  std::vector<TearHint> hints;
+  for (size_t begin = 0; begin < bands.size();) {
+    size_t end = begin + 1;
+    auto near = [&](const TearBand& b) {
+      for (int ch = 0; ch < 3; ++ch)
+        if (std::abs(b.color[ch] - bands[begin].color[ch]) > color_tolerance) return false;
+      return true;
+    };
+    while (end < bands.size() && bands[end].side == bands[begin].side &&
+           bands[end].edge[0] == bands[end - 1].edge[1] && near(bands[end]))
+      ++end;
+    TearHint hint;
+    auto mid = [](const Vec2& a, const Vec2& b) { return Vec2{0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; };
+    // Along the tear (corners 0 and 1), then back along the offsets (corners 2 and 3).
+    hint.polygon.push_back(bands[begin].corners[0]);
+    for (size_t k = begin; k + 1 < end; ++k)
+      hint.polygon.push_back(mid(bands[k].corners[1], bands[k + 1].corners[0]));
+    hint.polygon.push_back(bands[end - 1].corners[1]);
+    hint.polygon.push_back(bands[end - 1].corners[2]);
+    for (size_t k = end - 1; k > begin; --k)
+      hint.polygon.push_back(mid(bands[k].corners[3], bands[k - 1].corners[2]));
+    hint.polygon.push_back(bands[begin].corners[3]);
+    for (size_t k = begin; k < end; ++k)
+      for (int ch = 0; ch < 3; ++ch) hint.color[ch] += bands[k].color[ch] / double(end - begin);
+    hints.push_back(std::move(hint));
+    begin = end;
+  }
+  return hints;
 }
 
 std::string fixed(double v, int decimals) {

@@ -21,6 +21,9 @@
 namespace subvec {
 namespace {
 
+// Consecutive tear bands whose colors are this close (levels) are drawn as one (export_p.h).
+constexpr double kHintColorTolerance = 1.0;
+
 std::string hex_color(double r, double g, double b) {
   auto byte = [](double v) { return static_cast<int>(std::lround(std::clamp(v, 0.0, 255.0))); };
   char buf[8];
@@ -73,7 +76,7 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport local;
   ExportReport& r = report ? *report : local;
   const RefinedMesh mesh =
-      detail::export_limit_mesh(image, options.level, detail::export_depth(image, options, r), r);
+      detail::export_mesh(image, options, detail::Shading::kFlat, r);
   const double w = image.width, h = image.height, s = export_scale(options, image.width);
   // Coordinates in image pixels, to a tenth of an output pixel (crisp edges sample pixel centres).
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 10) - 1e-9)), 1, 9);
@@ -122,18 +125,18 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
     svg += "<path fill=\"" + color + "\" d=\"" + paths.at(color).text() + "\"/>\n";
   svg += "</g>\n";
   if (options.tear_hints) {
-    for (const detail::TearBand& band : detail::tear_bands(mesh, 1.0 / s)) {
+    for (const detail::TearHint& hint : detail::tear_hints(mesh, 1.0 / s, kHintColorTolerance)) {
       PathData d(decimals + 1);
       d.command('M');
-      d.number(band.corners[0].x);
-      d.number(band.corners[0].y);
+      d.number(hint.polygon[0].x);
+      d.number(hint.polygon[0].y);
       d.command('L');
-      for (int k = 1; k < 4; ++k) {
-        d.number(band.corners[k].x);
-        d.number(band.corners[k].y);
+      for (size_t k = 1; k < hint.polygon.size(); ++k) {
+        d.number(hint.polygon[k].x);
+        d.number(hint.polygon[k].y);
       }
       d.command('z');
-      svg += "<path fill=\"" + hex_color(band.color[0], band.color[1], band.color[2]) +
+      svg += "<path fill=\"" + hex_color(hint.color[0], hint.color[1], hint.color[2]) +
              "\" d=\"" + d.text() + "\"/>\n";
     }
   }

@@ -1,10 +1,11 @@
 // Vector exports of a vector image (docs/export.md): the limit surface (paper §3, as rendered in
-// §7.1) refined into small triangles until drawing them flat-sided is within a tolerance, then
+// §7.1) as triangles, each control face refined only as deep as its own error needs (never deeper
+// than `subvec render` refines at that scale) and stitched without cracks, then
 //  - PDF: one ShadingType 4 (free-form Gouraud-shaded triangle mesh) shading, thin bands along the
 //    tears that anti-alias them where a viewer does not anti-alias shadings, strokes as filled
 //    paths;
-//  - SVG: every triangle filled with its mean color and stroked in the same color, which hides the
-//    anti-aliasing seams viewers leave between adjacent shapes (librsvg, Chromium, Inkscape).
+//  - SVG: every triangle filled flat with its mean color, with crisp edges (no seams), and the same
+//    tear bands.
 // Outputs are deterministic: the same image and options give the same bytes.
 #pragma once
 
@@ -29,14 +30,19 @@ struct ExportOptions {
   int level = 0;       // level of detail
   double scale = 1;    // output units (PDF points, SVG pixels) per image pixel
   int width = 0;       // > 0: the page's width in output units instead of `scale`
-  // The triangles are refined until the piecewise-linear surface deviates from the limit surface
-  // by at most `tolerance` output units in position and `color_tolerance` levels (0-255 scale) in
-  // color, measured at the midpoints of the refined edges, at all but 1% of them (the error only
-  // halves per level at the surface's singular points: tear corners, junctions).
+  // Each control face is refined until its triangles deviate from the limit surface by at most
+  // `tolerance` output units in position where the surface has an edge (tears, the image border)
+  // and `color_tolerance` levels (0-255 scale) in color elsewhere, where a misplaced point shows as
+  // the color's slope times the distance; measured at the midpoints of the refined edges. Pieces
+  // under one output unit are left as they are (at the surface's singular points, tear corners and
+  // junctions, the error only halves per level).
   double tolerance = 0.25;
   double color_tolerance = 1.0;
+  // SVG (flat triangles, one color each): the largest difference, in levels, between a triangle's
+  // color and the limit surface's at its corners and edge midpoints.
+  double flat_color_tolerance = 3.0;
   int depth = -1;      // 0..8: this subdivision depth instead of the tolerance rule
-  int max_depth = 6;   // the tolerance rule stops here (and below 2^24 triangles)
+  int max_depth = 6;   // the tolerance rule stops here, or at the renderer's depth if lower
   // PDF: along both sides of every tear, a band one output unit wide in that side's color, so that
   // viewers that do not anti-alias shadings (poppler) still show anti-aliased tears.
   bool tear_hints = true;
@@ -44,7 +50,8 @@ struct ExportOptions {
 };
 
 struct ExportReport {
-  int depth = 0;
+  int depth = 0;      // the deepest control face's depth
+  int min_depth = 0;  // the shallowest's
   int64_t triangles = 0;
   // Measured at `depth` by the tolerance rule (zero with an explicit depth): the largest
   // deviations (output units, levels) and the fraction of refined edges over a tolerance.

@@ -22,7 +22,9 @@
 #include "subvec/export/export.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
+#include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/subdiv/subdivision.h"
 #include "subvec/render/renderer.h"
 #include "subvec/vectorize/vectorize.h"
 #include "support/shared_photos.h"
@@ -96,22 +98,148 @@ class ExportViewers : public ::testing::Test {
 
 TEST(Export, DepthFollowsTheToleranceAndTheScale) {
   const VectorImage image = example("01-disk");
-  ExportReport coarse, fine, zoomed;
-  ExportOptions options;
-  options.tolerance = 1;
-  options.color_tolerance = 8;
-  const int d1 = detail::export_depth(image, options, coarse);
-  options.tolerance = 0.05;
-  options.color_tolerance = 0.25;
-  const int d2 = detail::export_depth(image, options, fine);
-  EXPECT_LT(d1, d2);
-  EXPECT_LE(fine.over_tolerance, 0.01);
-  options = {};
-  const int d3 = detail::export_depth(image, options, coarse);
-  options.scale = 8;
-  EXPECT_GT(detail::export_depth(image, options, zoomed), d3);
-  options.depth = 2;
-  EXPECT_EQ(detail::export_depth(image, options, coarse), 2);
+  auto mesh_of = [&](ExportOptions options, ExportReport& report) {
+    return detail::export_mesh(image, options, detail::Shading::kGouraud, report);
+  };
+  ExportReport coarse, fine, zoomed, fixed;
+  (void)mesh_of({.tolerance = 1, .color_tolerance = 8}, coarse);
+  (void)mesh_of({.tolerance = 0.05, .color_tolerance = 0.25}, fine);
+  EXPECT_LT(coarse.triangles, fine.triangles);
+  EXPECT_LE(coarse.depth, fine.depth);
+  (void)mesh_of({.scale = 8}, zoomed);
+  EXPECT_GT(zoomed.depth, coarse.depth);
+  const RefinedMesh uniform = mesh_of({.depth = 2}, fixed);
+  EXPECT_EQ(fixed.depth, 2);
+  EXPECT_EQ(fixed.min_depth, 2);
+  EXPECT_EQ(fixed.triangles, int64_t{image.levels[0].num_triangles()} * 16);
+  EXPECT_EQ(uniform.num_triangles(), fixed.triangles);
+}
+
+// Faces are refined as deep as their own error needs: the flat inside of the disk less than the
+// faces along its tear, and never deeper than `subvec render` refines at that scale.
+TEST(Export, FacesAreRefinedOnlyAsDeepAsTheyNeed) {
+  const VectorImage image = synthetic();
+  const ControlMesh& mesh = image.levels[0];
+  const MeshTopology topology = MeshTopology::build(mesh, image.width, image.height);
+  const LimitEvaluator evaluator(mesh, topology);
+  detail::FaceTolerance tolerance;
+  detail::LinearError error;
+  const std::vector<uint8_t> depths = detail::face_depths(evaluator, mesh, topology, tolerance, 5, &error);
+  const auto [low, high] = std::minmax_element(depths.begin(), depths.end());
+  EXPECT_LT(*low, *high);
+  // At the chosen depths the tolerance holds (no face reached the cap here).
+  EXPECT_LT(*high, 5);
+  EXPECT_EQ(error.over, 0);
+  EXPECT_LE(error.max_position, tolerance.position + 1e-12);
+  // The exports' cap is the renderer's depth at the output scale.
+  ExportReport report;
+  (void)detail::export_mesh(image, {}, detail::Shading::kGouraud, report);
+  RenderOptions render;
+  EXPECT_LE(report.depth, view_faces(image, render).depth);
+}
+
+// With one depth for every face the adaptive mesh is the uniform refinement pushed to the limit
+// (OpenSubdiv's refiner and limit stencils, what the renderer draws): the same triangles, with
+// the same limit positions and colors.
+TEST(Export, AdaptiveMeshAtOneDepthIsTheUniformRefinement) {
+  const VectorImage image = synthetic();
+  const ControlMesh& mesh = image.levels[0];
+  const MeshTopology topology = MeshTopology::build(mesh, image.width, image.height);
+  const LimitEvaluator evaluator(mesh, topology);
+  for (const int depth : {0, 2}) {
+    const std::vector<uint8_t> depths(mesh.num_triangles(), static_cast<uint8_t>(depth));
+    const RefinedMesh ours = detail::adaptive_limit_mesh(mesh, topology, evaluator, depths);
+    RefinedMesh reference;
+    Subdivision(mesh, topology, depth).evaluate(mesh.positions, mesh.colors, reference);
+    ASSERT_EQ(ours.num_triangles(), reference.num_triangles());
+    ASSERT_EQ(ours.num_vertices(), reference.num_vertices());
+    EXPECT_EQ(ours.tear_edges.size(), reference.tear_edges.size());
+    EXPECT_EQ(ours.border_edges.size(), reference.border_edges.size());
+    // Each triangle, found by its centroid (to 1/64 px), has the same corners and corner colors.
+    auto key = [](const RefinedMesh& m, int t) {
+      double x = 0, y = 0;
+      for (const int32_t v : m.triangles[t]) x += m.positions[2 * v] / 3, y += m.positions[2 * v + 1] / 3;
+      return std::pair<int64_t, int64_t>{std::llround(x * 64), std::llround(y * 64)};
+    };
+    std::map<std::pair<int64_t, int64_t>, int> by_centroid;
+    for (int t = 0; t < reference.num_triangles(); ++t) by_centroid[key(reference, t)] = t;
+    int matched = 0;
+    double position = 0, color = 0;
+    for (int t = 0; t < ours.num_triangles(); ++t) {
+      const auto it = by_centroid.find(key(ours, t));
+      if (it == by_centroid.end()) continue;
+      ++matched;
+      for (int k = 0; k < 3; ++k) {
+        // The reference corner nearest to ours.
+        double best = 1e9;
+        int bk = 0;
+        for (int j = 0; j < 3; ++j) {
+          const int32_t a = ours.triangles[t][k], b = reference.triangles[it->second][j];
+          const double d = std::hypot(ours.positions[2 * a] - reference.positions[2 * b],
+                                      ours.positions[2 * a + 1] - reference.positions[2 * b + 1]);
+          if (d < best) best = d, bk = j;
+        }
+        position = std::max(position, best);
+        for (int ch = 0; ch < 3; ++ch) {
+          color = std::max(color, double(std::abs(
+                                      ours.colors[3 * ours.triangle_colors[t][k] + ch] -
+                                      reference.colors[3 * reference.triangle_colors[it->second][bk] + ch])));
+        }
+      }
+    }
+    EXPECT_GE(matched, ours.num_triangles() * 99 / 100) << "depth " << depth;
+    EXPECT_LT(position, 1e-3) << "depth " << depth;
+    EXPECT_LT(color, 1e-2) << "depth " << depth;
+  }
+}
+
+// Faces of different depths meet without cracks or T-junctions: every refined edge has a triangle
+// on each side except on the image border, no directed edge repeats, and the triangles cover the
+// image's area once. Tears keep their two colors.
+TEST(Export, AdaptiveMeshHasNoCracks) {
+  const VectorImage image = synthetic();
+  const ControlMesh& mesh = image.levels[0];
+  const MeshTopology topology = MeshTopology::build(mesh, image.width, image.height);
+  const LimitEvaluator evaluator(mesh, topology);
+  std::vector<uint8_t> depths(mesh.num_triangles());
+  uint32_t state = 12345;
+  for (uint8_t& d : depths) d = static_cast<uint8_t>((state = state * 1664525u + 1013904223u) >> 30);
+  const RefinedMesh refined = detail::adaptive_limit_mesh(mesh, topology, evaluator, depths);
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  double area = 0;
+  for (int t = 0; t < refined.num_triangles(); ++t) {
+    const Tri& v = refined.triangles[t];
+    for (int k = 0; k < 3; ++k) ++directed[{v[k], v[(k + 1) % 3]}];
+    const auto p = [&](int k) { return Vec2{refined.positions[2 * v[k]], refined.positions[2 * v[k] + 1]}; };
+    const double a = 0.5 * ((p(1).x - p(0).x) * (p(2).y - p(0).y) - (p(1).y - p(0).y) * (p(2).x - p(0).x));
+    EXPECT_GT(a, 0) << "triangle " << t;
+    area += a;
+  }
+  std::set<std::pair<int32_t, int32_t>> border;
+  for (const EdgeVerts& e : refined.border_edges) border.insert({std::min(e[0], e[1]), std::max(e[0], e[1])});
+  int open = 0;
+  for (const auto& [edge, count] : directed) {
+    EXPECT_EQ(count, 1);
+    const bool twin = directed.count({edge.second, edge.first}) > 0;
+    if (!twin) {
+      ++open;
+      EXPECT_TRUE(border.count({std::min(edge.first, edge.second), std::max(edge.first, edge.second)}))
+          << "an open edge inside the image: a crack or a T-junction";
+    }
+  }
+  EXPECT_EQ(open, static_cast<int>(refined.border_edges.size()));
+  EXPECT_NEAR(area, double(image.width) * image.height, 1e-3 * image.width * image.height);
+  // Across a refined tear edge the two triangles' colors differ at its ends.
+  ASSERT_FALSE(refined.tear_edges.empty());
+  std::map<std::pair<int32_t, int32_t>, int32_t> color_at;  // (directed edge) -> color of its start
+  for (int t = 0; t < refined.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k)
+      color_at[{refined.triangles[t][k], refined.triangles[t][(k + 1) % 3]}] = refined.triangle_colors[t][k];
+  for (const EdgeVerts& e : refined.tear_edges) {
+    const auto a = color_at.find({e[0], e[1]}), b = color_at.find({e[1], e[0]});
+    ASSERT_TRUE(a != color_at.end() && b != color_at.end());
+    EXPECT_NE(a->second, b->second);
+  }
 }
 
 // A page width is the scale that makes it: the same file, and a page of that width.
@@ -141,7 +269,8 @@ TEST(Export, RejectsBadOptions) {
 TEST(Export, StripsCoverEveryRefinedTriangleOnce) {
   const VectorImage image = synthetic();
   ExportReport report;
-  const RefinedMesh mesh = detail::export_limit_mesh(image, 0, 2, report);
+  const RefinedMesh mesh = detail::export_mesh(image, {}, detail::Shading::kGouraud, report);
+  ASSERT_LT(report.min_depth, report.depth);  // with the fans where depths meet
   const detail::Strips strips = detail::make_strips(mesh);
   // Replay the flags as a PDF reader does; each triangle must be a refined one, with its corners
   // (positions and colors), and all of them must come out exactly once.
