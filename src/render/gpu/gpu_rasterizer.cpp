@@ -405,6 +405,24 @@ class PassClock {
   std::chrono::steady_clock::time_point started_;
 };
 
+// Times the GL commands issued during its lifetime as one pass of `clock`; does nothing when
+// profiling is off.
+class PassScope {
+ public:
+  PassScope(PassClock& clock, bool profile, double GpuPassTimes::*pass)
+      : clock_(profile ? &clock : nullptr) {
+    if (clock_) clock_->begin(pass);
+  }
+  ~PassScope() {
+    if (clock_) clock_->end();
+  }
+  PassScope(const PassScope&) = delete;
+  PassScope& operator=(const PassScope&) = delete;
+
+ private:
+  PassClock* clock_;
+};
+
 // Rows of one stencil matrix on the GPU, applied in dispatches whose index / weight ranges fit
 // one shader storage binding.
 struct StencilBuffers {
@@ -583,41 +601,40 @@ class GlRasterizer final : public GpuRasterizer {
     for (int ty = 0; ty < height; ty += tile_h) {
       for (int tx = 0; tx < width; tx += tile_w) {
         const int w = std::min(tile_w, width - tx), h = std::min(tile_h, height - ty);
-        if (profile) clock_.begin(&GpuPassTimes::centres);
-        draw_triangles(centres_, view, tx, ty, w, h, 1);
-        if (profile) clock_.end();
+        {
+          const PassScope pass(clock_, profile, &GpuPassTimes::centres);
+          draw_triangles(centres_, view, tx, ty, w, h, 1);
+        }
         if (supersample) {
-          if (profile) clock_.begin(&GpuPassTimes::samples);
-          draw_triangles(samples_, view, tx, ty, w, h, 4);
-          if (profile) {
-            clock_.end();
-            clock_.begin(&GpuPassTimes::mark);
+          {
+            const PassScope pass(clock_, profile, &GpuPassTimes::samples);
+            draw_triangles(samples_, view, tx, ty, w, h, 4);
           }
+          const PassScope pass(clock_, profile, &GpuPassTimes::mark);
           mark(view, tx, ty, w, h, mark_edges);
-          if (profile) clock_.end();
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-        // Resolve.
-        if (profile) clock_.begin(&GpuPassTimes::resolve);
         const int pixels = w * h;
-        glUseProgram(resolve_);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, samples_.texture);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, centres_.texture);
-        glUniform1i(uniform(resolve_, "u_samples"), 0);
-        glUniform1i(uniform(resolve_, "u_centres"), 1);
-        glUniform1i(uniform(resolve_, "u_width"), w);
-        glUniform1i(uniform(resolve_, "u_pixels"), pixels);
-        glUniform1i(uniform(resolve_, "u_antialias"), supersample ? 1 : 0);
-        glUniform1i(uniform(resolve_, "u_channels"), channels);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, resolved_);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, marks_);
-        glDispatchCompute(GLuint((pixels + 255) / 256), 1, 1);
-        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        {  // Resolve.
+          const PassScope pass(clock_, profile, &GpuPassTimes::resolve);
+          glUseProgram(resolve_);
+          glActiveTexture(GL_TEXTURE0);
+          glBindTexture(GL_TEXTURE_2D, samples_.texture);
+          glActiveTexture(GL_TEXTURE1);
+          glBindTexture(GL_TEXTURE_2D, centres_.texture);
+          glUniform1i(uniform(resolve_, "u_samples"), 0);
+          glUniform1i(uniform(resolve_, "u_centres"), 1);
+          glUniform1i(uniform(resolve_, "u_width"), w);
+          glUniform1i(uniform(resolve_, "u_pixels"), pixels);
+          glUniform1i(uniform(resolve_, "u_antialias"), supersample ? 1 : 0);
+          glUniform1i(uniform(resolve_, "u_channels"), channels);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, resolved_);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, marks_);
+          glDispatchCompute(GLuint((pixels + 255) / 256), 1, 1);
+          glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        }
         std::chrono::steady_clock::time_point read_start;
         if (profile) {
-          clock_.end();
           glFinish();
           read_start = std::chrono::steady_clock::now();
         }
@@ -746,29 +763,26 @@ class GlRasterizer final : public GpuRasterizer {
     glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(std::max<size_t>(values.size(), 1) * 8),
                  values.data(), GL_DYNAMIC_DRAW);
     const bool profile = profiling.load(std::memory_order_relaxed);
-    if (profile) {
-      clock_.start();
-      clock_.begin(&GpuPassTimes::stencils);
+    if (profile) clock_.start();
+    {
+      const PassScope pass(clock_, profile, &GpuPassTimes::stencils);
+      glUseProgram(program);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b.offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, control);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, limit);
+      for (const StencilBuffers::Chunk& c : b.chunks) {
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, b.indices, GLintptr(c.base * 4),
+                          GLsizeiptr(c.count * 4));
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 2, b.weights, GLintptr(c.base * 8),
+                          GLsizeiptr(c.count * 8));
+        glUniform1i(uniform(program, "u_first_row"), c.first_row);
+        glUniform1i(uniform(program, "u_end_row"), c.end_row);
+        glUniform1i(uniform(program, "u_base"), static_cast<GLint>(c.base));
+        glDispatchCompute(GLuint((c.end_row - c.first_row + 63) / 64), 1, 1);
+      }
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     }
-    glUseProgram(program);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b.offsets);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, control);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, limit);
-    for (const StencilBuffers::Chunk& c : b.chunks) {
-      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, b.indices, GLintptr(c.base * 4),
-                        GLsizeiptr(c.count * 4));
-      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 2, b.weights, GLintptr(c.base * 8),
-                        GLsizeiptr(c.count * 8));
-      glUniform1i(uniform(program, "u_first_row"), c.first_row);
-      glUniform1i(uniform(program, "u_end_row"), c.end_row);
-      glUniform1i(uniform(program, "u_base"), static_cast<GLint>(c.base));
-      glDispatchCompute(GLuint((c.end_row - c.first_row + 63) / 64), 1, 1);
-    }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    if (profile) {
-      clock_.end();
-      clock_.add_to(pending_);
-    }
+    if (profile) clock_.add_to(pending_);
     check_gl("evaluating the stencils");
   }
 
