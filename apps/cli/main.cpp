@@ -105,6 +105,8 @@ struct RenderArgs {
   int depth = -1;
   double tolerance = 0.25;  // .pdf and .svg only
   std::string pdf_target = "any";  // .pdf only: any or poppler (checked by CLI11)
+  std::string svg_target = "browser";  // .svg only: browser or inkscape (checked by CLI11)
+  bool verbose = false;     // -v: what a vector export holds
   bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
   int64_t max_pixels = subvec::RenderOptions{}.max_pixels;  // the library's default
 };
@@ -137,7 +139,20 @@ void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bo
   options.depth = a.depth;
   options.pdf_target =
       lower(a.pdf_target) == "poppler" ? subvec::PdfTarget::kPoppler : subvec::PdfTarget::kAny;
-  subvec::write_vector_export(a.output, image, options);
+  options.svg_target = lower(a.svg_target) == "inkscape" ? subvec::SvgTarget::kInkscape
+                                                         : subvec::SvgTarget::kBrowser;
+  subvec::ExportReport report;
+  subvec::write_vector_export(a.output, image, options, &report);
+  if (a.verbose) {
+    const std::string pieces =
+        report.patches ? std::to_string(report.patches) + " mesh patches (one per control face)"
+                       : std::to_string(report.triangles) + " triangles (control faces at depths " +
+                             std::to_string(report.min_depth) + " to " +
+                             std::to_string(report.depth) + ")";
+    std::fprintf(stderr, "subvec: %s: %s, %lld tear hints, %lld strokes, %lld bytes\n",
+                 a.output.c_str(), pieces.c_str(), static_cast<long long>(report.tear_hints),
+                 static_cast<long long>(report.strokes), static_cast<long long>(report.bytes));
+  }
 }
 
 void run_render(const RenderArgs& a, bool width_given, bool scale_given) {
@@ -769,6 +784,16 @@ int run(int argc, char** argv) {
                    "smoothly, about four times larger, offset half a unit elsewhere)")
       ->check(CLI::IsMember({"any", "poppler"}, CLI::ignore_case))
       ->default_str("any");
+  render
+      ->add_option("--svg-target", ra.svg_target,
+                   ".svg: the programs the file is built for: browser (default; flat triangles, "
+                   "drawn alike by browsers and librsvg) or inkscape (SVG 2 mesh gradients, one "
+                   "patch per control face, editable with Inkscape's mesh tool)")
+      ->check(CLI::IsMember({"browser", "inkscape"}, CLI::ignore_case))
+      ->default_str("browser");
+  render->add_flag("-v,--verbose", ra.verbose,
+                   ".pdf, .svg: print what the file holds (triangles or patches, tear hints, "
+                   "strokes) and its size");
   render->footer(
       "Examples:\n"
       "  subvec render in.svec.json -o out.png                  # the image's own size\n"

@@ -103,12 +103,14 @@ std::string stream_object(std::string dict, const std::string& data) {
 constexpr double kHintColorTolerance = 1.0;
 
 // The tear hints and strokes drawn over the shadings, in image pixels.
-std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const ExportOptions& options, double s) {
+std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const ExportOptions& options, double s,
+                     ExportReport& report) {
   std::string content;
   if (options.tear_hints) {
     // Coordinates to a hundredth of an output unit, colors to a quarter of a level.
     const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 100) - 1e-9)), 1, 9);
     for (const detail::TearHint& hint : detail::tear_hints(mesh, 1.0 / s, kHintColorTolerance)) {
+      ++report.tear_hints;
       for (const double c : hint.color)
         content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 3) + " ";
       content += "rg";
@@ -123,6 +125,7 @@ std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const Ex
     if (stroke.level != options.level) continue;
     const std::vector<Vec2> outline = detail::stroke_outline(stroke);
     if (outline.empty()) continue;
+    ++report.strokes;
     const float rgb[3] = {stroke.color.r, stroke.color.g, stroke.color.b};
     for (const float c : rgb) content += detail::fixed(std::clamp(c / 255.0, 0.0, 1.0), 4) + " ";
     content += "rg\n";
@@ -285,10 +288,12 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     }
     resources = "/XObject <<" + forms + " >> /ExtGState << /GA0 << /ca 1 >> /GA1 << /ca 0.5 >> >>";
   }
-  content += overlays(image, mesh, options, s);
+  content += overlays(image, mesh, options, s, r);
   content += "Q\n";
 
-  return assemble(image, w, h, s, resources, content, extra);
+  std::string pdf = assemble(image, w, h, s, resources, content, extra);
+  r.bytes = static_cast<int64_t>(pdf.size());
+  return pdf;
 }
 
 }  // namespace subvec

@@ -12,11 +12,15 @@
 #include <string>
 #include <unordered_map>
 
+#include <Eigen/Dense>
+
 #include "export/export_p.h"
 #include "export/limit_mesh_p.h"
 #include "subvec/core/error.h"
 #include "subvec/export/export.h"
 #include "subvec/io/file.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/validate.h"
 
 namespace subvec {
 namespace {
@@ -70,11 +74,172 @@ class PathData {
   bool number_ = false, dot_ = false;
 };
 
+// The image's strokes of `level` as filled outlines (export_p.h).
+std::string stroke_paths(const VectorImage& image, int level, int decimals, ExportReport& report) {
+  std::string out;
+  for (const Stroke& stroke : image.strokes) {
+    if (stroke.level != level) continue;
+    const std::vector<Vec2> outline = detail::stroke_outline(stroke);
+    if (outline.empty()) continue;
+    ++report.strokes;
+    PathData d(decimals);
+    for (size_t i = 0; i < outline.size(); ++i) {
+      if (i < 2) d.command(i == 0 ? 'M' : 'L');
+      d.number(outline[i].x);
+      d.number(outline[i].y);
+    }
+    d.command('z');
+    out += "<path fill=\"" + hex_color(stroke.color.r, stroke.color.g, stroke.color.b) +
+           "\" d=\"" + d.text() + "\"/>\n";
+  }
+  return out;
+}
+
+// SvgTarget::kInkscape: the limit surface as SVG 2 mesh gradients, one bicubic Coons patch per
+// control face (docs/export.md, "SVG for Inkscape"). A face's sides are cubic Béziers through the
+// limit points of its corners with the limit curve's tangents there (on tears, the limit curve
+// is itself a cubic B-spline); each control edge's curve is computed once, so neighbours share it
+// exactly. A triangle is a Coons patch whose third side has collapsed to its third corner. The
+// corners take the limit colors of the face's side of any tear. Each face is a path filled with
+// its own one-patch gradient, so Inkscape's mesh tool edits each face's corners and colors.
+std::string svg_mesh(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
+  const double scale = detail::check_export_options(image, options);
+  const ControlMesh& mesh = image.levels[options.level];
+  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
+  const LimitEvaluator evaluator(mesh, topology);
+  const double w = image.width, h = image.height;
+  // Coordinates in image pixels, to a tenth of an output pixel.
+  const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(scale * 10) - 1e-9)), 1, 9);
+
+  // Each control edge as a cubic Bézier from its lower-numbered vertex, from its first face.
+  struct Curve {
+    std::array<Vec2, 4> p;
+  };
+  std::vector<Curve> curves(topology.num_edges());
+  // Face corner (u, v), and the derivative along the face's side k at its start and end.
+  constexpr double kCorner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  auto along = [](const LimitEvaluator::Sample& s, int k) {  // d/dt along side k (corner k to k+1)
+    const Vec2 &du = s.position_du, &dv = s.position_dv;
+    return k == 0 ? du : k == 1 ? Vec2{dv.x - du.x, dv.y - du.y} : Vec2{-dv.x, -dv.y};
+  };
+  for (int e = 0; e < topology.num_edges(); ++e) {
+    const int f = topology.edge_faces[e][0];
+    const Tri& v = mesh.triangles[f];
+    int k = 0;
+    while (topology.face_edges[f][k] != e) ++k;
+    const LimitEvaluator::Sample a = evaluator.evaluate(f, kCorner[k][0], kCorner[k][1]);
+    const LimitEvaluator::Sample b =
+        evaluator.evaluate(f, kCorner[(k + 1) % 3][0], kCorner[(k + 1) % 3][1]);
+    const Vec2 ta = along(a, k), tb = along(b, k);
+    Curve c;
+    c.p = {a.position, Vec2{a.position.x + ta.x / 3, a.position.y + ta.y / 3},
+           Vec2{b.position.x - tb.x / 3, b.position.y - tb.y / 3}, b.position};
+    if (v[k] > v[(k + 1) % 3]) std::reverse(c.p.begin(), c.p.end());
+    curves[e] = c;
+  }
+
+  // Base-36 ids: the file repeats one per face twice.
+  auto id_of = [](int f) {
+    std::string id;
+    do {
+      id += "0123456789abcdefghijklmnopqrstuvwxyz"[f % 36];
+      f /= 36;
+    } while (f > 0);
+    return "m" + id;
+  };
+  std::string defs, paths;
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const Tri& v = mesh.triangles[f];
+    std::array<std::array<Vec2, 4>, 3> side;
+    for (int k = 0; k < 3; ++k) {
+      side[k] = curves[topology.face_edges[f][k]].p;
+      if (v[k] > v[(k + 1) % 3]) std::reverse(side[k].begin(), side[k].end());
+    }
+    // The patch's color is linear in the face's parameters, c0 (1 - u - v) + c1 u + c2 v: the
+    // corners' colors are fitted by least squares to the limit colors at the parameters
+    // (i, j) / 4 over the face, which draws the face's inside closer than its corner values.
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d rhs = Eigen::Matrix3d::Zero();  // column per channel
+    constexpr int kSamples = 4;
+    for (int j = 0; j <= kSamples; ++j) {
+      for (int i = 0; i + j <= kSamples; ++i) {
+        const double u = double(i) / kSamples, t = double(j) / kSamples;
+        const LimitEvaluator::Sample sample = evaluator.evaluate(f, u, t);
+        const Eigen::Vector3d b(1 - u - t, u, t);
+        normal += b * b.transpose();
+        for (int ch = 0; ch < 3; ++ch) rhs.col(ch) += b * sample.color[ch];
+      }
+    }
+    const Eigen::Matrix3d corner = normal.ldlt().solve(rhs);  // row k: corner k's color
+    std::array<std::string, 3> color;
+    for (int k = 0; k < 3; ++k) color[k] = hex_color(corner(k, 0), corner(k, 1), corner(k, 2));
+    auto relative = [&](const std::array<Vec2, 4>& c) {
+      PathData d(decimals);
+      d.command('c');
+      for (int i = 1; i < 4; ++i) {
+        d.number(c[i].x - c[0].x);
+        d.number(c[i].y - c[0].y);
+      }
+      return d.text();
+    };
+    const std::string id = id_of(f);
+    defs += "<meshgradient id=\"" + id + "\" xlink:href=\"#t\" x=\"" +
+            detail::fixed(side[0][0].x, decimals) + "\" y=\"" + detail::fixed(side[0][0].y, decimals) +
+            "\"><meshrow><meshpatch><stop path=\"" + relative(side[0]) + "\" stop-color=\"" +
+            color[0] + "\"/><stop path=\"" + relative(side[1]) + "\" stop-color=\"" + color[1] +
+            "\"/><stop path=\"l0 0\" stop-color=\"" + color[2] + "\"/><stop path=\"" +
+            relative(side[2]) + "\" stop-color=\"" + color[2] +
+            "\"/></meshpatch></meshrow></meshgradient>\n";
+    // The mesh paints nothing outside its patch, so the shape it fills is the face's bounding box
+    // (the curves' control points bound them), to the grid of the coordinates.
+    double x0 = side[0][0].x, y0 = side[0][0].y, x1 = x0, y1 = y0;
+    for (const auto& c : side) {
+      for (const Vec2& p : c) {
+        x0 = std::min(x0, p.x), y0 = std::min(y0, p.y);
+        x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+      }
+    }
+    const double unit = std::pow(10.0, decimals);
+    x0 = std::floor(x0 * unit) / unit, y0 = std::floor(y0 * unit) / unit;
+    x1 = std::ceil(x1 * unit) / unit, y1 = std::ceil(y1 * unit) / unit;
+    PathData d(decimals);
+    d.command('M');
+    d.number(x0);
+    d.number(y0);
+    d.command('h');
+    d.number(x1 - x0);
+    d.command('v');
+    d.number(y1 - y0);
+    d.command('h');
+    d.number(x0 - x1);
+    d.command('z');
+    paths += "<path fill=\"url(#" + id + ")\" d=\"" + d.text() + "\"/>\n";
+  }
+  report.depth = report.min_depth = 0;
+  report.triangles = 0;
+  report.patches = mesh.num_triangles();
+
+  std::string svg = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" width=\"" + detail::fixed(w * scale, 6) +
+         "\" height=\"" + detail::fixed(h * scale, 6) + "\" viewBox=\"0 0 " + detail::fixed(w, 6) +
+         " " + detail::fixed(h, 6) + "\">\n";
+  for (const auto& [key, value] : image.metadata)
+    if (key == "title") svg += "<title>" + xml_text(value) + "</title>\n";
+  // The template holds what every face's gradient shares.
+  svg += "<defs>\n<meshgradient id=\"t\" gradientUnits=\"userSpaceOnUse\" type=\"bicubic\"/>\n" +
+         defs + "</defs>\n<g>\n" + paths + "</g>\n";
+  svg += stroke_paths(image, options.level, decimals + 1, report);
+  svg += "</svg>\n";
+  report.bytes = static_cast<int64_t>(svg.size());
+  return svg;
+}
+
 }  // namespace
 
 std::string to_svg(const VectorImage& image, const ExportOptions& options, ExportReport* report) {
   ExportReport local;
   ExportReport& r = report ? *report : local;
+  if (options.svg_target == SvgTarget::kInkscape) return svg_mesh(image, options, r);
   const RefinedMesh mesh =
       detail::export_mesh(image, options, detail::Shading::kFlat, r);
   const double w = image.width, h = image.height, s = export_scale(options, image.width);
@@ -126,6 +291,7 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   svg += "</g>\n";
   if (options.tear_hints) {
     for (const detail::TearHint& hint : detail::tear_hints(mesh, 1.0 / s, kHintColorTolerance)) {
+      ++r.tear_hints;
       PathData d(decimals + 1);
       d.command('M');
       d.number(hint.polygon[0].x);
@@ -140,21 +306,9 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
              "\" d=\"" + d.text() + "\"/>\n";
     }
   }
-  for (const Stroke& stroke : image.strokes) {
-    if (stroke.level != options.level) continue;
-    const std::vector<Vec2> outline = detail::stroke_outline(stroke);
-    if (outline.empty()) continue;
-    PathData d(decimals + 1);
-    for (size_t i = 0; i < outline.size(); ++i) {
-      if (i < 2) d.command(i == 0 ? 'M' : 'L');
-      d.number(outline[i].x);
-      d.number(outline[i].y);
-    }
-    d.command('z');
-    svg += "<path fill=\"" + hex_color(stroke.color.r, stroke.color.g, stroke.color.b) +
-           "\" d=\"" + d.text() + "\"/>\n";
-  }
+  svg += stroke_paths(image, options.level, decimals + 1, r);
   svg += "</svg>\n";
+  r.bytes = static_cast<int64_t>(svg.size());
   return svg;
 }
 

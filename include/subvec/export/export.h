@@ -26,6 +26,12 @@ namespace subvec {
 // sample at pixel centres (cairo, MuPDF, Ghostscript), and the file is about four times larger.
 enum class PdfTarget { kAny, kPoppler };
 
+// Which SVG renderers the file is built for (docs/export.md, "SVG"). kBrowser: flat triangles at
+// each face's depth, drawn alike by browsers and librsvg. kInkscape: SVG 2 mesh gradients, one
+// bicubic Coons patch per control face, which Inkscape draws and its mesh tool edits (browsers and
+// librsvg draw nothing of them).
+enum class SvgTarget { kBrowser, kInkscape };
+
 struct ExportOptions {
   int level = 0;       // level of detail
   double scale = 1;    // output units (PDF points, SVG pixels) per image pixel
@@ -47,6 +53,7 @@ struct ExportOptions {
   // viewers that do not anti-alias shadings (poppler) still show anti-aliased tears.
   bool tear_hints = true;
   PdfTarget pdf_target = PdfTarget::kAny;
+  SvgTarget svg_target = SvgTarget::kBrowser;
 };
 
 struct ExportReport {
@@ -58,6 +65,12 @@ struct ExportReport {
   double max_position_error = 0;
   double max_color_error = 0;
   double over_tolerance = 0;
+  // What the file holds: mesh patches (SvgTarget::kInkscape, else 0), tear-hint paths, stroke
+  // outlines, and its size.
+  int64_t patches = 0;
+  int64_t tear_hints = 0;
+  int64_t strokes = 0;
+  int64_t bytes = 0;
 };
 
 // Output units per image pixel: width / image_width when `width` is given, else `scale`.

@@ -258,6 +258,17 @@ TEST_F(Cli, RenderExportsPdfAndSvg) {
   r = subvec("render " + q(example("01-disk")) + " -o " + q(svg) + " --width 48 --tolerance 0.5");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(read_text(svg).find("width=\"48\" height=\"48\""), std::string::npos);
+  r = subvec("render " + q(example("01-disk")) + " -o " + q(svg) + " --svg-target inkscape -v");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(svg).find("<meshgradient"), std::string::npos);
+  EXPECT_NE(r.err.find("96 mesh patches (one per control face), 0 tear hints, 0 strokes, " +
+                       std::to_string(fs::file_size(svg)) + " bytes"),
+            std::string::npos)
+      << r.err;
+  r = subvec("render " + q(example("01-disk")) + " -o " + q(pdf) + " -v");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find(" triangles (control faces at depths "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(std::to_string(fs::file_size(pdf)) + " bytes"), std::string::npos) << r.err;
   expect_failure(subvec("render " + q(example("01-disk")) + " -o " + q(dir_ / "b.pdf") +
                         " --window 0,0,10,10"),
                  "--window and --overlay apply to .png output only");
