@@ -192,7 +192,13 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   const int cbits = std::max(w, h) * s / 65535 <= options.tolerance / 8 ? 16 : 24;
   const int kbits = channels ? 16 : 8;
   const double kCoordinateMax = double((1 << cbits) - 1);
-  // Writes strips of the mesh as a shading's data; channel -1 writes all three components.
+  // The coordinates reach two output units past the page's right edge, where one triangle of no
+  // area ends the mesh: PDF.js draws a mesh into an image as wide as the mesh and writes one pixel
+  // past the end of each row, so the mesh's last column would land in the next row's first, on
+  // the page (docs/export.md, "PDF.js").
+  // The right edge x = w is a whole code, so that it decodes to w (MuPDF rounds vertices to
+  // pixels, and a right edge a hair inside the page lost it the last column).
+  const double x_end = w * kCoordinateMax / std::floor(kCoordinateMax * w / (w + 2 / s));
   auto stream = [&](const detail::Strips& part, int channel) {
     std::vector<uint8_t> data;
     data.reserve(part.flags.size() * (channel < 0 ? 13 : 9));
@@ -203,7 +209,8 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       const auto [t, k] = part.corners[i];
       const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
       put(part.flags[i], 1);
-      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / w, 0.0, 1.0) * kCoordinateMax)), cbits / 8);
+      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / x_end, 0.0, 1.0) * kCoordinateMax)),
+          cbits / 8);
       put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
           cbits / 8);
       for (int ch = 0; ch < 3; ++ch) {
@@ -211,6 +218,12 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
         const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
         put(uint64_t(std::lround(value * double((1 << kbits) - 1))), kbits / 8);
       }
+    }
+    for (int corner = 0; corner < 3; ++corner) {  // the triangle of no area at (x_end, 0)
+      put(0, 1);
+      put(uint64_t(kCoordinateMax), cbits / 8);
+      put(0, cbits / 8);
+      put(0, (channel < 0 ? 3 : 1) * kbits / 8);
     }
     return deflate(data);
   };
@@ -221,7 +234,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     extra.push_back(std::move(body));
     return std::to_string(5 + extra.size()) + " 0 R";
   };
-  const std::string decode = "/Decode [0 " + detail::fixed(w, 6) + " 0 " + detail::fixed(h, 6);
+  const std::string decode = "/Decode [0 " + detail::fixed(x_end, 6) + " 0 " + detail::fixed(h, 6);
   auto shading = [&](const std::string& data, int channel, double offset) {
     std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate " + std::to_string(cbits) +
                        " /BitsPerComponent " + std::to_string(kbits) + " /BitsPerFlag 8 " + decode;
