@@ -29,6 +29,19 @@ using detail::num;
 
 constexpr int64_t kMaxTriangles = int64_t{1} << 24;
 
+// Calls edge(i0, j0, i1, j1) for each edge of the triangles of a face's grid of size n (the
+// grid points (i, j), i + j <= n): each once.
+template <class Edge>
+void for_each_grid_edge(int n, const Edge& edge) {
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i + j < n; ++i) {
+      edge(i, j, i + 1, j);
+      edge(i, j, i, j + 1);
+      edge(i + 1, j, i, j + 1);
+    }
+  }
+}
+
 // A face's limit values on the grid of parameters (i / n, j / n), i + j <= n.
 struct Value {
   double x, y, c[3];
@@ -124,13 +137,7 @@ FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int s
       record(sharp(i0, j0, i1, j1) ? delta : 0, color_error(i0 + i1, j0 + j1, mean, delta),
              length(a, b));
     };
-    for (int j = 0; j <= n; ++j) {
-      for (int i = 0; i + j < n; ++i) {
-        edge(i, j, i + 1, j);
-        edge(i, j, i, j + 1);
-        edge(i + 1, j, i, j + 1);
-      }
-    }
+    for_each_grid_edge(n, edge);
     return error;
   }
   // Flat: a triangle (corners p, q, r in grid units at depth d) against its mean color at its
@@ -194,13 +201,7 @@ LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mes
       error.over += position > position_tolerance || color > color_tolerance;
       ++error.edges;
     };
-    for (int j = 0; j <= n; ++j) {
-      for (int i = 0; i + j < n; ++i) {
-        edge(i, j, i + 1, j);
-        edge(i, j, i, j + 1);
-        edge(i + 1, j, i, j + 1);
-      }
-    }
+    for_each_grid_edge(n, edge);
   }
   return error;
 }

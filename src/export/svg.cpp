@@ -74,6 +74,19 @@ class PathData {
   bool number_ = false, dot_ = false;
 };
 
+// The XML declaration, the <svg> element (its size in output units, the image in its viewBox, and
+// `attributes`) and the image's title.
+std::string header(const VectorImage& image, double scale, const std::string& attributes) {
+  const double w = image.width, h = image.height;
+  std::string svg = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\"" + attributes + " width=\"" +
+         detail::fixed(w * scale, 6) + "\" height=\"" + detail::fixed(h * scale, 6) +
+         "\" viewBox=\"0 0 " + detail::fixed(w, 6) + " " + detail::fixed(h, 6) + "\">\n";
+  for (const auto& [key, value] : image.metadata)
+    if (key == "title") svg += "<title>" + xml_text(value) + "</title>\n";
+  return svg;
+}
+
 // The image's strokes of `level` as filled outlines (export_p.h).
 std::string stroke_paths(const VectorImage& image, int level, int decimals, ExportReport& report) {
   std::string out;
@@ -107,7 +120,6 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
   const ControlMesh& mesh = image.levels[options.level];
   const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
   const LimitEvaluator evaluator(mesh, topology);
-  const double w = image.width, h = image.height;
   // Coordinates in image pixels, to a tenth of an output pixel.
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(scale * 10) - 1e-9)), 1, 9);
 
@@ -219,12 +231,7 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
   report.triangles = 0;
   report.patches = mesh.num_triangles();
 
-  std::string svg = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" width=\"" + detail::fixed(w * scale, 6) +
-         "\" height=\"" + detail::fixed(h * scale, 6) + "\" viewBox=\"0 0 " + detail::fixed(w, 6) +
-         " " + detail::fixed(h, 6) + "\">\n";
-  for (const auto& [key, value] : image.metadata)
-    if (key == "title") svg += "<title>" + xml_text(value) + "</title>\n";
+  std::string svg = header(image, scale, " xmlns:xlink=\"http://www.w3.org/1999/xlink\"");
   // The template holds what every face's gradient shares.
   svg += "<defs>\n<meshgradient id=\"t\" gradientUnits=\"userSpaceOnUse\" type=\"bicubic\"/>\n" +
          defs + "</defs>\n<g>\n" + paths + "</g>\n";
@@ -242,7 +249,7 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   if (options.svg_target == SvgTarget::kInkscape) return svg_mesh(image, options, r);
   const RefinedMesh mesh =
       detail::export_mesh(image, options, detail::Shading::kFlat, r);
-  const double w = image.width, h = image.height, s = export_scale(options, image.width);
+  const double s = export_scale(options, image.width);
   // Coordinates in image pixels, to a tenth of an output pixel (crisp edges sample pixel centres).
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 10) - 1e-9)), 1, 9);
   // The grid is offset by half a step (the group below translates it back), so that no vertex
@@ -278,12 +285,7 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
     d.command('z');
   }
 
-  std::string svg = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-  svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + detail::fixed(w * s, 6) +
-         "\" height=\"" + detail::fixed(h * s, 6) + "\" viewBox=\"0 0 " + detail::fixed(w, 6) +
-         " " + detail::fixed(h, 6) + "\">\n";
-  for (const auto& [key, value] : image.metadata)
-    if (key == "title") svg += "<title>" + xml_text(value) + "</title>\n";
+  std::string svg = header(image, s, "");
   svg += "<g shape-rendering=\"crispEdges\" transform=\"translate(" + detail::fixed(offset, 9) +
          " " + detail::fixed(offset, 9) + ")\">\n";
   for (const std::string& color : order)
