@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -510,6 +511,19 @@ TEST_F(ExportViewers, InkscapeDrawsTheMeshSvgLikeTheRenderer) {
     RecordProperty(name + "_inkscape_mae", std::to_string(mae));
     EXPECT_LE(mae, 2.0) << name;
   }
+  // Inkscape opens the file as an editable document: saved again as Inkscape SVG, every face's
+  // mesh gradient and the shape it fills are still there (its XML editor lists them).
+  const VectorImage image = example("01-disk");
+  const fs::path svg = write("open.svg", to_svg(image, {.svg_target = SvgTarget::kInkscape}));
+  const fs::path saved = dir_ / "saved.svg";
+  ASSERT_TRUE(run("HOME='" + dir_.string() + "' inkscape '" + svg.string() +
+                  "' --export-type=svg --export-filename='" + saved.string() + "' 2>/dev/null"));
+  std::ifstream in(saved);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t faces = image.levels[0].triangles.size();
+  EXPECT_EQ(count_of(text, "<meshgradient"), faces + 1);  // and the template
+  EXPECT_EQ(count_of(text, "<meshpatch"), faces);
+  EXPECT_EQ(count_of(text, "url(#m"), faces);
 }
 
 TEST_F(ExportViewers, LibrsvgDrawsTheSvgLikeTheRenderer) {
