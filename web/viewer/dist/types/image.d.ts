@@ -1,0 +1,40 @@
+/** A tear feature: a chain of vertex indices (closed when the last repeats the first). */
+export interface Feature {
+    id: number;
+    saliency: number;
+    vertices: Int32Array;
+}
+/** One level: a control mesh over [0, W] x [0, H]. */
+export interface Level {
+    /** x, y per vertex (image pixels, y down). */
+    positions: Float64Array;
+    /** r, g, b per color value (0-255 sRGB scale, as stored). */
+    colors: Float32Array;
+    /** a, b, c per triangle (positive signed area). */
+    triangles: Int32Array;
+    /** the color value of each corner, 3 per triangle (always filled, also for JSON without it). */
+    triangleColors: Int32Array;
+    /** a, b per crease edge. */
+    creases: Int32Array;
+    features: Feature[];
+}
+/** A stroke: the clamped uniform cubic B-spline of its points (docs/format.md, Strokes). */
+export interface Stroke {
+    level: number;
+    /** x, y per control point. */
+    points: Float64Array;
+    width: number;
+    color: [number, number, number];
+    taper: number;
+}
+export interface SvecImage {
+    width: number;
+    height: number;
+    levels: Level[];
+    strokes: Stroke[];
+    metadata: Array<[string, string]>;
+}
+/** Every problem with a file is reported as one of these: a one-line message naming it. */
+export declare class SvecError extends Error {
+    constructor(message: string);
+}

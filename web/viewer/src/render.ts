@@ -1,0 +1,404 @@
+// Draws a vector image into a canvas with WebGL2, as `subvec render` draws it on the CPU
+// (src/render/renderer.cpp): the same view plan (visible faces from ring boxes, the depth rule in
+// output pixels), the same refinement (subdivide.ts), Gouraud-shaded limit triangles, then the
+// strokes. Tears and the image border are anti-aliased by the canvas's 4x multisampling (the C++
+// rasterizer supersamples the pixels along tears 4 x 4); strokes by their coverage (strokes.ts).
+// (Drawing each refined tear edge again as a band that mixes its two sides' colors by area was
+// tried: no closer to the C++ renderer, because colors ramp steeply beside tears, and not faster.)
+//
+// A view reuses the last refinement when it needs the same level and depth and a subset of its
+// faces: zooming in within one depth, and panning within the refined region, only redraw.
+import { SvecError, type SvecImage } from './image';
+import { adaptiveIndices, buildTopology, refine, uniformIndices, type Refined, type Topology } from './subdivide';
+import { strokeChords, type ViewTransform } from './strokes';
+
+/** A region of the image, in image pixels. */
+export interface ViewWindow {
+  x0: number;
+  y0: number;
+  x1: number;
+  y1: number;
+}
+
+export interface RenderStats {
+  /** subdivision depth of the last frame */
+  depth: number;
+  /** triangles drawn */
+  triangles: number;
+  /** milliseconds spent refining for the last frame (0 when it reused the refinement) */
+  refineMs: number;
+  /** milliseconds spent issuing the draw calls */
+  drawMs: number;
+}
+
+// The depth rule of src/render/renderer.cpp (choose_depth): the smallest k with mean refined edge
+// <= maxEdgePixels * sqrt(zoom), at most 8, fewer while faces * 4^k is over the budget. The C++
+// renderer refines to edges of 2.5 output pixels; the viewer by default to 5, one level less, a
+// quarter of the triangles: the difference is a few tenths of a level (docs/viewer.md). The C++
+// renderer allows 2^24 triangles; a browser gets 2^22.
+export const DEFAULT_MAX_EDGE_PIXELS = 5;
+const MAX_DEPTH = 8;
+const MAX_TRIANGLES = 1 << 22;
+
+export function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom: number, faces: number): number {
+  const target = maxEdgePixels * Math.sqrt(Math.max(1, zoom));
+  let k = 0;
+  while (k < MAX_DEPTH && meanEdgePixels / 2 ** k > target) ++k;
+  while (k > 0 && faces * 4 ** k > MAX_TRIANGLES) --k;
+  return k;
+}
+
+const MESH_VS = `#version 300 es
+layout(location = 0) in vec2 position;
+layout(location = 1) in vec3 color;
+uniform vec4 view;   // window origin (image pixels), output pixels per image pixel
+uniform vec2 size;   // output pixels
+out vec3 shade;
+void main() {
+  vec2 o = (position - view.xy) * view.zw;
+  gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
+  shade = color;
+}`;
+const MESH_FS = `#version 300 es
+precision highp float;
+in vec3 shade;
+out vec4 outColor;
+void main() { outColor = vec4(clamp(shade / 255.0, 0.0, 1.0), 1.0); }`;
+
+// One instanced quad per chord, covering the chord's capsule plus a pixel.
+const CHORD_VS = `#version 300 es
+layout(location = 0) in vec2 corner;
+layout(location = 1) in vec4 ends;   // x0, y0, x1, y1 (output pixels)
+layout(location = 2) in vec2 radii;
+uniform vec2 size;
+out vec4 vEnds;
+out vec2 vRadii;
+void main() {
+  float reach = max(radii.x, radii.y) + 1.0;
+  vec2 lo = min(ends.xy, ends.zw) - reach, hi = max(ends.xy, ends.zw) + reach;
+  vec2 o = mix(lo, hi, corner);
+  gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
+  vEnds = ends;
+  vRadii = radii;
+}`;
+const CHORD_FS = `#version 300 es
+precision highp float;
+in vec4 vEnds;
+in vec2 vRadii;
+uniform vec2 size;
+out vec4 coverage;
+void main() {
+  vec2 p = vec2(gl_FragCoord.x, size.y - gl_FragCoord.y);  // output pixel centre, y down
+  vec2 a = vEnds.xy, d = vEnds.zw - vEnds.xy;
+  float len2 = dot(d, d);
+  float u = len2 > 0.0 ? clamp(dot(p - a, d) / len2, 0.0, 1.0) : 0.0;
+  float dist = length(p - (a + u * d)), r = mix(vRadii.x, vRadii.y, u);
+  coverage = vec4(clamp(min(dist + r, 0.5) - max(dist - r, -0.5), 0.0, 1.0));
+}`;
+// Source-over of one stroke's color with its coverage (premultiplied output).
+const COMPOSITE_VS = `#version 300 es
+layout(location = 0) in vec2 corner;
+void main() { gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0); }`;
+const COMPOSITE_FS = `#version 300 es
+precision highp float;
+uniform sampler2D coverage;
+uniform vec3 color;
+out vec4 outColor;
+void main() {
+  float a = texelFetch(coverage, ivec2(gl_FragCoord.xy), 0).r;
+  outColor = vec4(clamp(color / 255.0, 0.0, 1.0) * a, a);
+}`;
+
+function compile(gl: WebGL2RenderingContext, vs: string, fs: string): WebGLProgram {
+  const program = gl.createProgram();
+  for (const [type, source] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]] as const) {
+    const shader = gl.createShader(type);
+    if (!shader) throw new SvecError('WebGL2: cannot create a shader');
+    gl.shaderSource(shader, source);
+    gl.compileShader(shader);
+    gl.attachShader(program, shader);
+    gl.deleteShader(shader);
+  }
+  gl.linkProgram(program);
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
+    throw new SvecError(`WebGL2: shader program failed: ${gl.getProgramInfoLog(program) ?? 'no log'}`);
+  }
+  return program;
+}
+
+function checkWindow(w: ViewWindow): void {
+  const ok = [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
+  if (!ok) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
+}
+
+// The refinement of the last view, on the GPU.
+interface Cache {
+  level: number;
+  depth: number;
+  faces: Int32Array | null; // ascending; null: all faces
+  refined: Refined;
+  scale: number; // the output pixels per image pixel the index buffer was chosen for
+  numIndices: number;
+  vao: WebGLVertexArrayObject;
+  buffers: WebGLBuffer[];
+}
+
+// Whether the ascending list `want` (null: all) is within `have` (null: all).
+function covers(have: Int32Array | null, want: Int32Array | null): boolean {
+  if (!have) return true;
+  if (!want || want.length > have.length) return false;
+  let i = 0;
+  for (const f of want) {
+    while (i < have.length && have[i] < f) ++i;
+    if (i === have.length || have[i] !== f) return false;
+  }
+  return true;
+}
+
+export class SubvecRenderer {
+  readonly stats: RenderStats = { depth: 0, triangles: 0, refineMs: 0, drawMs: 0 };
+  /** The depth rule's refined edge length at 1x, in output pixels: 2.5 draws what `subvec render` draws. */
+  maxEdgePixels = DEFAULT_MAX_EDGE_PIXELS;
+  /**
+   * How far (in color levels) a control face's triangles may be from the next level's before it
+   * is refined further, up to the depth rule's depth; 0 refines every face to that depth.
+   */
+  colorTolerance = 1;
+  /** The same for tear and border curves, in output pixels. */
+  positionTolerance = 0.25;
+  private readonly gl: WebGL2RenderingContext;
+  private readonly mesh: WebGLProgram;
+  private readonly chord: WebGLProgram;
+  private readonly composite: WebGLProgram;
+  private readonly quad: WebGLBuffer;
+  private image: SvecImage | null = null;
+  private level = 0;
+  private topologies: Array<Topology | undefined> = [];
+  private window: ViewWindow | null = null;
+  private cache: Cache | null = null;
+  private coverage: { texture: WebGLTexture; framebuffer: WebGLFramebuffer; width: number; height: number } | null = null;
+
+  constructor(readonly canvas: HTMLCanvasElement | OffscreenCanvas) {
+    // preserveDrawingBuffer: the frame stays readable (toDataURL, drawImage) after it is shown.
+    const gl = canvas.getContext('webgl2', { antialias: true, alpha: true, premultipliedAlpha: true, preserveDrawingBuffer: true });
+    if (!gl) throw new SvecError('this browser cannot draw the image: WebGL2 is not available');
+    this.gl = gl as WebGL2RenderingContext;
+    this.mesh = compile(this.gl, MESH_VS, MESH_FS);
+    this.chord = compile(this.gl, CHORD_VS, CHORD_FS);
+    this.composite = compile(this.gl, COMPOSITE_VS, COMPOSITE_FS);
+    this.quad = this.gl.createBuffer()!;
+    this.gl.bindBuffer(this.gl.ARRAY_BUFFER, this.quad);
+    this.gl.bufferData(this.gl.ARRAY_BUFFER, new Float32Array([0, 0, 1, 0, 0, 1, 1, 1]), this.gl.STATIC_DRAW);
+  }
+
+  /** Shows `image` (already validated by decode/load) at `level`. */
+  setImage(image: SvecImage, level = 0): void {
+    this.dropCache();
+    this.image = image;
+    this.topologies = [];
+    this.level = 0;
+    this.setLevel(level);
+  }
+
+  setLevel(level: number): void {
+    const count = this.image ? this.image.levels.length : 0;
+    if (!Number.isInteger(level) || level < 0 || level >= count) {
+      throw new SvecError(`level ${level} is out of range (${count} levels)`);
+    }
+    this.level = level;
+  }
+
+  /** The region of the image mapped onto the whole canvas; null: the whole image. */
+  setView(window: ViewWindow | null): void {
+    if (window) checkWindow(window);
+    this.window = window ? { ...window } : null;
+  }
+
+  /** Draws at canvas.width x canvas.height device pixels; outside the image stays transparent. */
+  render(): void {
+    const gl = this.gl;
+    const width = this.canvas.width, height = this.canvas.height;
+    gl.viewport(0, 0, width, height);
+    gl.clearColor(0, 0, 0, 0);
+    gl.clear(gl.COLOR_BUFFER_BIT);
+    const image = this.image;
+    if (!image || width < 1 || height < 1) return;
+    const w = this.window ?? { x0: 0, y0: 0, x1: image.width, y1: image.height };
+    const view: ViewTransform = { x0: w.x0, y0: w.y0, sx: width / (w.x1 - w.x0), sy: height / (w.y1 - w.y0), width, height };
+
+    const t0 = performance.now();
+    const cache = this.plan(image, w, view);
+    const t1 = performance.now();
+    this.stats.refineMs = cache ? t1 - t0 : 0;
+    if (cache) {
+      gl.useProgram(this.mesh);
+      gl.uniform4f(gl.getUniformLocation(this.mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
+      gl.uniform2f(gl.getUniformLocation(this.mesh, 'size'), width, height);
+      gl.bindVertexArray(cache.vao);
+      gl.drawElements(gl.TRIANGLES, cache.numIndices, gl.UNSIGNED_INT, 0);
+      gl.bindVertexArray(null);
+    }
+    this.drawStrokes(image, view);
+    this.stats.drawMs = performance.now() - t1;
+  }
+
+  /** Frees the GPU resources; the renderer cannot draw afterwards. */
+  dispose(): void {
+    this.dropCache();
+    const gl = this.gl;
+    if (this.coverage) {
+      gl.deleteTexture(this.coverage.texture);
+      gl.deleteFramebuffer(this.coverage.framebuffer);
+      this.coverage = null;
+    }
+    for (const p of [this.mesh, this.chord, this.composite]) gl.deleteProgram(p);
+    gl.deleteBuffer(this.quad);
+    this.image = null;
+  }
+
+  // The view plan of src/render/renderer.cpp (plan_view): the faces whose ring box meets the
+  // window, their mean edge in output pixels, the depth; then the refinement, reused if it can be.
+  private plan(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache | null {
+    let topo = this.topologies[this.level];
+    if (!topo) topo = this.topologies[this.level] = buildTopology(image.levels[this.level], image.width, image.height);
+    const { triangles: tri, positions: p } = topo.level;
+    const nf = tri.length / 3, boxes = topo.ringBoxes;
+    const visible: number[] = [];
+    let edges = 0;
+    for (let f = 0; f < nf; ++f) {
+      if (boxes[4 * f + 2] < w.x0 || boxes[4 * f] > w.x1 || boxes[4 * f + 3] < w.y0 || boxes[4 * f + 1] > w.y1) continue;
+      visible.push(f);
+      for (let k = 0; k < 3; ++k) {
+        const a = tri[3 * f + k], b = tri[3 * f + ((k + 1) % 3)];
+        edges += Math.hypot((p[2 * b] - p[2 * a]) * view.sx, (p[2 * b + 1] - p[2 * a + 1]) * view.sy);
+      }
+    }
+    if (visible.length === 0) {
+      this.stats.depth = this.stats.triangles = 0;
+      return null;
+    }
+    const depth = chooseDepth(edges / (3 * visible.length), this.maxEdgePixels, Math.min(view.sx, view.sy), visible.length);
+    const faces = visible.length === nf ? null : Int32Array.from(visible);
+    const c = this.cache;
+    if (!(c && c.level === this.level && c.depth === depth && covers(c.faces, faces))) this.upload(topo, faces, depth);
+    const cache = this.cache!;
+    const scale = Math.min(view.sx, view.sy);
+    if (cache.scale !== scale) this.uploadIndices(cache, scale);
+    this.stats.depth = depth;
+    this.stats.triangles = cache.numIndices / 3;
+    return cache;
+  }
+
+  private upload(topo: Topology, faces: Int32Array | null, depth: number): void {
+    this.dropCache();
+    const gl = this.gl;
+    const refined = refine(topo, faces, depth);
+    const vao = gl.createVertexArray()!;
+    const vertices = gl.createBuffer()!, indices = gl.createBuffer()!;
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
+    gl.bufferData(gl.ARRAY_BUFFER, refined.vertices, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
+    gl.enableVertexAttribArray(1);
+    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
+    gl.bindVertexArray(null);
+    this.cache = { level: this.level, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
+  }
+
+  // The triangles to draw at this scale: each face as deep as it needs (the position tolerance is
+  // in output pixels, so a zoom changes them), or all at the depth.
+  private uploadIndices(cache: Cache, scale: number): void {
+    const r = cache.refined;
+    const indices = this.colorTolerance > 0 ? adaptiveIndices(r, scale, this.colorTolerance, this.positionTolerance) : uniformIndices(r);
+    const gl = this.gl;
+    gl.bindVertexArray(cache.vao);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
+    gl.bindVertexArray(null);
+    cache.scale = scale;
+    cache.numIndices = indices.length;
+  }
+
+  private dropCache(): void {
+    if (!this.cache) return;
+    this.gl.deleteVertexArray(this.cache.vao);
+    for (const b of this.cache.buffers) this.gl.deleteBuffer(b);
+    this.cache = null;
+  }
+
+  // Each stroke of the level: its coverage (the maximum over its chords) into a texture, then
+  // composited over the frame, in file order.
+  private drawStrokes(image: SvecImage, view: ViewTransform): void {
+    const strokes = image.strokes.filter((s) => s.level === this.level && s.points.length >= 4);
+    if (strokes.length === 0) return;
+    const gl = this.gl;
+    const target = this.coverageTarget(view.width, view.height);
+    const chords = gl.createBuffer()!;
+    const vao = gl.createVertexArray()!;
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.quad);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 0, 0);
+    gl.bindBuffer(gl.ARRAY_BUFFER, chords);
+    gl.enableVertexAttribArray(1);
+    gl.vertexAttribPointer(1, 4, gl.FLOAT, false, 24, 0);
+    gl.vertexAttribDivisor(1, 1);
+    gl.enableVertexAttribArray(2);
+    gl.vertexAttribPointer(2, 2, gl.FLOAT, false, 24, 16);
+    gl.vertexAttribDivisor(2, 1);
+    gl.enable(gl.BLEND);
+    for (const stroke of strokes) {
+      const data = strokeChords(stroke, view);
+      if (data.length === 0) continue;
+      gl.bindFramebuffer(gl.FRAMEBUFFER, target.framebuffer);
+      gl.clearColor(0, 0, 0, 0);
+      gl.clear(gl.COLOR_BUFFER_BIT);
+      gl.blendEquation(gl.MAX);
+      gl.useProgram(this.chord);
+      gl.uniform2f(gl.getUniformLocation(this.chord, 'size'), view.width, view.height);
+      gl.bindBuffer(gl.ARRAY_BUFFER, chords);
+      gl.bufferData(gl.ARRAY_BUFFER, data, gl.STREAM_DRAW);
+      gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, data.length / 6);
+
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      gl.blendEquation(gl.FUNC_ADD);
+      gl.blendFunc(gl.ONE, gl.ONE_MINUS_SRC_ALPHA);
+      gl.useProgram(this.composite);
+      gl.bindTexture(gl.TEXTURE_2D, target.texture);
+      gl.uniform1i(gl.getUniformLocation(this.composite, 'coverage'), 0);
+      gl.uniform3f(gl.getUniformLocation(this.composite, 'color'), ...stroke.color);
+      gl.vertexAttribDivisor(1, 0);
+      gl.disableVertexAttribArray(1);
+      gl.disableVertexAttribArray(2);
+      gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+      gl.enableVertexAttribArray(1);
+      gl.enableVertexAttribArray(2);
+      gl.vertexAttribDivisor(1, 1);
+    }
+    gl.disable(gl.BLEND);
+    gl.bindVertexArray(null);
+    gl.deleteVertexArray(vao);
+    gl.deleteBuffer(chords);
+  }
+
+  private coverageTarget(width: number, height: number) {
+    const gl = this.gl;
+    if (this.coverage && this.coverage.width === width && this.coverage.height === height) return this.coverage;
+    if (this.coverage) {
+      gl.deleteTexture(this.coverage.texture);
+      gl.deleteFramebuffer(this.coverage.framebuffer);
+    }
+    const texture = gl.createTexture()!;
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.R8, width, height);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    const framebuffer = gl.createFramebuffer()!;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.coverage = { texture, framebuffer, width, height };
+    return this.coverage;
+  }
+}

@@ -1,0 +1,29 @@
+// The viewer as one minified ES module, dist/subvec-viewer.js, with fzstd bundled in: a static page
+// loads it with one <script type="module">. Built from web/ with `npm run build:viewer`.
+// Not Vite's library mode: that leaves ES output's whitespace unminified.
+import { defineConfig } from 'vite';
+
+const here = decodeURIComponent(new URL('.', import.meta.url).pathname);
+
+export default defineConfig({
+  root: here,
+  publicDir: false,
+  build: {
+    outDir: 'dist',
+    emptyOutDir: true,
+    target: 'es2020',
+    sourcemap: false,
+    modulePreload: false,
+    rollupOptions: {
+      input: here + 'src/index.ts',
+      // keep the module's exports (an app build would drop them)
+      preserveEntrySignatures: 'strict',
+      output: {
+        format: 'es',
+        entryFileNames: 'subvec-viewer.js',
+        inlineDynamicImports: true,
+        banner: '/*! subvec-viewer (docs/viewer.md). Includes fzstd, (c) Arjun Barrett, MIT license. */',
+      },
+    },
+  },
+});
