@@ -1,0 +1,400 @@
+// The viewer's decoder (web/viewer/src/decode.ts) against the C++ reader (the `subvec` CLI).
+//
+//   node web/tests/viewer-decode.mjs BUILD/bin/subvec
+//
+// Bundles decode.ts for node with esbuild, then checks that
+//  1. it rejects exactly the files of the bad-input corpora (tests/data/bad, fuzz/corpus) that
+//     `subvec info` rejects, each with a SvecError of one non-empty line (both messages printed);
+//  2. good files (the examples as JSON and as .svec versions 1 and 3, a vectorized and a stylized
+//     photograph, a hand-made image with strokes and metadata) decode to what the C++ reader
+//     gives, as `subvec convert X -o X.svec.json --lossless` writes it: same numbering, same
+//     values (positions within 1e-9 relative, colors exact in float32);
+//  3. the worked examples of docs/format.md (JSON, and the version 2 and 3 payloads) decode as the
+//     document says;
+//  4. small crafted inputs (JSON corner cases, huge counts in tiny payloads) are accepted or
+//     rejected as by the C++ reader;
+//  5. mutations of good files (truncations; flipped bytes of the file, and of the payload wrapped
+//     in a fresh zstd frame) always give a SvecError or a valid image, quickly; accept/reject as
+//     the C++ reader does.
+// Exit 0 when all pass, 1 on a failure, 77 (SKIPPED) without web/node_modules or the CLI.
+import { spawn, spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const root = path.dirname(web);
+const cli = process.argv[2] ? path.resolve(process.argv[2]) : '';
+const skip = (reason) => {
+  console.log(`SKIPPED: ${reason}`);
+  process.exit(77);
+};
+if (!cli || !fs.existsSync(cli)) skip(`the subvec CLI ${cli ? `${cli} is missing` : 'is not given (node web/tests/viewer-decode.mjs BUILD/bin/subvec)'}`);
+const require = createRequire(path.join(web, 'package.json'));
+let esbuild, fzstd;
+try {
+  esbuild = require('esbuild');
+  fzstd = require('fzstd');
+} catch {
+  skip('web/node_modules lacks esbuild or fzstd (npm ci in web/)');
+}
+
+const started = Date.now();
+const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'viewer-decode-'));
+process.on('exit', () => fs.rmSync(tmp, { recursive: true, force: true }));
+esbuild.buildSync({
+  entryPoints: [path.join(web, 'viewer/src/decode.ts')],
+  bundle: true,
+  format: 'esm',
+  platform: 'node',
+  outfile: path.join(tmp, 'decode.mjs'),
+  logLevel: 'error',
+});
+const { decode, load } = await import(pathToFileURL(path.join(tmp, 'decode.mjs')).href);
+
+let passed = 0, failed = 0;
+const check = (ok, what) => {
+  if (ok) passed++;
+  else {
+    failed++;
+    console.log(`FAIL: ${what}`);
+  }
+  return ok;
+};
+
+// The C++ reader: accepts or its message (without "subvec: PATH: "); `subvec info` on many files
+// at once (starting the CLI is most of the test's time).
+const subvec = (...args) => spawnSync(cli, args, { encoding: 'utf8' });
+const verdict = (status, stderr, file) => ({
+  ok: status === 0,
+  message: (stderr.split('\n').find((l) => l.trim()) ?? '').replace(/^subvec: /, '').replace(`${file}: `, ''),
+});
+async function cppAll(files) {
+  const out = [];
+  let next = 0;
+  const worker = async () => {
+    for (let i; (i = next++) < files.length; )
+      out[i] = await new Promise((resolve) => {
+        const p = spawn(cli, ['info', files[i]], { stdio: ['ignore', 'ignore', 'pipe'] });
+        let stderr = '';
+        p.stderr.setEncoding('utf8').on('data', (d) => (stderr += d));
+        p.on('close', (status) => resolve(verdict(status, stderr, files[i])));
+      });
+  };
+  await Promise.all(Array.from({ length: Math.max(2, Math.min(8, os.cpus().length)) }, worker));
+  return out;
+}
+// The viewer: the image, or the error (anything but a SvecError is a failure of its own).
+function js(bytes) {
+  const t = performance.now();
+  try {
+    return { ok: true, image: decode(bytes), ms: performance.now() - t };
+  } catch (e) {
+    return { ok: false, error: e, message: e?.message ?? String(e), ms: performance.now() - t };
+  }
+}
+const wellFormed = (r) => r.ok || (r.error?.name === 'SvecError' && /^[^\n\r]+$/.test(r.message) && !r.message.startsWith('internal error'));
+
+// ---------------------------------------------------------------------------------------------
+console.log('== 1. bad-input corpora: accept/reject as the C++ reader, one-line SvecError');
+const corpora = [path.join(root, 'tests/data/bad'), path.join(root, 'fuzz/corpus/svec_binary'), path.join(root, 'fuzz/corpus/svec_json')];
+let same = 0, total = 0;
+const corpus = corpora.filter((d) => fs.existsSync(d)).flatMap((d) => fs.readdirSync(d).sort().map((n) => path.join(d, n)));
+const corpusVerdicts = await cppAll(corpus);
+{
+  for (const [k, file] of corpus.entries()) {
+    const c = corpusVerdicts[k], j = js(fs.readFileSync(file));
+    const label = path.relative(root, file);
+    check(wellFormed(j), `${label}: not a one-line SvecError: ${j.error?.name}: ${j.message}`);
+    if (!check(c.ok === j.ok, `${label}: C++ ${c.ok ? 'accepts' : 'rejects'} it, the viewer ${j.ok ? 'accepts' : 'rejects'} it`)) continue;
+    total++;
+    if (c.ok) console.log(`  ${label}: both accept`);
+    else {
+      same += c.message === j.message;
+      console.log(`  ${label}:\n    C++:    ${c.message}\n    viewer: ${j.message}${c.message === j.message ? '  (same)' : ''}`);
+    }
+  }
+}
+console.log(`  ${total} files agree on accept/reject; ${same} messages identical`);
+
+// ---------------------------------------------------------------------------------------------
+// The C++ decode of a file, as JSON (exact: shortest round-trip numbers).
+function reference(file) {
+  const out = path.join(tmp, `ref-${path.basename(file)}.svec.json`);
+  const r = subvec('convert', file, '-o', out, '--lossless');
+  if (r.status !== 0) throw new Error(`subvec convert ${file}: ${r.stderr}`);
+  return JSON.parse(fs.readFileSync(out, 'utf8'));
+}
+// Differences between a decoded image and the C++ one (as JSON); empty when equal.
+function compare(image, ref) {
+  const diffs = [];
+  const eq = (a, b, what) => a !== b && !(Number.isNaN(a) && Number.isNaN(b)) && diffs.push(`${what}: ${a} != ${b}`);
+  const close = (a, b, what) => Math.abs(a - b) > 1e-9 * Math.max(1, Math.abs(b)) && diffs.push(`${what}: ${a} != ${b}`);
+  const flat = (rows) => (rows ?? []).flat();
+  const array = (a, b, what, cmp = eq) => {
+    eq(a.length, b.length, `${what} length`);
+    for (let i = 0; i < Math.min(a.length, b.length) && diffs.length < 8; i++) cmp(a[i], b[i], `${what}[${i}]`);
+  };
+  eq(image.width, ref.width, 'width');
+  eq(image.height, ref.height, 'height');
+  eq(image.levels.length, ref.levels.length, 'levels');
+  ref.levels.forEach((r, l) => {
+    const m = image.levels[l];
+    if (!m) return;
+    array(m.positions, flat(r.vertices), `level ${l} positions`, close);
+    array(m.colors, flat(r.colors).map(Math.fround), `level ${l} colors`);
+    array(m.triangles, flat(r.triangles), `level ${l} triangles`);
+    array(m.triangleColors, flat(r.triangle_colors ?? r.triangles), `level ${l} triangle colors`);
+    array(m.creases, flat(r.creases), `level ${l} creases`);
+    eq(m.features.length, (r.features ?? []).length, `level ${l} features`);
+    (r.features ?? []).forEach((f, i) => {
+      const g = m.features[i];
+      if (!g) return;
+      eq(g.id, f.id, `level ${l} feature ${i} id`);
+      close(g.saliency, f.saliency, `level ${l} feature ${i} saliency`);
+      array(g.vertices, f.vertices, `level ${l} feature ${i} vertices`);
+    });
+  });
+  eq(image.strokes.length, (ref.strokes ?? []).length, 'strokes');
+  (ref.strokes ?? []).forEach((s, i) => {
+    const t = image.strokes[i];
+    if (!t) return;
+    eq(t.level, s.level, `stroke ${i} level`);
+    array(t.points, flat(s.points), `stroke ${i} points`, close);
+    eq(t.width, Math.fround(s.width), `stroke ${i} width`);
+    array(t.color, s.color.map(Math.fround), `stroke ${i} color`);
+    eq(t.taper, Math.fround(s.taper), `stroke ${i} taper`);
+  });
+  array(image.metadata.map((e) => e.join('\u0000')), Object.entries(ref.metadata ?? {}).map((e) => e.join('\u0000')), 'metadata');
+  return diffs;
+}
+function same_as_cpp(file, label = path.relative(tmp, file)) {
+  const j = js(fs.readFileSync(file));
+  if (!check(j.ok, `${label}: the viewer rejects it: ${j.message}`)) return undefined;
+  const diffs = compare(j.image, reference(file));
+  const v = fs.readFileSync(file).subarray(0, 8).toString('latin1') === 'SUBVEC\0\x1a' ? `v${fs.readFileSync(file).readUInt32LE(8)}` : 'json';
+  const sizes = j.image.levels.map((m) => `${m.positions.length / 2}/${m.triangles.length / 3}/${m.colors.length / 3}`).join(' ');
+  if (check(!diffs.length, `${label}: differs from the C++ decode: ${diffs.join('; ')}`))
+    console.log(`  ${label} (${v}, levels V/T/C ${sizes}, ${j.image.strokes.length} strokes, ${j.image.metadata.length} metadata): same as C++ (${j.ms.toFixed(1)} ms)`);
+  return j.image;
+}
+
+console.log('== 2. good files decode to what the C++ reader gives');
+const goods = [];
+const make = (name, ...args) => {
+  const out = path.join(tmp, name), r = subvec(...args.map((a) => (a === '@' ? out : a)));
+  if (!check(r.status === 0, `subvec ${args.join(' ')}: ${r.stderr}`)) return;
+  goods.push(out);
+  return out;
+};
+for (const e of fs.readdirSync(path.join(root, 'examples')).filter((f) => f.endsWith('.svec.json')).sort()) {
+  const src = path.join(root, 'examples', e), base = e.replace('.svec.json', '');
+  goods.push(src);
+  make(`${base}-v1.svec`, 'convert', src, '-o', '@', '--lossless');
+  make(`${base}-v3.svec`, 'convert', src, '-o', '@');
+}
+// Strokes, metadata (with escapes and UTF-8), creases, two levels with a pyramid record.
+const rich = JSON.parse(fs.readFileSync(path.join(root, 'examples/02-open-tear.svec.json'), 'utf8'));
+rich.strokes = [
+  { level: 0, points: [[1.5, 2.25], [30, 20.125], [59.9, 0.1]], width: 2.5, color: [10, 20.5, 30.25], taper: 0.1 },
+  { points: [[0, 0], [60, 40]], width: 1, color: [0, 0, 0] },
+];
+rich.metadata = { title: 'rich "test" image', note: 'line one\nline two\ttab \\ backslash', unicode: 'café ✓ \u{1F600}' };
+fs.writeFileSync(path.join(tmp, 'rich.svec.json'), JSON.stringify(rich));
+goods.push(path.join(tmp, 'rich.svec.json'));
+make('rich-v1.svec', 'convert', path.join(tmp, 'rich.svec.json'), '-o', '@', '--lossless');
+make('rich-v3.svec', 'convert', path.join(tmp, 'rich.svec.json'), '-o', '@');
+const rocketPng = path.join(root, 'examples/04-rocket.png');
+const rocket = make('rocket.svec', 'vectorize', rocketPng, '-o', '@');
+make('rocket-1.svec', 'vectorize', rocketPng, '-o', '@', '--levels', '1');
+if (rocket) {
+  make('rocket-v1.svec', 'convert', rocket, '-o', '@', '--lossless');
+  make('rocket.svec.json', 'convert', rocket, '-o', '@');
+  make('rocket-styled.svec', 'stylize', rocket, '-o', '@');
+}
+for (const file of goods) same_as_cpp(file, path.relative(file.startsWith(tmp) ? tmp : root, file));
+
+// ---------------------------------------------------------------------------------------------
+console.log('== 3. the worked examples of docs/format.md');
+const doc = fs.readFileSync(path.join(root, 'docs/format.md'), 'utf8');
+const blocks = (tag) => [...doc.matchAll(new RegExp('```' + tag + '\\n([^]*?)```', 'g'))].map((m) => m[1]);
+const hexBytes = (text) => Buffer.from(text.split('\n').map((l) => l.replace(/#.*/, '')).join(' ').trim().split(/\s+/).join(''), 'hex');
+// A .svec file around a payload: the header and a zstd frame of raw blocks (content size, no checksum).
+function svecFile(payload, version) {
+  const frame = [Buffer.from([0x28, 0xb5, 0x2f, 0xfd, 0xe0]), Buffer.alloc(8)];
+  frame[1].writeBigUInt64LE(BigInt(payload.length));
+  for (let pos = 0; pos < payload.length || pos === 0; ) {
+    const n = Math.min(payload.length - pos, 1 << 17), h = Buffer.alloc(3);
+    h.writeUIntLE((n << 3) | (pos + n === payload.length ? 1 : 0), 0, 3);
+    frame.push(h, payload.subarray(pos, (pos += n)));
+    if (!n) break;
+  }
+  const f = Buffer.concat(frame), header = Buffer.alloc(32);
+  header.write('SUBVEC\0\x1a', 'latin1');
+  header.writeUInt32LE(version, 8);
+  header.writeBigUInt64LE(BigInt(payload.length), 16);
+  header.writeBigUInt64LE(BigInt(f.length), 24);
+  return Buffer.concat([header, f]);
+}
+const examples = blocks('json svec-example');
+check(examples.length === 2, `docs/format.md has ${examples.length} json svec-example blocks, expected 2`);
+examples.forEach((text, i) => {
+  const file = path.join(tmp, `doc-example-${i + 1}.svec.json`);
+  fs.writeFileSync(file, text);
+  const image = same_as_cpp(file);
+  if (!image) return;
+  const m = image.levels[0];
+  check(m.positions.join() === '0,0,4,0,4,4,0,4,2,2' && m.triangles.join() === '0,1,4,1,2,4,2,3,4,3,0,4', `doc example ${i + 1}: the square mesh`);
+  if (i === 0) check(m.triangleColors.join() === m.triangles.join() && m.colors.join() === '255,0,0,255,0,0,0,0,255,0,0,255,127.5,0,127.5', 'doc example 1: colors per vertex');
+  else
+    check(
+      m.triangleColors.join() === '0,1,4,1,2,4,2,3,4,3,5,4' && m.features.length === 1 && m.features[0].vertices.join() === '4,0' &&
+        image.metadata[0]?.join('=') === 'title=a tear that ends in the middle',
+      'doc example 2: the tear, its colors and the title',
+    );
+});
+let compact;
+for (const [tag, version] of [['text svec-compact-example', 2], ['text svec-coded-example', 3]]) {
+  const [text] = blocks(tag);
+  if (!check(text, `docs/format.md has no ${tag} block`)) continue;
+  const file = path.join(tmp, `doc-v${version}.svec`);
+  fs.writeFileSync(file, svecFile(hexBytes(text), version));
+  goods.push(file);
+  const image = same_as_cpp(file);
+  if (!image) continue;
+  const m = image.levels[0];
+  check(
+    m.positions.join() === '0,0,4,0,2,2,0,4,4,4' && m.triangles.join() === '0,1,2,3,0,2,3,2,4,4,2,1' &&
+      m.colors.join() === '256,0,0,254,0,0,128,0,128,0,0,254,0,0,256',
+    `doc version ${version} example: reads back as the document says`,
+  );
+  if (version === 3 && compact) check(!compare(image, { ...compact, levels: compact.levels }).length, 'doc version 3 example: same image as version 2');
+  if (version === 2)
+    compact = { width: 4, height: 4, levels: [{ vertices: [[0, 0], [4, 0], [2, 2], [0, 4], [4, 4]], colors: [[256, 0, 0], [254, 0, 0], [128, 0, 128], [0, 0, 254], [0, 0, 256]], triangles: [[0, 1, 2], [3, 0, 2], [3, 2, 4], [4, 2, 1]] }] };
+}
+
+// ---------------------------------------------------------------------------------------------
+console.log('== 4. crafted inputs: accepted or rejected as by the C++ reader');
+const square = (extra = '', level = '') =>
+  `{"format": "subvec", "version": 1, "width": 4, "height": 4${extra}, "levels": [{"vertices": [[0, 0], [4, 0], [4, 4], [0, 4], [2, 2]], ` +
+  `"colors": [[255, 0, 0], [255, 0, 0], [0, 0, 255], [0, 0, 255], [127.5, 0, 127.5]], "triangles": [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]${level}}]}`;
+const deep = (n) => `{"format": "subvec", "version": 1, "metadata": {"a": ${'['.repeat(n)}${']'.repeat(n)}}}`;
+const le = (...words) => Buffer.concat(words.map(([type, v]) => {
+  const b = Buffer.alloc(type === 'f64' ? 8 : type === 'u8' ? 1 : 4);
+  if (type === 'f64') b.writeDoubleLE(v);
+  else if (type === 'u8') b.writeUInt8(v);
+  else b.writeUInt32LE(v >>> 0);
+  return b;
+}));
+const crafted = {
+  'json-float-width.svec.json': square().replace('"width": 4', '"width": 4.0'),
+  'json-exponent-index.svec.json': square().replace('[0, 1, 4]', '[0, 1, 4e0]'),
+  'json-negative-zero.svec.json': square().replace('"width": 4', '"width": -0'),
+  'json-bom.svec.json': '\ufeff' + square(),
+  'json-big-integer.svec.json': square().replace('"width": 4', '"width": 18446744073709551616'),
+  'json-null-saliency.svec.json': square('', ', "features": [{"id": 0, "vertices": [4, 0], "saliency": null}], "triangle_colors": [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 5, 4]]').replace('[127.5, 0, 127.5]]', '[127.5, 0, 127.5], [0, 0, 255]]'),
+  'json-tear.svec.json': square('', ', "features": [{"id": 0, "vertices": [4, 0], "saliency": 1e-3}], "triangle_colors": [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 5, 4]]').replace('[127.5, 0, 127.5]]', '[127.5, 0, 127.5], [0, 0, 255]]'),
+  'json-duplicate-level-key.svec.json': square('', ', "creases": [], "creases": []'),
+  'json-depth-32.svec.json': deep(30),
+  'json-depth-33.svec.json': deep(31),
+  'json-metadata-escapes.svec.json': square(', "metadata": {"k\\u00e9y": "v\\ud83d\\ude00\\n", "b": ""}'),
+  'json-lone-surrogate.svec.json': square(', "metadata": {"k": "\\ud83d"}'),
+  'json-invalid-utf8.svec.json': Buffer.from(square(', "metadata": {"k": "\u00c3("}'), 'latin1'),
+  'json-control-char.svec.json': square(', "metadata": {"k": "a\tb"}'),
+  'json-color-3e38.svec.json': square().replace('[127.5, 0, 127.5]', '[3e38, 0, 127.5]'),
+  'json-color-4e38.svec.json': square().replace('[127.5, 0, 127.5]', '[4e38, 0, 127.5]'),
+  'json-unterminated-string.svec.json': square().replace('"triangles": ', '"triangles ').repeat(4),
+  'json-trailing-comma.svec.json': square().replace(']]}]}', ']],}]}'),
+  'json-trailing-garbage.svec.json': square() + ' x',
+  'json-stroke-taper.svec.json': square(', "strokes": [{"points": [[0, 0], [1, 1]], "width": 1, "color": [0, 0, 0], "taper": 0.5000001}]'),
+  'json-pyramid-on-level-0.svec.json': square('', ', "parent_vertices": [0, 1, 2, 3, 4]'),
+  'json-top-array.svec.json': '[1, 2]',
+  'empty.svec': '',
+  'png.svec': Buffer.from('89504e470d0a1a0a0000000d49484452', 'hex'),
+  // 2^26 - 1 vertices declared in a tiny version 1 payload, and in a version 3 one.
+  'v1-huge-count.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 1], ['u32', 2 ** 26 - 1], ['u32', 0], ['u32', 0], ['u32', 0], ['u32', 0], ['f64', 0]), 1),
+  'v3-huge-count.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 1], ['u32', 2 ** 26], ['u32', 2 ** 26], ['u32', 2 ** 27], ['u32', 0], ['u32', 0], ['u8', 2], ['u8', 255], ['u32', 8], ['u32', 0x01020304], ['u32', 0x05060708]), 3),
+  'v1-too-many-levels.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 65]), 1),
+};
+const craftedFiles = Object.entries(crafted).map(([name, content]) => (fs.writeFileSync(path.join(tmp, name), content), path.join(tmp, name)));
+const craftedVerdicts = await cppAll(craftedFiles);
+for (const [k, file] of craftedFiles.entries()) {
+  const name = path.basename(file), c = craftedVerdicts[k], j = js(fs.readFileSync(file));
+  check(wellFormed(j), `${name}: not a one-line SvecError: ${j.message}`);
+  check(j.ms < 1000, `${name}: took ${j.ms.toFixed(0)} ms`);
+  if (check(c.ok === j.ok, `${name}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`))
+    console.log(`  ${name}: ${c.ok ? 'both accept' : `both reject\n    C++:    ${c.message}\n    viewer: ${j.message}`}`);
+  if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${name}: differs from the C++ decode`);
+}
+// load(): bytes, Blob, File, and failures as SvecError.
+{
+  const bytes = fs.readFileSync(goods[0]);
+  const ok = await load(new Uint8Array(bytes)).then((i) => i.width > 0, () => false);
+  const blob = await load(new Blob([bytes])).then((i) => i.width > 0, () => false);
+  const file = await load(new File([Buffer.from('{"format": 1}')], 'bad.svec.json')).then(() => '', (e) => `${e.name}: ${e.message}`);
+  const url = await load('http://127.0.0.1:9/none.svec').then(() => '', (e) => `${e.name}: ${e.message}`);
+  const nourl = await load('not a url').then(() => '', (e) => e.name);
+  check(ok && blob, 'load() of bytes and of a Blob');
+  check(file === 'SvecError: bad.svec.json: format: expected "subvec", got 1 (this is not a subvec file)', `load() of a File names it: ${file}`);
+  check(url.startsWith('SvecError: http://127.0.0.1:9/none.svec: '), `load() of an unreachable URL: ${url}`);
+  check(nourl === 'SvecError', `load() of a bad URL: ${nourl}`);
+  console.log(`  load(): bytes, Blob ok; File: ${file}; unreachable URL: ${url}`);
+}
+
+// ---------------------------------------------------------------------------------------------
+console.log('== 5. mutations: a SvecError or a valid image, quickly; as the C++ reader decides');
+let seed = 20261205;
+const random = () => {
+  seed = (seed + 0x6d2b79f5) | 0;
+  let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
+  t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+  return ((t ^ (t >>> 14)) >>> 0) / 2 ** 32;
+};
+const pick = (n) => Math.floor(random() * n);
+const stats = { runs: 0, rejected: 0, valid: 0, agree: 0, slowest: 0 };
+const mutants = [];
+const mutant = (bytes, what) => mutants.push({ bytes, what, file: path.join(tmp, `mutant-${mutants.length}.svec`) });
+function judge({ bytes, what, file }, c) {
+  const j = js(bytes);
+  stats.runs++;
+  j.ok ? stats.valid++ : stats.rejected++;
+  stats.slowest = Math.max(stats.slowest, j.ms);
+  check(wellFormed(j), `${what}: ${j.error?.name}: ${j.message}`);
+  check(j.ms < 2000, `${what}: took ${j.ms.toFixed(0)} ms`);
+  if (check(c.ok === j.ok, `${what}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`)) stats.agree++;
+  if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${what}: differs from the C++ decode`);
+}
+const sources = ['rocket.svec', 'rocket-v1.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
+for (const file of sources) {
+  const bytes = fs.readFileSync(file), label = path.basename(file), version = bytes.readUInt32LE(8);
+  for (let k = 0; k < (label.startsWith('rocket') ? 20 : 8); k++) {
+    const at = pick(bytes.length);
+    mutant(bytes.subarray(0, at), `${label} cut at ${at}`);
+  }
+  for (let k = 0; k < 6; k++) {
+    const b = Buffer.from(bytes), at = 32 + pick(b.length - 32);
+    b[at] ^= 1 + pick(255);
+    mutant(b, `${label} byte ${at} flipped`);
+  }
+  // The payload itself, flipped and wrapped in a fresh frame: reaches the payload decoders.
+  const payload = Buffer.from(fzstd.decompress(bytes.subarray(32)));
+  for (let k = 0; k < 12; k++) {
+    const b = Buffer.from(payload), n = 1 + pick(3), where = [];
+    for (let i = 0; i < n; i++) {
+      const at = pick(b.length);
+      b[at] ^= 1 << pick(8);
+      where.push(at);
+    }
+    mutant(svecFile(b, version), `${label} payload bytes ${where.join(', ')} flipped`);
+  }
+}
+for (const m of mutants) fs.writeFileSync(m.file, m.bytes);
+const mutantVerdicts = await cppAll(mutants.map((m) => m.file));
+mutants.forEach((m, k) => judge(m, mutantVerdicts[k]));
+console.log(`  ${stats.runs} mutants: ${stats.rejected} rejected, ${stats.valid} valid; ${stats.agree} as C++; slowest ${stats.slowest.toFixed(1)} ms`);
+
+console.log(`(${((Date.now() - started) / 1000).toFixed(1)} s)`);
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);
