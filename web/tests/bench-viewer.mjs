@@ -10,7 +10,7 @@
 // is missing.
 import { readFileSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
-import { openViewer, bundle, pageMessage, Skip } from './viewer-render.mjs';
+import { openViewer, bundle as defaultBundle, pageMessage, Skip } from './viewer-render.mjs';
 
 const ZOOM_STEP = 1.25;  // one wheel notch of the element is about this much
 const ZOOM_STEPS = 10;   // zoom steps timed per run
@@ -28,20 +28,24 @@ async function bench([url, size, zoomStep, zoomSteps]) {
     const half = Math.max(w, h) / 2 / z;
     return { x0: cx - half, y0: cy - half, x1: cx + half, y1: cy + half };
   };
-  // A first frame on a new canvas: decode, renderer, refine, draw, sync.
+  // A first frame on a new canvas: renderer (context, shaders: the GPU process compiles them
+  // while the page decodes), decode, refine, draw, sync; in <subvec-image>'s order.
   const firstFrame = () => {
     const t0 = performance.now();
-    const image = decode(bytes, url.slice(url.lastIndexOf('/') + 1));
-    const t1 = performance.now();
     const canvas = document.createElement('canvas');
     canvas.width = canvas.height = size;
     document.body.append(canvas);
     const renderer = new SubvecRenderer(canvas);
+    const t1 = performance.now();
+    const image = decode(bytes, url.slice(url.lastIndexOf('/') + 1));
+    const t2 = performance.now();
     renderer.setImage(image, 0);
     renderer.setView(fit(image.width, image.height, 1));
     renderer.render();
+    const t3 = performance.now();
     sync(canvas);
-    return { image, canvas, renderer, time: { total: performance.now() - t0, decode: t1 - t0, ...renderer.stats } };
+    const t4 = performance.now();
+    return { image, canvas, renderer, time: { total: t4 - t0, setup: t1 - t0, decode: t2 - t1, render: t3 - t2, sync: t4 - t3, ...renderer.stats } };
   };
   const { image, canvas, renderer, time: first } = firstFrame();
   // Zooming in about a point off the centre (where the image has detail), as a wheel does.
@@ -84,7 +88,7 @@ async function main(argv) {
   const [file] = files;
   let viewer;
   try {
-    viewer = await openViewer();
+    viewer = await openViewer({ module: process.env.SUBVEC_VIEWER_BUNDLE || defaultBundle });
   } catch (e) {
     console.error(`bench-viewer: ${e instanceof Skip ? 'skipped: ' : ''}${e.message.split('\n')[0]}`);
     return e instanceof Skip ? 77 : 1;
@@ -106,7 +110,7 @@ async function main(argv) {
   const firsts = results.map((r) => r.first);
   const agains = results.map((r) => r.again);
   const zooms = results.flatMap((r) => r.zooms);
-  const js = readFileSync(bundle);
+  const js = readFileSync(process.env.SUBVEC_VIEWER_BUNDLE || defaultBundle);
   const row = (what, rs, extra) => `| ${what} | **${ms(median(rs.map((r) => r.total)))}** | ` +
     `${ms(Math.min(...rs.map((r) => r.total)))} – ${ms(Math.max(...rs.map((r) => r.total)))} | ${extra} |`;
   console.log(`${file}: ${results[0].vertices} vertices at level 0, canvas ${size} x ${size}, ` +
@@ -116,7 +120,8 @@ async function main(argv) {
   console.log('|---|---|---|---|');
   console.log(row('first frame after the fetch', firsts,
     `decode ${ms(median(firsts.map((r) => r.decode)))}, refine ${ms(median(firsts.map((r) => r.refineMs)))}, ` +
-    `draw ${ms(median(firsts.map((r) => r.drawMs)))}; depth ${median(firsts.map((r) => r.depth))}, ` +
+    `draw ${ms(median(firsts.map((r) => r.drawMs)))}, context and shaders ${ms(median(firsts.map((r) => r.setup)))}, ` +
+    `render() ${ms(median(firsts.map((r) => r.render)))}, GPU wait ${ms(median(firsts.map((r) => r.sync)))}; depth ${median(firsts.map((r) => r.depth))}, ` +
     `${median(firsts.map((r) => r.triangles))} triangles`));
   console.log(row('the same, a second file in that page', agains,
     `decode ${ms(median(agains.map((r) => r.decode)))}, refine ${ms(median(agains.map((r) => r.refineMs)))}`));

@@ -73,6 +73,7 @@ export class SubvecImageElement extends Base {
         this.resize.observe(this.canvas);  // browsers without that box
       }
     }
+    this.makeRenderer();
     this.schedule();
   }
 
@@ -99,6 +100,17 @@ export class SubvecImageElement extends Base {
       this.schedule();
     });
     return canvas;
+  }
+
+  // The renderer (its context and shaders) gets ready while the file is in flight; a failure
+  // here is reported by prepare() once the file is in.
+  private makeRenderer(): void {
+    if (!this.isConnected || this.renderer || !this.abort) return;
+    try {
+      this.renderer = new SubvecRenderer(this.canvas);
+    } catch {
+      // prepare() tries again and reports it
+    }
   }
 
   private forgetRenderer(): void {
@@ -194,6 +206,7 @@ export class SubvecImageElement extends Base {
     this.schedule();  // hides the old picture
     if (!src) return;
     this.abort = new AbortController();
+    this.makeRenderer();
     // fetch() resolves src against the page, and messages name it as the page wrote it.
     load(src, { signal: this.abort.signal })
       .then((image) => {

@@ -109,6 +109,8 @@ void main() {
   outColor = vec4(clamp(color / 255.0, 0.0, 1.0) * a, a);
 }`;
 
+// Compiles and links without waiting: the GPU process works on it while the page goes on (the
+// file is decoded meanwhile); `linked` asks for the result at first use.
 function compile(gl: WebGL2RenderingContext, vs: string, fs: string): WebGLProgram {
   const program = gl.createProgram();
   for (const [type, source] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]] as const) {
@@ -120,8 +122,12 @@ function compile(gl: WebGL2RenderingContext, vs: string, fs: string): WebGLProgr
     gl.deleteShader(shader);
   }
   gl.linkProgram(program);
-  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
-    throw new SvecError(`WebGL2: shader program failed: ${gl.getProgramInfoLog(program) ?? 'no log'}`);
+  return program;
+}
+
+function linked(gl: WebGL2RenderingContext, program: WebGLProgram): WebGLProgram {
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS) && !gl.isContextLost()) {
+    throw new SvecError(`WebGL2: shader program failed: ${gl.getProgramInfoLog(program) || 'no log'}`);
   }
   return program;
 }
@@ -168,9 +174,8 @@ export class SubvecRenderer {
   positionTolerance = 0.25;
   private readonly gl: WebGL2RenderingContext;
   private readonly mesh: WebGLProgram;
-  private readonly chord: WebGLProgram;
-  private readonly composite: WebGLProgram;
-  private readonly quad: WebGLBuffer;
+  private meshLinked = false;
+  private strokePrograms: { chord: WebGLProgram; composite: WebGLProgram; quad: WebGLBuffer } | null = null;
   private image: SvecImage | null = null;
   private level = 0;
   private topologies: Array<Topology | undefined> = [];
@@ -184,11 +189,29 @@ export class SubvecRenderer {
     if (!gl) throw new SvecError('this browser cannot draw the image: WebGL2 is not available');
     this.gl = gl as WebGL2RenderingContext;
     this.mesh = compile(this.gl, MESH_VS, MESH_FS);
-    this.chord = compile(this.gl, CHORD_VS, CHORD_FS);
-    this.composite = compile(this.gl, COMPOSITE_VS, COMPOSITE_FS);
-    this.quad = this.gl.createBuffer()!;
-    this.gl.bindBuffer(this.gl.ARRAY_BUFFER, this.quad);
-    this.gl.bufferData(this.gl.ARRAY_BUFFER, new Float32Array([0, 0, 1, 0, 0, 1, 1, 1]), this.gl.STATIC_DRAW);
+    this.warmUp();
+  }
+
+  // One empty draw in the mesh's state, so that the GPU process prepares its pipeline (software
+  // GL compiles the shaders to machine code there) while the page decodes and refines the file.
+  private warmUp(): void {
+    const gl = this.gl;
+    const vao = gl.createVertexArray(), vertices = gl.createBuffer(), indices = gl.createBuffer();
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(15), gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
+    gl.enableVertexAttribArray(1);
+    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array([0, 1, 2]), gl.STATIC_DRAW);
+    gl.useProgram(this.mesh);
+    gl.drawElements(gl.TRIANGLES, 3, gl.UNSIGNED_INT, 0);  // a degenerate triangle: no pixels
+    gl.bindVertexArray(null);
+    gl.deleteVertexArray(vao);
+    gl.deleteBuffer(vertices);
+    gl.deleteBuffer(indices);
   }
 
   /** Shows `image` (already validated by decode/load) at `level`. */
@@ -231,6 +254,7 @@ export class SubvecRenderer {
     const t1 = performance.now();
     this.stats.refineMs = cache ? t1 - t0 : 0;
     if (cache) {
+      if (!this.meshLinked) this.meshLinked = !!linked(gl, this.mesh);
       gl.useProgram(this.mesh);
       gl.uniform4f(gl.getUniformLocation(this.mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
       gl.uniform2f(gl.getUniformLocation(this.mesh, 'size'), width, height);
@@ -251,8 +275,13 @@ export class SubvecRenderer {
       gl.deleteFramebuffer(this.coverage.framebuffer);
       this.coverage = null;
     }
-    for (const p of [this.mesh, this.chord, this.composite]) gl.deleteProgram(p);
-    gl.deleteBuffer(this.quad);
+    gl.deleteProgram(this.mesh);
+    if (this.strokePrograms) {
+      gl.deleteProgram(this.strokePrograms.chord);
+      gl.deleteProgram(this.strokePrograms.composite);
+      gl.deleteBuffer(this.strokePrograms.quad);
+      this.strokePrograms = null;
+    }
     this.image = null;
   }
 
@@ -334,10 +363,11 @@ export class SubvecRenderer {
     if (strokes.length === 0) return;
     const gl = this.gl;
     const target = this.coverageTarget(view.width, view.height);
+    const { chord, composite, quad } = this.strokeState();
     const chords = gl.createBuffer()!;
     const vao = gl.createVertexArray()!;
     gl.bindVertexArray(vao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, this.quad);
+    gl.bindBuffer(gl.ARRAY_BUFFER, quad);
     gl.enableVertexAttribArray(0);
     gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 0, 0);
     gl.bindBuffer(gl.ARRAY_BUFFER, chords);
@@ -355,8 +385,8 @@ export class SubvecRenderer {
       gl.clearColor(0, 0, 0, 0);
       gl.clear(gl.COLOR_BUFFER_BIT);
       gl.blendEquation(gl.MAX);
-      gl.useProgram(this.chord);
-      gl.uniform2f(gl.getUniformLocation(this.chord, 'size'), view.width, view.height);
+      gl.useProgram(chord);
+      gl.uniform2f(gl.getUniformLocation(chord, 'size'), view.width, view.height);
       gl.bindBuffer(gl.ARRAY_BUFFER, chords);
       gl.bufferData(gl.ARRAY_BUFFER, data, gl.STREAM_DRAW);
       gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, data.length / 6);
@@ -364,10 +394,10 @@ export class SubvecRenderer {
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
       gl.blendEquation(gl.FUNC_ADD);
       gl.blendFunc(gl.ONE, gl.ONE_MINUS_SRC_ALPHA);
-      gl.useProgram(this.composite);
+      gl.useProgram(composite);
       gl.bindTexture(gl.TEXTURE_2D, target.texture);
-      gl.uniform1i(gl.getUniformLocation(this.composite, 'coverage'), 0);
-      gl.uniform3f(gl.getUniformLocation(this.composite, 'color'), ...stroke.color);
+      gl.uniform1i(gl.getUniformLocation(composite, 'coverage'), 0);
+      gl.uniform3f(gl.getUniformLocation(composite, 'color'), ...stroke.color);
       gl.vertexAttribDivisor(1, 0);
       gl.disableVertexAttribArray(1);
       gl.disableVertexAttribArray(2);
@@ -380,6 +410,18 @@ export class SubvecRenderer {
     gl.bindVertexArray(null);
     gl.deleteVertexArray(vao);
     gl.deleteBuffer(chords);
+  }
+
+  // The strokes' programs, made for the first image with strokes.
+  private strokeState() {
+    if (!this.strokePrograms) {
+      const gl = this.gl, quad = gl.createBuffer()!;
+      gl.bindBuffer(gl.ARRAY_BUFFER, quad);
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([0, 0, 1, 0, 0, 1, 1, 1]), gl.STATIC_DRAW);
+      const chord = compile(gl, CHORD_VS, CHORD_FS), composite = compile(gl, COMPOSITE_VS, COMPOSITE_FS);
+      this.strokePrograms = { chord: linked(gl, chord), composite: linked(gl, composite), quad };
+    }
+    return this.strokePrograms;
   }
 
   private coverageTarget(width: number, height: number) {

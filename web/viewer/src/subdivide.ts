@@ -55,31 +55,40 @@ export interface Topology {
 export function buildTopology(level: Level, width: number, height: number): Topology {
   const { positions: p, triangles: tri } = level;
   const nv = p.length / 2, nf = tri.length / 3;
-  // Edges by their sorted ends; a vertex pair fits a double exactly (nv < 2^26).
-  const index = new Map<number, number>();
-  const triEdges = new Int32Array(3 * nf);
-  const ends: number[] = [];
-  const faceCount: number[] = [];
+  // Faces around each vertex.
+  const vertexFaceOffsets = new Int32Array(nv + 1);
+  for (let i = 0; i < 3 * nf; ++i) vertexFaceOffsets[tri[i] + 1]++;
+  for (let v = 0; v < nv; ++v) vertexFaceOffsets[v + 1] += vertexFaceOffsets[v];
+  const vertexFaces = new Int32Array(3 * nf);
+  const fill = vertexFaceOffsets.slice(0, nv);
+  for (let i = 0; i < 3 * nf; ++i) vertexFaces[fill[tri[i]]++] = (i / 3) | 0;
+  // The corner index (3f + k) of the side a -> b, or -1: among the faces around a.
+  const side = (a: number, b: number) => {
+    for (let j = vertexFaceOffsets[a]; j < vertexFaceOffsets[a + 1]; ++j) {
+      const f = 3 * vertexFaces[j];
+      for (let k = 0; k < 3; ++k) if (tri[f + k] === a && tri[f + (k === 2 ? 0 : k + 1)] === b) return f + k;
+    }
+    return -1;
+  };
+  // Edges in order of first use; a side takes the edge of the opposite side seen before it.
+  const triEdges = new Int32Array(3 * nf).fill(-1), twin = new Int32Array(3 * nf);
+  const ends = new Int32Array(6 * nf);
+  let ne = 0;
   for (let i = 0; i < 3 * nf; ++i) {
     const a = tri[i], b = tri[i - (i % 3) + ((i + 1) % 3)];
-    const key = a < b ? a * nv + b : b * nv + a;
-    let e = index.get(key);
-    if (e === undefined) {
-      e = ends.length / 2;
-      index.set(key, e);
-      ends.push(a, b);
-      faceCount.push(0);
+    const o = (twin[i] = side(b, a));
+    if (o >= 0 && triEdges[o] >= 0) {
+      triEdges[i] = triEdges[o];
+    } else {
+      (ends[2 * ne] = a), (ends[2 * ne + 1] = b), (triEdges[i] = ne++);
     }
-    faceCount[e]++;
-    triEdges[i] = e;
   }
-  const ne = ends.length / 2;
-  const edgeVerts = Int32Array.from(ends);
+  const edgeVerts = ends.slice(0, 2 * ne);
   const edgeTags = new Uint8Array(ne);
-  for (let e = 0; e < ne; ++e) if (faceCount[e] < 2) edgeTags[e] = BORDER;
+  for (let i = 0; i < 3 * nf; ++i) if (twin[i] < 0) edgeTags[triEdges[i]] = BORDER;
   const tag = (a: number, b: number, t: number) => {
-    const e = index.get(a < b ? a * nv + b : b * nv + a);
-    if (e !== undefined) edgeTags[e] = t;
+    const i = side(a, b) >= 0 ? side(a, b) : side(b, a);
+    if (i >= 0) edgeTags[triEdges[i]] = t;
   };
   for (let i = 0; i < level.creases.length; i += 2) tag(level.creases[i], level.creases[i + 1], SHARP);
   const endpoint = new Uint8Array(nv);
@@ -103,13 +112,6 @@ export function buildTopology(level: Level, width: number, height: number): Topo
     const c = creases[v], t = tears[v];
     corner[v] = imageCorner || endpoint[v] || !((c === 0 && t === 0) || (c === 2 && t === 0) || (t === 2 && c === 0)) ? 1 : 0;
   }
-  // Faces around each vertex.
-  const vertexFaceOffsets = new Int32Array(nv + 1);
-  for (let i = 0; i < 3 * nf; ++i) vertexFaceOffsets[tri[i] + 1]++;
-  for (let v = 0; v < nv; ++v) vertexFaceOffsets[v + 1] += vertexFaceOffsets[v];
-  const vertexFaces = new Int32Array(3 * nf);
-  const fill = vertexFaceOffsets.slice(0, nv);
-  for (let i = 0; i < 3 * nf; ++i) vertexFaces[fill[tri[i]]++] = (i / 3) | 0;
   // Ring boxes: the limit patch of a face lies in the hull of the control points of the faces
   // around its corners (every mask is a convex combination), as the C++ renderer bounds it.
   const star = new Float64Array(4 * nv);
@@ -125,7 +127,7 @@ export function buildTopology(level: Level, width: number, height: number): Topo
         if (y > y1) y1 = y;
       }
     }
-    star.set([x0, y0, x1, y1], 4 * v);
+    (star[4 * v] = x0), (star[4 * v + 1] = y0), (star[4 * v + 2] = x1), (star[4 * v + 3] = y1);
   }
   const ringBoxes = new Float64Array(4 * nf);
   for (let f = 0; f < nf; ++f) {
@@ -159,7 +161,7 @@ export interface Refined {
 }
 
 // Smooth (Loop) masks of OpenSubdiv's Sdc::Scheme<SCHEME_LOOP>: edge weight of a valence-n vertex
-// for refinement and for the limit (valence 6: 1/16 and 1/12, in applyVertexRule).
+// for refinement and for the limit (valence 6: 1/16 and 1/12, in vertexPoints).
 function loopEdgeWeight(n: number): number {
   const beta = 0.25 * Math.cos((Math.PI * 2) / n) + 0.375;
   return (0.625 - beta * beta) / n;
@@ -170,76 +172,81 @@ function loopLimitEdgeWeight(n: number): number {
   return 1 / (n + 3 / (8 * gamma));
 }
 
-/** 0 smooth, 1 crease, 2 corner, per vertex of a level. */
-function vertexRules(m: Mesh): Uint8Array {
-  const rule = new Uint8Array(m.numVertices);
-  const sharp = new Uint8Array(m.numVertices);
-  for (let e = 0; e < m.edgeTags.length; ++e) {
-    if (m.edgeTags[e] === SMOOTH) continue;
-    sharp[m.edgeVerts[2 * e]]++;
-    sharp[m.edgeVerts[2 * e + 1]]++;
+// The vertex masks (refinement, or limit when `limit`) applied to the positions (2 per vertex) and
+// colors (3 per color value) of level m, into outPos and outCol. Each vertex's rule: corner (tagged,
+// or more than two sharp edges) keeps its value; exactly two sharp edges: crease; else smooth.
+// The sums run over the faces around each vertex and each color value: the neighbour after each
+// corner (the one-ring, for the smooth mask) and the sharp neighbours (for the crease mask).
+function vertexPoints(m: Mesh, pos: Float64Array, col: Float64Array, limit: boolean, outPos: Float64Array, outCol: Float64Array): void {
+  const nv = m.numVertices, nc = m.numValues, nf = m.tri.length / 3;
+  const { tri, triValues: tv, triEdges: te, edgeTags: tags, edgeVerts: ev } = m;
+  const sharpEdges = new Uint8Array(nv);
+  for (let e = 0; e < tags.length; ++e) {
+    if (tags[e] !== SMOOTH) sharpEdges[ev[2 * e]]++, sharpEdges[ev[2 * e + 1]]++;
   }
-  for (let v = 0; v < m.numVertices; ++v) rule[v] = m.corner[v] || sharp[v] > 2 ? 2 : sharp[v] === 2 ? 1 : 0;
-  return rule;
-}
-
-// Sums over the faces around each vertex (and each color value): the neighbours after each corner
-// (the one-ring, for the smooth masks) and the sharp neighbours (for the crease masks).
-interface Sums {
-  ring: Float64Array; // per vertex x, y; per value r, g, b
-  ringCount: Int32Array;
-  sharp: Float64Array;
-  sharpCount: Int32Array;
-}
-
-function gather(m: Mesh, data: Float64Array, channels: number, count: number, values: boolean): Sums {
-  const ring = new Float64Array(channels * count), sharp = new Float64Array(channels * count);
-  const ringCount = new Int32Array(count), sharpCount = new Int32Array(count);
-  const ids = values ? m.triValues : m.tri;
-  const nf = m.tri.length / 3;
+  const ringP = new Float64Array(2 * nv), sharpP = new Float64Array(2 * nv), ringC = new Float64Array(3 * nc), sharpC = new Float64Array(3 * nc);
+  const ringN = new Int32Array(nv), sharpN = new Int32Array(nv), ringNC = new Int32Array(nc), sharpNC = new Int32Array(nc);
   for (let f = 0; f < nf; ++f) {
     for (let k = 0; k < 3; ++k) {
-      const i = 3 * f + k, next = 3 * f + ((k + 1) % 3), prev = 3 * f + ((k + 2) % 3);
-      const v = ids[i], n = ids[next], p = ids[prev];
-      ringCount[v]++;
-      for (let c = 0; c < channels; ++c) ring[channels * v + c] += data[channels * n + c];
-      if (m.edgeTags[m.triEdges[i]] !== SMOOTH) {
-        sharpCount[v]++;
-        for (let c = 0; c < channels; ++c) sharp[channels * v + c] += data[channels * n + c];
+      const i = 3 * f + k, next = 3 * f + (k === 2 ? 0 : k + 1), prev = 3 * f + (k === 0 ? 2 : k - 1);
+      const v = 2 * tri[i], n = 2 * tri[next], p = 2 * tri[prev];
+      const c = 3 * tv[i], cn = 3 * tv[next], cp = 3 * tv[prev];
+      ringN[tri[i]]++, ringNC[tv[i]]++;
+      ringP[v] += pos[n], ringP[v + 1] += pos[n + 1];
+      ringC[c] += col[cn], ringC[c + 1] += col[cn + 1], ringC[c + 2] += col[cn + 2];
+      if (tags[te[i]] !== SMOOTH) {
+        sharpN[tri[i]]++, sharpNC[tv[i]]++;
+        sharpP[v] += pos[n], sharpP[v + 1] += pos[n + 1];
+        sharpC[c] += col[cn], sharpC[c + 1] += col[cn + 1], sharpC[c + 2] += col[cn + 2];
       }
-      if (m.edgeTags[m.triEdges[prev]] !== SMOOTH) {
-        sharpCount[v]++;
-        for (let c = 0; c < channels; ++c) sharp[channels * v + c] += data[channels * p + c];
+      if (tags[te[prev]] !== SMOOTH) {
+        sharpN[tri[i]]++, sharpNC[tv[i]]++;
+        sharpP[v] += pos[p], sharpP[v + 1] += pos[p + 1];
+        sharpC[c] += col[cp], sharpC[c + 1] += col[cp + 1], sharpC[c + 2] += col[cp + 2];
       }
     }
   }
-  return { ring, ringCount, sharp, sharpCount };
-}
-
-// New values of the vertices (or color values) under the vertex masks: refinement or limit.
-function applyVertexRule(data: Float64Array, channels: number, count: number, rule: (i: number) => number,
-                         s: Sums, limit: boolean, out: Float64Array): void {
+  // Per vertex the weights of itself and of the sums (crease: the sharp sum, smooth: the ring).
   const crease = limit ? 2 / 3 : 0.75, regular = limit ? 1 / 12 : 0.0625;
-  for (let i = 0; i < count; ++i) {
-    const r = rule(i), o = channels * i;
-    if (r === 2 || (r === 1 && s.sharpCount[i] === 0)) {
-      for (let c = 0; c < channels; ++c) out[o + c] = data[o + c];
-    } else if (r === 1) {
-      const w = (1 - crease) / s.sharpCount[i];
-      for (let c = 0; c < channels; ++c) out[o + c] = crease * data[o + c] + w * s.sharp[o + c];
+  const self = new Float64Array(nv), other = new Float64Array(nv), useRing = new Uint8Array(nv);
+  for (let v = 0; v < nv; ++v) {
+    const s = sharpEdges[v];
+    if (m.corner[v] || s > 2 || (s === 2 && sharpN[v] === 0)) {
+      self[v] = 1;
+    } else if (s === 2) {
+      self[v] = crease;
+      other[v] = (1 - crease) / sharpN[v];
     } else {
-      const n = s.ringCount[i];
-      const ew = n === 6 ? regular : limit ? loopLimitEdgeWeight(n) : loopEdgeWeight(n);
-      const vw = 1 - ew * n;
-      for (let c = 0; c < channels; ++c) out[o + c] = vw * data[o + c] + ew * s.ring[o + c];
+      const n = ringN[v], w = n === 6 ? regular : limit ? loopLimitEdgeWeight(n) : loopEdgeWeight(n);
+      self[v] = 1 - w * n;
+      other[v] = w;
+      useRing[v] = 1;
     }
+  }
+  for (let v = 0; v < nv; ++v) {
+    const a = self[v], b = other[v], sum = useRing[v] ? ringP : sharpP;
+    outPos[2 * v] = a * pos[2 * v] + b * sum[2 * v];
+    outPos[2 * v + 1] = a * pos[2 * v + 1] + b * sum[2 * v + 1];
+  }
+  // A color value's crease mask counts its own side's sharp neighbours.
+  for (let c = 0; c < nc; ++c) {
+    const v = m.valueVertex[c], o = 3 * c;
+    let a = self[v], b = other[v];
+    const sum = useRing[v] ? ringC : sharpC;
+    if (!useRing[v] && b !== 0) b = sharpNC[c] ? (1 - crease) / sharpNC[c] : ((a = 1), 0);
+    else if (useRing[v] && ringNC[c] !== ringN[v]) {
+      const n = ringNC[c], w = n === 6 ? regular : limit ? loopLimitEdgeWeight(n) : loopEdgeWeight(n);
+      (a = 1 - w * n), (b = w);
+    }
+    outCol[o] = a * col[o] + b * sum[o];
+    outCol[o + 1] = a * col[o + 1] + b * sum[o + 1];
+    outCol[o + 2] = a * col[o + 2] + b * sum[o + 2];
   }
 }
 
 // One step of Loop subdivision: topology, positions and colors.
 function refineOnce(m: Mesh, pos: Float64Array, col: Float64Array, sides: Int32Array): { mesh: Mesh; pos: Float64Array; col: Float64Array; sides: Int32Array } {
   const nv = m.numVertices, nc = m.numValues, nf = m.tri.length / 3, ne = m.edgeTags.length;
-  const rules = vertexRules(m);
   const { tri, triValues: tv, triEdges: te, edgeVerts: ev, edgeTags: tags } = m;
 
   // Edge values: one per edge, two for a tear (side 0: the face that runs it edgeVerts[0] -> [1]).
@@ -253,8 +260,7 @@ function refineOnce(m: Mesh, pos: Float64Array, col: Float64Array, sides: Int32A
   // Vertex points.
   const newPos = new Float64Array(2 * (nv + ne));
   const newCol = new Float64Array(3 * numValues);
-  applyVertexRule(pos, 2, nv, (v) => rules[v], gather(m, pos, 2, nv, false), false, newPos);
-  applyVertexRule(col, 3, nc, (c) => rules[m.valueVertex[c]], gather(m, col, 3, nc, true), false, newCol);
+  vertexPoints(m, pos, col, false, newPos, newCol);
 
   // Edge points: 1/8 of the opposite corners gathered per face, then the ends.
   const opposite = new Float64Array(2 * ne);
@@ -429,10 +435,8 @@ export function refine(topo: Topology, faces: Int32Array | null, depth: number):
   }
 
   // Limit positions and colors, one output vertex per color value.
-  const rules = vertexRules(mesh);
   const limitPos = new Float64Array(pos.length), limitCol = new Float64Array(col.length);
-  applyVertexRule(pos, 2, mesh.numVertices, (v) => rules[v], gather(mesh, pos, 2, mesh.numVertices, false), true, limitPos);
-  applyVertexRule(col, 3, mesh.numValues, (c) => rules[mesh.valueVertex[c]], gather(mesh, col, 3, mesh.numValues, true), true, limitCol);
+  vertexPoints(mesh, pos, col, true, limitPos, limitCol);
   const vertices = new Float32Array(5 * mesh.numValues);
   for (let c = 0; c < mesh.numValues; ++c) {
     const v = mesh.valueVertex[c];
@@ -506,10 +510,13 @@ export function adaptiveIndices(r: Refined, scale: number, colorTolerance: numbe
       }
     }
   }
-  const out: number[] = [];
+  // A face at depth d < D gives at most 4 triangles per level-d triangle: at most the uniform count.
+  const out = new Uint32Array(3 * n * 4 ** D);
+  let size = 0;
   for (let f = 0; f < n; ++f) {
     const d = depthOf[f];
     const { values, sides } = r.levels[d];
+    const child = d < D ? r.levels[d + 1].values : values;
     for (let t = f * 4 ** d; t < (f + 1) * 4 ** d; ++t) {
       // Sides whose neighbour across the control edge is a level deeper.
       let split = 0;
@@ -517,23 +524,24 @@ export function adaptiveIndices(r: Refined, scale: number, colorTolerance: numbe
         const e = sides[3 * t + k], g = e >= 0 ? neighbour(f, e) : -1;
         if (g >= 0 && g < n && depthOf[g] > d) split |= 1 << k;
       }
-      const v = (k: number) => values[3 * t + (k % 3)];
+      const v = 3 * t, m = 3 * (4 * t + 3);
       if (split === 0) {
-        out.push(v(0), v(1), v(2));
-        continue;
-      }
-      const child = r.levels[d + 1].values, mid = (k: number) => child[3 * (4 * t + 3) + (k % 3)];
-      if (split === 7) {
-        for (let i = 3 * 4 * t; i < 3 * (4 * t + 4); ++i) out.push(child[i]);
+        out[size++] = values[v], out[size++] = values[v + 1], out[size++] = values[v + 2];
+      } else if (split === 7) {
+        for (let i = 12 * t; i < 12 * t + 12; ++i) out[size++] = child[i];
       } else if (split === 1 || split === 2 || split === 4) {
-        const k = split === 1 ? 0 : split === 2 ? 1 : 2; // the split side: corner k to k + 1
-        out.push(v(k), mid(k), v(k + 2), mid(k), v(k + 1), v(k + 2));
+        // the split side: corner k to k1; two triangles
+        const k = split >> 1, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        out[size++] = values[v + k], out[size++] = child[m + k], out[size++] = values[v + k2];
+        out[size++] = child[m + k], out[size++] = values[v + k1], out[size++] = values[v + k2];
       } else {
-        const j = split === 6 ? 0 : split === 5 ? 1 : 2; // the whole side: corner j to j + 1
-        const k = j + 1; // sides k and k + 1 split: corners a = k, b = k + 1, c = k + 2
-        out.push(v(k), mid(k), v(k + 2), mid(k), v(k + 1), mid(k + 1), mid(k), mid(k + 1), v(k + 2));
+        // the whole side: corner j to j + 1; sides k and k1 split (corners k, k1, k2): three triangles
+        const k = split === 6 ? 1 : split === 5 ? 2 : 0, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        out[size++] = values[v + k], out[size++] = child[m + k], out[size++] = values[v + k2];
+        out[size++] = child[m + k], out[size++] = values[v + k1], out[size++] = child[m + k1];
+        out[size++] = child[m + k], out[size++] = child[m + k1], out[size++] = values[v + k2];
       }
     }
   }
-  return Uint32Array.from(out);
+  return out.slice(0, size);
 }

@@ -21,6 +21,7 @@ export declare class SubvecImageElement extends Base {
     connectedCallback(): void;
     disconnectedCallback(): void;
     private makeCanvas;
+    private makeRenderer;
     private forgetRenderer;
     attributeChangedCallback(name: string, old: string | null, value: string | null): void;
     get src(): string;

@@ -32,9 +32,8 @@ export declare class SubvecRenderer {
     positionTolerance: number;
     private readonly gl;
     private readonly mesh;
-    private readonly chord;
-    private readonly composite;
-    private readonly quad;
+    private meshLinked;
+    private strokePrograms;
     private image;
     private level;
     private topologies;
@@ -42,6 +41,7 @@ export declare class SubvecRenderer {
     private cache;
     private coverage;
     constructor(canvas: HTMLCanvasElement | OffscreenCanvas);
+    private warmUp;
     /** Shows `image` (already validated by decode/load) at `level`. */
     setImage(image: SvecImage, level?: number): void;
     setLevel(level: number): void;
@@ -56,5 +56,6 @@ export declare class SubvecRenderer {
     private uploadIndices;
     private dropCache;
     private drawStrokes;
+    private strokeState;
     private coverageTarget;
 }
