@@ -31,101 +31,101 @@ export class SubvecImageElement extends Base {
     return ['src', 'level', 'interactive'];
   }
 
-  private canvas: HTMLCanvasElement;
-  private sizeStyle: HTMLStyleElement;
-  private renderer: SubvecRenderer | null = null;
-  private current: SvecImage | null = null;
-  private shownLevel = -1;      // the level last handed to the renderer, -1: none
-  private ready = false;        // the renderer holds this.current at shownLevel
-  private window: ViewWindow | null = null;
-  private errorText: string | null = null;
-  private generation = 0;       // a newer src makes older loads' results stale
-  private abort: AbortController | null = null;
-  private frame = 0;            // the pending requestAnimationFrame, 0: none
-  private resize: ResizeObserver | null = null;
-  private drag: { id: number; x: number; y: number; view: ViewWindow } | null = null;
-  private readonly wheel = (e: WheelEvent) => this.onWheel(e);
+  #canvas: HTMLCanvasElement;
+  #sizeStyle: HTMLStyleElement;
+  #renderer: SubvecRenderer | null = null;
+  #current: SvecImage | null = null;
+  #shownLevel = -1;      // the level last handed to the renderer, -1: none
+  #ready = false;        // the renderer holds this.#current at shownLevel
+  #window: ViewWindow | null = null;
+  #errorText: string | null = null;
+  #generation = 0;       // a newer src makes older loads' results stale
+  #abort: AbortController | null = null;
+  #frame = 0;            // the pending requestAnimationFrame, 0: none
+  #resize: ResizeObserver | null = null;
+  #drag: { id: number; x: number; y: number; view: ViewWindow } | null = null;
+  readonly #wheel = (e: WheelEvent) => this.#onWheel(e);
 
   constructor() {
     super();
     const root = this.attachShadow({ mode: 'open' });
     const style = document.createElement('style');
     style.textContent = STYLE;
-    this.sizeStyle = document.createElement('style');
-    this.canvas = this.makeCanvas();
-    root.append(style, this.sizeStyle, this.canvas);
-    this.addEventListener('pointerdown', (e) => this.onPointerDown(e));
-    this.addEventListener('pointermove', (e) => this.onPointerMove(e));
-    this.addEventListener('pointerup', (e) => this.onPointerUp(e));
-    this.addEventListener('pointercancel', (e) => this.onPointerUp(e));
+    this.#sizeStyle = document.createElement('style');
+    this.#canvas = this.#makeCanvas();
+    root.append(style, this.#sizeStyle, this.#canvas);
+    this.addEventListener('pointerdown', (e) => this.#onPointerDown(e));
+    this.addEventListener('pointermove', (e) => this.#onPointerMove(e));
+    this.addEventListener('pointerup', (e) => this.#onPointerUp(e));
+    this.addEventListener('pointercancel', (e) => this.#onPointerUp(e));
     this.addEventListener('dblclick', () => {
-      if (this.interactive) this.changeView(null);
+      if (this.interactive) this.#changeView(null);
     });
   }
 
   connectedCallback(): void {
-    if (typeof ResizeObserver !== 'undefined' && !this.resize) {
-      this.resize = new ResizeObserver(() => this.schedule());
+    if (typeof ResizeObserver !== 'undefined' && !this.#resize) {
+      this.#resize = new ResizeObserver(() => this.#schedule());
       // The device-pixel box also changes with the device pixel ratio (browser zoom, screens).
       try {
-        this.resize.observe(this.canvas, { box: 'device-pixel-content-box' });
+        this.#resize.observe(this.#canvas, { box: 'device-pixel-content-box' });
       } catch {
-        this.resize.observe(this.canvas);  // browsers without that box
+        this.#resize.observe(this.#canvas);  // browsers without that box
       }
     }
-    this.makeRenderer();
-    this.schedule();
+    this.#makeRenderer();
+    this.#schedule();
   }
 
   disconnectedCallback(): void {
     // Browsers keep few WebGL contexts alive: give this one back; a reconnect draws on a new canvas.
-    this.resize?.disconnect();
-    this.resize = null;
-    if (this.frame) cancelAnimationFrame(this.frame);
-    this.frame = 0;
-    this.renderer?.dispose();
-    this.forgetRenderer();
-    const fresh = this.makeCanvas();
-    this.canvas.replaceWith(fresh);
-    this.canvas = fresh;
+    this.#resize?.disconnect();
+    this.#resize = null;
+    if (this.#frame) cancelAnimationFrame(this.#frame);
+    this.#frame = 0;
+    this.#renderer?.dispose();
+    this.#forgetRenderer();
+    const fresh = this.#makeCanvas();
+    this.#canvas.replaceWith(fresh);
+    this.#canvas = fresh;
   }
 
   // A lost context (a GPU reset, too many contexts) comes back when the page asks for that; the
   // renderer's GL objects died with it, so a new renderer draws on the restored one.
-  private makeCanvas(): HTMLCanvasElement {
+  #makeCanvas(): HTMLCanvasElement {
     const canvas = document.createElement('canvas');
     canvas.addEventListener('webglcontextlost', (e) => e.preventDefault());
     canvas.addEventListener('webglcontextrestored', () => {
-      this.forgetRenderer();
-      this.schedule();
+      this.#forgetRenderer();
+      this.#schedule();
     });
     return canvas;
   }
 
   // The renderer (its context and shaders) gets ready while the file is in flight; a failure
   // here is reported by prepare() once the file is in.
-  private makeRenderer(): void {
-    if (!this.isConnected || this.renderer || !this.abort) return;
+  #makeRenderer(): void {
+    if (!this.isConnected || this.#renderer || !this.#abort) return;
     try {
-      this.renderer = new SubvecRenderer(this.canvas);
+      this.#renderer = new SubvecRenderer(this.#canvas);
     } catch {
       // prepare() tries again and reports it
     }
   }
 
-  private forgetRenderer(): void {
-    this.renderer = null;
-    this.ready = false;
-    this.shownLevel = -1;
+  #forgetRenderer(): void {
+    this.#renderer = null;
+    this.#ready = false;
+    this.#shownLevel = -1;
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
     if (old === value) return;
-    if (name === 'src') this.startLoad(value);
-    else if (name === 'level') this.schedule();
+    if (name === 'src') this.#startLoad(value);
+    else if (name === 'level') this.#schedule();
     // Only an interactive element takes the wheel: a blocking wheel listener slows scrolling.
-    else if (value === null) this.removeEventListener('wheel', this.wheel);
-    else this.addEventListener('wheel', this.wheel, { passive: false });
+    else if (value === null) this.removeEventListener('wheel', this.#wheel);
+    else this.addEventListener('wheel', this.#wheel, { passive: false });
   }
 
   get src(): string {
@@ -154,24 +154,24 @@ export class SubvecImageElement extends Base {
 
   /** The message of the last problem (loading, decoding, drawing), null when there is none. */
   get error(): string | null {
-    return this.errorText;
+    return this.#errorText;
   }
 
   /** The decoded file, null until it is loaded. */
   get image(): SvecImage | null {
-    return this.current;
+    return this.#current;
   }
 
   get naturalWidth(): number {
-    return this.current?.width ?? 0;
+    return this.#current?.width ?? 0;
   }
   get naturalHeight(): number {
-    return this.current?.height ?? 0;
+    return this.#current?.height ?? 0;
   }
 
   /** What the last frame cost (the renderer's stats), null before the first one. */
   get stats(): SubvecRenderer['stats'] | null {
-    return this.renderer && this.shownLevel >= 0 ? this.renderer.stats : null;
+    return this.#renderer && this.#shownLevel >= 0 ? this.#renderer.stats : null;
   }
 
   /**
@@ -179,7 +179,7 @@ export class SubvecImageElement extends Base {
    * image. Setting it draws again at the next frame.
    */
   get view(): ViewWindow | null {
-    return this.window ? { ...this.window } : null;
+    return this.#window ? { ...this.#window } : null;
   }
   set view(w: ViewWindow | null) {
     this.setView(w);
@@ -187,47 +187,47 @@ export class SubvecImageElement extends Base {
 
   setView(w: ViewWindow | null): void {
     if (w !== null && !(w && typeof w === 'object' && validWindow(w))) {
-      this.fail(new SvecError('view window must have finite x0 < x1 and y0 < y1, or be null'));
+      this.#fail(new SvecError('view window must have finite x0 < x1 and y0 < y1, or be null'));
       return;
     }
-    this.window = w ? { x0: w.x0, y0: w.y0, x1: w.x1, y1: w.y1 } : null;
-    this.schedule();
+    this.#window = w ? { x0: w.x0, y0: w.y0, x1: w.x1, y1: w.y1 } : null;
+    this.#schedule();
   }
 
-  private startLoad(src: string | null): void {
-    const generation = ++this.generation;
-    this.abort?.abort();
-    this.abort = null;
-    this.current = null;
-    this.ready = false;
-    this.shownLevel = -1;
-    this.errorText = null;
-    this.setNaturalSize(null);
-    this.schedule();  // hides the old picture
+  #startLoad(src: string | null): void {
+    const generation = ++this.#generation;
+    this.#abort?.abort();
+    this.#abort = null;
+    this.#current = null;
+    this.#ready = false;
+    this.#shownLevel = -1;
+    this.#errorText = null;
+    this.#setNaturalSize(null);
+    this.#schedule();  // hides the old picture
     if (!src) return;
-    this.abort = new AbortController();
-    this.makeRenderer();
+    this.#abort = new AbortController();
+    this.#makeRenderer();
     // fetch() resolves src against the page, and messages name it as the page wrote it.
-    load(src, { signal: this.abort.signal })
+    load(src, { signal: this.#abort.signal })
       .then((image) => {
-        if (generation !== this.generation) return;
-        this.current = image;
-        this.setNaturalSize(image);
+        if (generation !== this.#generation) return;
+        this.#current = image;
+        this.#setNaturalSize(image);
         // The level is checked now, so that a bad one is this load's error rather than a load.
-        if (this.prepare()) {
-          this.emit('load', { width: image.width, height: image.height, levels: image.levels.length });
+        if (this.#prepare()) {
+          this.#emit('load', { width: image.width, height: image.height, levels: image.levels.length });
         }
       })
       .catch((e) => {
-        if (generation === this.generation) this.fail(e);
+        if (generation === this.#generation) this.#fail(e);
       });
   }
 
   // The fallback width is for browsers without contain-intrinsic-size (Safari before 17), where
   // a CSS height alone then letterboxes the image instead of setting the width.
-  private setNaturalSize(image: SvecImage | null): void {
+  #setNaturalSize(image: SvecImage | null): void {
     const w = image?.width, h = image?.height;
-    this.sizeStyle.textContent = image
+    this.#sizeStyle.textContent = image
       ? `:host{aspect-ratio:${w}/${h};contain-intrinsic-size:${w}px ${h}px}` +
         `@supports not (contain-intrinsic-size:1px){:host{width:${w}px}}`
       : '';
@@ -235,59 +235,59 @@ export class SubvecImageElement extends Base {
 
   // Gives the renderer (made at first use) the image at the wanted level. Tried once per level:
   // false, with one error event, when that fails.
-  private prepare(): boolean {
-    if (!this.current) return false;
-    if (this.shownLevel === this.level) return this.ready;
-    this.shownLevel = this.level;
-    this.ready = false;
+  #prepare(): boolean {
+    if (!this.#current) return false;
+    if (this.#shownLevel === this.level) return this.#ready;
+    this.#shownLevel = this.level;
+    this.#ready = false;
     try {
-      this.renderer ??= new SubvecRenderer(this.canvas);
-      this.renderer.setImage(this.current, this.level);
-      this.ready = true;
-      this.errorText = null;
+      this.#renderer ??= new SubvecRenderer(this.#canvas);
+      this.#renderer.setImage(this.#current, this.level);
+      this.#ready = true;
+      this.#errorText = null;
     } catch (e) {
-      this.fail(e);
+      this.#fail(e);
     }
-    this.schedule();
-    return this.ready;
+    this.#schedule();
+    return this.#ready;
   }
 
   // Re-renders are coalesced: any number of changes within a frame draw once.
-  private schedule(): void {
-    if (this.frame || typeof requestAnimationFrame === 'undefined') return;
-    this.frame = requestAnimationFrame(() => {
-      this.frame = 0;
-      this.draw();
+  #schedule(): void {
+    if (this.#frame || typeof requestAnimationFrame === 'undefined') return;
+    this.#frame = requestAnimationFrame(() => {
+      this.#frame = 0;
+      this.#draw();
     });
   }
 
-  private draw(): void {
+  #draw(): void {
     if (!this.isConnected) return;
-    const shown = this.prepare();
+    const shown = this.#prepare();
     // Nothing is shown while loading or after a failure, as an <img> shows no stale picture.
-    this.canvas.style.visibility = shown ? '' : 'hidden';
-    if (!shown || !this.renderer) return;
+    this.#canvas.style.visibility = shown ? '' : 'hidden';
+    if (!shown || !this.#renderer) return;
     const ratio = window.devicePixelRatio || 1;
     // Read now, not from the ResizeObserver: its sizes come after this frame's layout.
-    const width = Math.round(this.canvas.clientWidth * ratio);
-    const height = Math.round(this.canvas.clientHeight * ratio);
+    const width = Math.round(this.#canvas.clientWidth * ratio);
+    const height = Math.round(this.#canvas.clientHeight * ratio);
     if (width < 1 || height < 1) return;  // not laid out: the ResizeObserver calls again
-    if (this.canvas.width !== width) this.canvas.width = width;
-    if (this.canvas.height !== height) this.canvas.height = height;
+    if (this.#canvas.width !== width) this.#canvas.width = width;
+    if (this.#canvas.height !== height) this.#canvas.height = height;
     try {
-      this.renderer.setView(this.shownWindow());
-      this.renderer.render();
-      this.emit('render', { ...this.renderer.stats });
+      this.#renderer.setView(this.#shownWindow());
+      this.#renderer.render();
+      this.#emit('render', { ...this.#renderer.stats });
     } catch (e) {
-      this.fail(e);
+      this.#fail(e);
     }
   }
 
   // The view (or the whole image) grown to the canvas's aspect about its centre: contain, centred.
-  private shownWindow(): ViewWindow {
-    const image = this.current!;
-    const w = this.window ?? { x0: 0, y0: 0, x1: image.width, y1: image.height };
-    const aspect = this.canvas.width / this.canvas.height;
+  #shownWindow(): ViewWindow {
+    const image = this.#current!;
+    const w = this.#window ?? { x0: 0, y0: 0, x1: image.width, y1: image.height };
+    const aspect = this.#canvas.width / this.#canvas.height;
     const cx = (w.x0 + w.x1) / 2, cy = (w.y0 + w.y1) / 2;
     let hw = (w.x1 - w.x0) / 2, hh = (w.y1 - w.y0) / 2;
     if (hw / hh < aspect) hw = hh * aspect;
@@ -296,61 +296,61 @@ export class SubvecImageElement extends Base {
   }
 
   // A view change by the user: kept as the window shown, so that later steps do not drift.
-  private changeView(w: ViewWindow | null): void {
-    this.window = w;
-    this.schedule();
-    this.emit('viewchange', this.view);
+  #changeView(w: ViewWindow | null): void {
+    this.#window = w;
+    this.#schedule();
+    this.#emit('viewchange', this.view);
   }
 
   // The image point under a client position, in the window shown now.
-  private imagePoint(e: MouseEvent, w: ViewWindow): [number, number] {
-    const r = this.canvas.getBoundingClientRect();
+  #imagePoint(e: MouseEvent, w: ViewWindow): [number, number] {
+    const r = this.#canvas.getBoundingClientRect();
     const u = r.width > 0 ? (e.clientX - r.left) / r.width : 0.5;
     const v = r.height > 0 ? (e.clientY - r.top) / r.height : 0.5;
     return [w.x0 + u * (w.x1 - w.x0), w.y0 + v * (w.y1 - w.y0)];
   }
 
-  private onWheel(e: WheelEvent): void {
-    if (!this.interactive || !this.ready || !this.canvas.width) return;
+  #onWheel(e: WheelEvent): void {
+    if (!this.interactive || !this.#ready || !this.#canvas.width) return;
     e.preventDefault();
-    const w = this.shownWindow();
-    const [px, py] = this.imagePoint(e, w);
+    const w = this.#shownWindow();
+    const [px, py] = this.#imagePoint(e, w);
     const pixels = e.deltaMode === 1 ? e.deltaY * 16 : e.deltaMode === 2 ? e.deltaY * 400 : e.deltaY;
-    const ww = w.x1 - w.x0, iw = this.current!.width;
+    const ww = w.x1 - w.x0, iw = this.#current!.width;
     // > 1 zooms out; kept between MAX_ZOOM x and an eighth of the image's size
     const f = Math.min(Math.max(Math.exp(pixels * 0.002), iw / MAX_ZOOM / ww), (8 * iw) / ww);
-    this.changeView({ x0: px + (w.x0 - px) * f, y0: py + (w.y0 - py) * f,
+    this.#changeView({ x0: px + (w.x0 - px) * f, y0: py + (w.y0 - py) * f,
       x1: px + (w.x1 - px) * f, y1: py + (w.y1 - py) * f });
   }
 
-  private onPointerDown(e: PointerEvent): void {
-    if (!this.interactive || !this.ready || e.button !== 0 || !this.canvas.width) return;
-    this.drag = { id: e.pointerId, x: e.clientX, y: e.clientY, view: this.shownWindow() };
+  #onPointerDown(e: PointerEvent): void {
+    if (!this.interactive || !this.#ready || e.button !== 0 || !this.#canvas.width) return;
+    this.#drag = { id: e.pointerId, x: e.clientX, y: e.clientY, view: this.#shownWindow() };
     this.setPointerCapture(e.pointerId);
-    this.canvas.style.cursor = 'grabbing';
+    this.#canvas.style.cursor = 'grabbing';
   }
 
-  private onPointerMove(e: PointerEvent): void {
-    const d = this.drag;
+  #onPointerMove(e: PointerEvent): void {
+    const d = this.#drag;
     if (!d || e.pointerId !== d.id) return;
-    const scale = (d.view.x1 - d.view.x0) / Math.max(1, this.canvas.clientWidth);
+    const scale = (d.view.x1 - d.view.x0) / Math.max(1, this.#canvas.clientWidth);
     const dx = (e.clientX - d.x) * scale, dy = (e.clientY - d.y) * scale;
-    this.changeView({ x0: d.view.x0 - dx, y0: d.view.y0 - dy, x1: d.view.x1 - dx, y1: d.view.y1 - dy });
+    this.#changeView({ x0: d.view.x0 - dx, y0: d.view.y0 - dy, x1: d.view.x1 - dx, y1: d.view.y1 - dy });
   }
 
-  private onPointerUp(e: PointerEvent): void {
-    if (!this.drag || e.pointerId !== this.drag.id) return;
-    this.drag = null;
-    this.canvas.style.cursor = '';
+  #onPointerUp(e: PointerEvent): void {
+    if (!this.#drag || e.pointerId !== this.#drag.id) return;
+    this.#drag = null;
+    this.#canvas.style.cursor = '';
   }
 
-  private fail(e: unknown): void {
-    this.errorText = message(e);
-    this.emit('error', { message: this.errorText });
+  #fail(e: unknown): void {
+    this.#errorText = message(e);
+    this.#emit('error', { message: this.#errorText });
   }
 
   // A listener's exception is reported by the browser and does not come back out of here.
-  private emit(type: string, detail: unknown): void {
+  #emit(type: string, detail: unknown): void {
     this.dispatchEvent(new CustomEvent(type, { detail }));
   }
 }

@@ -48,16 +48,18 @@ export function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom:
   return k;
 }
 
+// The shaders' text ships in the bundle, so it has no comments or indentation. view: the window's
+// origin (image pixels) and output pixels per image pixel; size: the output in pixels.
 const MESH_VS = `#version 300 es
 layout(location = 0) in vec2 position;
 layout(location = 1) in vec3 color;
-uniform vec4 view;   // window origin (image pixels), output pixels per image pixel
-uniform vec2 size;   // output pixels
+uniform vec4 view;
+uniform vec2 size;
 out vec3 shade;
 void main() {
-  vec2 o = (position - view.xy) * view.zw;
-  gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
-  shade = color;
+vec2 o = (position - view.xy) * view.zw;
+gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
+shade = color;
 }`;
 const MESH_FS = `#version 300 es
 precision highp float;
@@ -65,21 +67,22 @@ in vec3 shade;
 out vec4 outColor;
 void main() { outColor = vec4(clamp(shade / 255.0, 0.0, 1.0), 1.0); }`;
 
-// One instanced quad per chord, covering the chord's capsule plus a pixel.
+// One instanced quad per chord, covering the chord's capsule plus a pixel: ends x0, y0, x1, y1 and
+// p, the pixel centre, in output pixels, y down.
 const CHORD_VS = `#version 300 es
 layout(location = 0) in vec2 corner;
-layout(location = 1) in vec4 ends;   // x0, y0, x1, y1 (output pixels)
+layout(location = 1) in vec4 ends;
 layout(location = 2) in vec2 radii;
 uniform vec2 size;
 out vec4 vEnds;
 out vec2 vRadii;
 void main() {
-  float reach = max(radii.x, radii.y) + 1.0;
-  vec2 lo = min(ends.xy, ends.zw) - reach, hi = max(ends.xy, ends.zw) + reach;
-  vec2 o = mix(lo, hi, corner);
-  gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
-  vEnds = ends;
-  vRadii = radii;
+float reach = max(radii.x, radii.y) + 1.0;
+vec2 lo = min(ends.xy, ends.zw) - reach, hi = max(ends.xy, ends.zw) + reach;
+vec2 o = mix(lo, hi, corner);
+gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
+vEnds = ends;
+vRadii = radii;
 }`;
 const CHORD_FS = `#version 300 es
 precision highp float;
@@ -88,12 +91,12 @@ in vec2 vRadii;
 uniform vec2 size;
 out vec4 coverage;
 void main() {
-  vec2 p = vec2(gl_FragCoord.x, size.y - gl_FragCoord.y);  // output pixel centre, y down
-  vec2 a = vEnds.xy, d = vEnds.zw - vEnds.xy;
-  float len2 = dot(d, d);
-  float u = len2 > 0.0 ? clamp(dot(p - a, d) / len2, 0.0, 1.0) : 0.0;
-  float dist = length(p - (a + u * d)), r = mix(vRadii.x, vRadii.y, u);
-  coverage = vec4(clamp(min(dist + r, 0.5) - max(dist - r, -0.5), 0.0, 1.0));
+vec2 p = vec2(gl_FragCoord.x, size.y - gl_FragCoord.y);
+vec2 a = vEnds.xy, d = vEnds.zw - vEnds.xy;
+float len2 = dot(d, d);
+float u = len2 > 0.0 ? clamp(dot(p - a, d) / len2, 0.0, 1.0) : 0.0;
+float dist = length(p - (a + u * d)), r = mix(vRadii.x, vRadii.y, u);
+coverage = vec4(clamp(min(dist + r, 0.5) - max(dist - r, -0.5), 0.0, 1.0));
 }`;
 // Source-over of one stroke's color with its coverage (premultiplied output).
 const COMPOSITE_VS = `#version 300 es
@@ -105,8 +108,8 @@ uniform sampler2D coverage;
 uniform vec3 color;
 out vec4 outColor;
 void main() {
-  float a = texelFetch(coverage, ivec2(gl_FragCoord.xy), 0).r;
-  outColor = vec4(clamp(color / 255.0, 0.0, 1.0) * a, a);
+float a = texelFetch(coverage, ivec2(gl_FragCoord.xy), 0).r;
+outColor = vec4(clamp(color / 255.0, 0.0, 1.0) * a, a);
 }`;
 
 // Compiles and links without waiting: the GPU process works on it while the page goes on (the
@@ -172,30 +175,30 @@ export class SubvecRenderer {
   colorTolerance = 1;
   /** The same for tear and border curves, in output pixels. */
   positionTolerance = 0.25;
-  private readonly gl: WebGL2RenderingContext;
-  private readonly mesh: WebGLProgram;
-  private meshLinked = false;
-  private strokePrograms: { chord: WebGLProgram; composite: WebGLProgram; quad: WebGLBuffer } | null = null;
-  private image: SvecImage | null = null;
-  private level = 0;
-  private topologies: Array<Topology | undefined> = [];
-  private window: ViewWindow | null = null;
-  private cache: Cache | null = null;
-  private coverage: { texture: WebGLTexture; framebuffer: WebGLFramebuffer; width: number; height: number } | null = null;
+  readonly #gl: WebGL2RenderingContext;
+  readonly #mesh: WebGLProgram;
+  #meshLinked = false;
+  #strokePrograms: { chord: WebGLProgram; composite: WebGLProgram; quad: WebGLBuffer } | null = null;
+  #image: SvecImage | null = null;
+  #level = 0;
+  #topologies: Array<Topology | undefined> = [];
+  #window: ViewWindow | null = null;
+  #cache: Cache | null = null;
+  #coverage: { texture: WebGLTexture; framebuffer: WebGLFramebuffer; width: number; height: number } | null = null;
 
   constructor(readonly canvas: HTMLCanvasElement | OffscreenCanvas) {
     // preserveDrawingBuffer: the frame stays readable (toDataURL, drawImage) after it is shown.
     const gl = canvas.getContext('webgl2', { antialias: true, alpha: true, premultipliedAlpha: true, preserveDrawingBuffer: true });
     if (!gl) throw new SvecError('this browser cannot draw the image: WebGL2 is not available');
-    this.gl = gl as WebGL2RenderingContext;
-    this.mesh = compile(this.gl, MESH_VS, MESH_FS);
-    this.warmUp();
+    this.#gl = gl as WebGL2RenderingContext;
+    this.#mesh = compile(this.#gl, MESH_VS, MESH_FS);
+    this.#warmUp();
   }
 
   // One empty draw in the mesh's state, so that the GPU process prepares its pipeline (software
   // GL compiles the shaders to machine code there) while the page decodes and refines the file.
-  private warmUp(): void {
-    const gl = this.gl;
+  #warmUp(): void {
+    const gl = this.#gl;
     const vao = gl.createVertexArray(), vertices = gl.createBuffer(), indices = gl.createBuffer();
     gl.bindVertexArray(vao);
     gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
@@ -206,7 +209,7 @@ export class SubvecRenderer {
     gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array([0, 1, 2]), gl.STATIC_DRAW);
-    gl.useProgram(this.mesh);
+    gl.useProgram(this.#mesh);
     gl.drawElements(gl.TRIANGLES, 3, gl.UNSIGNED_INT, 0);  // a degenerate triangle: no pixels
     gl.bindVertexArray(null);
     gl.deleteVertexArray(vao);
@@ -216,80 +219,80 @@ export class SubvecRenderer {
 
   /** Shows `image` (already validated by decode/load) at `level`. */
   setImage(image: SvecImage, level = 0): void {
-    this.dropCache();
-    this.image = image;
-    this.topologies = [];
-    this.level = 0;
+    this.#dropCache();
+    this.#image = image;
+    this.#topologies = [];
+    this.#level = 0;
     this.setLevel(level);
   }
 
   setLevel(level: number): void {
-    const count = this.image ? this.image.levels.length : 0;
+    const count = this.#image ? this.#image.levels.length : 0;
     if (!Number.isInteger(level) || level < 0 || level >= count) {
       throw new SvecError(`level ${level} is out of range (${count} levels)`);
     }
-    this.level = level;
+    this.#level = level;
   }
 
   /** The region of the image mapped onto the whole canvas; null: the whole image. */
   setView(window: ViewWindow | null): void {
     if (window) checkWindow(window);
-    this.window = window ? { ...window } : null;
+    this.#window = window ? { ...window } : null;
   }
 
   /** Draws at canvas.width x canvas.height device pixels; outside the image stays transparent. */
   render(): void {
-    const gl = this.gl;
+    const gl = this.#gl;
     const width = this.canvas.width, height = this.canvas.height;
     gl.viewport(0, 0, width, height);
     gl.clearColor(0, 0, 0, 0);
     gl.clear(gl.COLOR_BUFFER_BIT);
-    const image = this.image;
+    const image = this.#image;
     if (!image || width < 1 || height < 1) return;
-    const w = this.window ?? { x0: 0, y0: 0, x1: image.width, y1: image.height };
+    const w = this.#window ?? { x0: 0, y0: 0, x1: image.width, y1: image.height };
     const view: ViewTransform = { x0: w.x0, y0: w.y0, sx: width / (w.x1 - w.x0), sy: height / (w.y1 - w.y0), width, height };
 
     const t0 = performance.now();
-    const cache = this.plan(image, w, view);
+    const cache = this.#plan(image, w, view);
     const t1 = performance.now();
     this.stats.refineMs = cache ? t1 - t0 : 0;
     if (cache) {
-      if (!this.meshLinked) this.meshLinked = !!linked(gl, this.mesh);
-      gl.useProgram(this.mesh);
-      gl.uniform4f(gl.getUniformLocation(this.mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
-      gl.uniform2f(gl.getUniformLocation(this.mesh, 'size'), width, height);
+      if (!this.#meshLinked) this.#meshLinked = !!linked(gl, this.#mesh);
+      gl.useProgram(this.#mesh);
+      gl.uniform4f(gl.getUniformLocation(this.#mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
+      gl.uniform2f(gl.getUniformLocation(this.#mesh, 'size'), width, height);
       gl.bindVertexArray(cache.vao);
       gl.drawElements(gl.TRIANGLES, cache.numIndices, gl.UNSIGNED_INT, 0);
       gl.bindVertexArray(null);
     }
-    this.drawStrokes(image, view);
+    this.#drawStrokes(image, view);
     this.stats.drawMs = performance.now() - t1;
   }
 
   /** Frees the GPU resources; the renderer cannot draw afterwards. */
   dispose(): void {
-    this.dropCache();
-    const gl = this.gl;
-    if (this.coverage) {
-      gl.deleteTexture(this.coverage.texture);
-      gl.deleteFramebuffer(this.coverage.framebuffer);
-      this.coverage = null;
+    this.#dropCache();
+    const gl = this.#gl;
+    if (this.#coverage) {
+      gl.deleteTexture(this.#coverage.texture);
+      gl.deleteFramebuffer(this.#coverage.framebuffer);
+      this.#coverage = null;
     }
-    gl.deleteProgram(this.mesh);
-    if (this.strokePrograms) {
-      gl.deleteProgram(this.strokePrograms.chord);
-      gl.deleteProgram(this.strokePrograms.composite);
-      gl.deleteBuffer(this.strokePrograms.quad);
-      this.strokePrograms = null;
+    gl.deleteProgram(this.#mesh);
+    if (this.#strokePrograms) {
+      gl.deleteProgram(this.#strokePrograms.chord);
+      gl.deleteProgram(this.#strokePrograms.composite);
+      gl.deleteBuffer(this.#strokePrograms.quad);
+      this.#strokePrograms = null;
     }
-    this.image = null;
+    this.#image = null;
   }
 
   // The view plan of src/render/renderer.cpp (plan_view): the faces whose ring box meets the
   // window, their mean edge in output pixels, the depth; then the refinement, reused if it can be.
-  private plan(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache | null {
-    let topo = this.topologies[this.level];
-    if (!topo) topo = this.topologies[this.level] = buildTopology(image.levels[this.level], image.width, image.height);
+  #plan(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache | null {
+    let topo = this.#topologies[this.#level];
+    if (!topo) topo = this.#topologies[this.#level] = buildTopology(image.levels[this.#level], image.width, image.height);
     const { triangles: tri, positions: p } = topo.level;
     const nf = tri.length / 3, boxes = topo.ringBoxes;
     const visible: number[] = [];
@@ -308,19 +311,19 @@ export class SubvecRenderer {
     }
     const depth = chooseDepth(edges / (3 * visible.length), this.maxEdgePixels, Math.min(view.sx, view.sy), visible.length);
     const faces = visible.length === nf ? null : Int32Array.from(visible);
-    const c = this.cache;
-    if (!(c && c.level === this.level && c.depth === depth && covers(c.faces, faces))) this.upload(topo, faces, depth);
-    const cache = this.cache!;
+    const c = this.#cache;
+    if (!(c && c.level === this.#level && c.depth === depth && covers(c.faces, faces))) this.#upload(topo, faces, depth);
+    const cache = this.#cache!;
     const scale = Math.min(view.sx, view.sy);
-    if (cache.scale !== scale) this.uploadIndices(cache, scale);
+    if (cache.scale !== scale) this.#uploadIndices(cache, scale);
     this.stats.depth = depth;
     this.stats.triangles = cache.numIndices / 3;
     return cache;
   }
 
-  private upload(topo: Topology, faces: Int32Array | null, depth: number): void {
-    this.dropCache();
-    const gl = this.gl;
+  #upload(topo: Topology, faces: Int32Array | null, depth: number): void {
+    this.#dropCache();
+    const gl = this.#gl;
     const refined = refine(topo, faces, depth);
     const vao = gl.createVertexArray()!;
     const vertices = gl.createBuffer()!, indices = gl.createBuffer()!;
@@ -333,15 +336,15 @@ export class SubvecRenderer {
     gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
     gl.bindVertexArray(null);
-    this.cache = { level: this.level, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
+    this.#cache = { level: this.#level, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
   }
 
   // The triangles to draw at this scale: each face as deep as it needs (the position tolerance is
   // in output pixels, so a zoom changes them), or all at the depth.
-  private uploadIndices(cache: Cache, scale: number): void {
+  #uploadIndices(cache: Cache, scale: number): void {
     const r = cache.refined;
     const indices = this.colorTolerance > 0 ? adaptiveIndices(r, scale, this.colorTolerance, this.positionTolerance) : uniformIndices(r);
-    const gl = this.gl;
+    const gl = this.#gl;
     gl.bindVertexArray(cache.vao);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
     gl.bindVertexArray(null);
@@ -349,21 +352,21 @@ export class SubvecRenderer {
     cache.numIndices = indices.length;
   }
 
-  private dropCache(): void {
-    if (!this.cache) return;
-    this.gl.deleteVertexArray(this.cache.vao);
-    for (const b of this.cache.buffers) this.gl.deleteBuffer(b);
-    this.cache = null;
+  #dropCache(): void {
+    if (!this.#cache) return;
+    this.#gl.deleteVertexArray(this.#cache.vao);
+    for (const b of this.#cache.buffers) this.#gl.deleteBuffer(b);
+    this.#cache = null;
   }
 
   // Each stroke of the level: its coverage (the maximum over its chords) into a texture, then
   // composited over the frame, in file order.
-  private drawStrokes(image: SvecImage, view: ViewTransform): void {
-    const strokes = image.strokes.filter((s) => s.level === this.level && s.points.length >= 4);
+  #drawStrokes(image: SvecImage, view: ViewTransform): void {
+    const strokes = image.strokes.filter((s) => s.level === this.#level && s.points.length >= 4);
     if (strokes.length === 0) return;
-    const gl = this.gl;
-    const target = this.coverageTarget(view.width, view.height);
-    const { chord, composite, quad } = this.strokeState();
+    const gl = this.#gl;
+    const target = this.#coverageTarget(view.width, view.height);
+    const { chord, composite, quad } = this.#strokeState();
     const chords = gl.createBuffer()!;
     const vao = gl.createVertexArray()!;
     gl.bindVertexArray(vao);
@@ -413,23 +416,23 @@ export class SubvecRenderer {
   }
 
   // The strokes' programs, made for the first image with strokes.
-  private strokeState() {
-    if (!this.strokePrograms) {
-      const gl = this.gl, quad = gl.createBuffer()!;
+  #strokeState() {
+    if (!this.#strokePrograms) {
+      const gl = this.#gl, quad = gl.createBuffer()!;
       gl.bindBuffer(gl.ARRAY_BUFFER, quad);
       gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([0, 0, 1, 0, 0, 1, 1, 1]), gl.STATIC_DRAW);
       const chord = compile(gl, CHORD_VS, CHORD_FS), composite = compile(gl, COMPOSITE_VS, COMPOSITE_FS);
-      this.strokePrograms = { chord: linked(gl, chord), composite: linked(gl, composite), quad };
+      this.#strokePrograms = { chord: linked(gl, chord), composite: linked(gl, composite), quad };
     }
-    return this.strokePrograms;
+    return this.#strokePrograms;
   }
 
-  private coverageTarget(width: number, height: number) {
-    const gl = this.gl;
-    if (this.coverage && this.coverage.width === width && this.coverage.height === height) return this.coverage;
-    if (this.coverage) {
-      gl.deleteTexture(this.coverage.texture);
-      gl.deleteFramebuffer(this.coverage.framebuffer);
+  #coverageTarget(width: number, height: number) {
+    const gl = this.#gl;
+    if (this.#coverage && this.#coverage.width === width && this.#coverage.height === height) return this.#coverage;
+    if (this.#coverage) {
+      gl.deleteTexture(this.#coverage.texture);
+      gl.deleteFramebuffer(this.#coverage.framebuffer);
     }
     const texture = gl.createTexture()!;
     gl.bindTexture(gl.TEXTURE_2D, texture);
@@ -440,7 +443,7 @@ export class SubvecRenderer {
     gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    this.coverage = { texture, framebuffer, width, height };
-    return this.coverage;
+    this.#coverage = { texture, framebuffer, width, height };
+    return this.#coverage;
   }
 }

@@ -19,6 +19,7 @@ export interface RenderStats {
 export declare const DEFAULT_MAX_EDGE_PIXELS = 5;
 export declare function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom: number, faces: number): number;
 export declare class SubvecRenderer {
+    #private;
     readonly canvas: HTMLCanvasElement | OffscreenCanvas;
     readonly stats: RenderStats;
     /** The depth rule's refined edge length at 1x, in output pixels: 2.5 draws what `subvec render` draws. */
@@ -30,18 +31,7 @@ export declare class SubvecRenderer {
     colorTolerance: number;
     /** The same for tear and border curves, in output pixels. */
     positionTolerance: number;
-    private readonly gl;
-    private readonly mesh;
-    private meshLinked;
-    private strokePrograms;
-    private image;
-    private level;
-    private topologies;
-    private window;
-    private cache;
-    private coverage;
     constructor(canvas: HTMLCanvasElement | OffscreenCanvas);
-    private warmUp;
     /** Shows `image` (already validated by decode/load) at `level`. */
     setImage(image: SvecImage, level?: number): void;
     setLevel(level: number): void;
@@ -51,11 +41,4 @@ export declare class SubvecRenderer {
     render(): void;
     /** Frees the GPU resources; the renderer cannot draw afterwards. */
     dispose(): void;
-    private plan;
-    private upload;
-    private uploadIndices;
-    private dropCache;
-    private drawStrokes;
-    private strokeState;
-    private coverageTarget;
 }
