@@ -5,18 +5,18 @@
 //
 // Nothing is trusted: the zstd frame header is checked before fzstd allocates anything from it,
 // every count is capped and checked against the bytes left before an array is sized from it
-// (compact levels grow their arrays as the traversal proves vertices), every loop is bounded by
-// the input, and whatever goes wrong inside surfaces as a SvecError.
+// (compact levels size theirs by what the stream can hold), every loop is bounded by the input,
+// and whatever goes wrong inside surfaces as a SvecError. The hot loops are plain loops over
+// typed arrays sized up front: a page decodes its file once, before anything is compiled.
 import { Decompress } from 'fzstd';
 import { Feature, Level, Stroke, SvecError, SvecImage } from './image';
-import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, fail, sortPairs, topology, validate, wedges } from './validate';
+import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, Topology, edges, escape, fail, next3, prev3, sortBy, topology, validate, wedges } from './validate';
 
 const GIB = 2 ** 30; // largest file, and largest payload
 const MAGIC = [0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a]; // "SUBVEC" NUL ^Z
 const HEADER = 32;
 const utf8 = new TextDecoder('utf-8', { fatal: true, ignoreBOM: true });
 
-const oneLine = (s: string) => s.replace(/[\x00-\x1f\x7f]/g, (c) => `\\x${c.charCodeAt(0).toString(16).padStart(2, '0')}`);
 const latin1 = (b: Uint8Array) => String.fromCharCode(...b);
 const hex = (b: ArrayLike<number>) => Array.from(b, (x) => x.toString(16).padStart(2, '0')).join(' ');
 const unzigzag = (v: number) => (v % 2 ? -(v + 1) / 2 : v / 2);
@@ -37,9 +37,9 @@ function text(b: Uint8Array): string {
 class Cursor {
   pos = 0;
   what = 'the payload';
-  private readonly d: DataView;
+  readonly #d: DataView;
   constructor(readonly b: Uint8Array) {
-    this.d = new DataView(b.buffer, b.byteOffset, b.length);
+    this.#d = new DataView(b.buffer, b.byteOffset, b.length);
   }
   left() {
     return this.b.length - this.pos;
@@ -58,24 +58,32 @@ class Cursor {
     return this.b[this.take(1)];
   }
   u32() {
-    return this.d.getUint32(this.take(4), true);
+    return this.#d.getUint32(this.take(4), true);
   }
   i32() {
-    return this.d.getInt32(this.take(4), true);
+    return this.#d.getInt32(this.take(4), true);
   }
   f32() {
-    return this.d.getFloat32(this.take(4), true);
+    return this.#d.getFloat32(this.take(4), true);
   }
   f64() {
-    return this.d.getFloat64(this.take(8), true);
+    return this.#d.getFloat64(this.take(8), true);
+  }
+  // n values of `size` bytes each, copied into a typed array (little-endian, as every browser
+  // is); short of bytes, it fails where reading them one by one would.
+  array<T>(type: new (b: ArrayBuffer) => T, n: number, size: number): T {
+    const p = this.pos, fit = Math.min(n, Math.floor(this.left() / size));
+    this.pos += fit * size;
+    if (fit < n) this.take(size);
+    return new type(this.b.slice(p, this.pos).buffer);
   }
   // Unsigned LEB128 of at most 64 bits; exact below 2^53, which every range check lies below.
   varint(): number {
     for (let v = 0, shift = 0; ; shift += 7) {
       const b = this.u8();
-      if (shift === 63 && (b & 0x7e || b & 0x80)) fail(`malformed varint while reading ${this.what}`);
+      if (shift === 63 && b > 1) fail(`malformed varint while reading ${this.what}`);
       v += (b & 0x7f) * 2 ** shift;
-      if (!(b & 0x80)) return v;
+      if (b < 128) return v;
     }
   }
   svarint() {
@@ -130,60 +138,94 @@ function unzstd(f: Uint8Array, expected: number): Uint8Array {
     end += 3 + (type === 1 ? 1 : size);
   }
   if (d & 4) end += 4; // checksum
-  const parts: Uint8Array[] = [];
+  const out = new Uint8Array(expected);
   let produced = 0;
   try {
     new Decompress((part) => {
+      if (produced + part.length > expected) fail(`zstd frame decompresses to more than the ${expected} bytes the header declares`);
+      out.set(part, produced);
       produced += part.length;
-      if (produced > expected) fail(`zstd frame decompresses to more than the ${expected} bytes the header declares`);
-      parts.push(part);
     }).push(f.subarray(0, end), true);
   } catch (e) {
     if (e instanceof SvecError) throw e;
     if (end <= f.length || (e as { code?: number }).code !== 5) fail(`corrupt zstd frame: ${(e as Error).message}`);
   }
   if (end > f.length) fail(`truncated zstd frame: it ends after ${produced + partial} of ${expected} payload bytes`);
-  const out = new Uint8Array(expected);
-  parts.reduce((at, part) => (out.set(part, at), at + part.length), 0);
   if (d & 4 && le(end - 4, 4) !== xxh64(out.subarray(0, produced))) fail("corrupt zstd frame: Restored data doesn't match checksum");
   if (produced !== expected) fail(`zstd frame decompresses to ${produced} bytes but the header declares ${expected}`);
   if (end < f.length) fail(`${f.length - end} unexpected bytes after the zstd frame`);
   return out;
 }
 
-// The low 32 bits of XXH64 (seed 0): zstd's content checksum.
-const M64 = 2n ** 64n - 1n, P1 = 11400714785074694791n, P2 = 14029467366897019727n;
-const P3 = 1609587929392839161n, P4 = 9650029242287828579n, P5 = 2870177450012600261n;
-const rotl = (x: bigint, r: bigint) => ((x << r) | (x >> (64n - r))) & M64;
-const round = (acc: bigint, lane: bigint) => (rotl((acc + lane * P2) & M64, 31n) * P1) & M64;
+// The low 32 bits of XXH64 (seed 0): zstd's content checksum. A 64-bit word is a pair (hi, lo)
+// of 32-bit halves (BigInt would be ten times slower); mul leaves its product in H, L.
+const P = [0x9e3779b1, 0x85ebca87, 0xc2b2ae3d, 0x27d4eb4f, 0x165667b1, 0x9e3779f9, 0x85ebca77, 0xc2b2ae63, 0x27d4eb2f, 0x165667c5];
+let H = 0, L = 0;
+// (ah, al) times prime k (P1 to P5: 0 to 4), mod 2^64: the low halves' product in 16-bit parts.
+function mul(ah: number, al: number, k: number) {
+  const bh = P[2 * k], bl = P[2 * k + 1], a1 = al >>> 16, a0 = al & 0xffff, b1 = bl >>> 16, b0 = bl & 0xffff;
+  const mid = a1 * b0 + a0 * b1, low = a0 * b0 + (mid & 0xffff) * 65536;
+  L = low >>> 0;
+  H = (Math.imul(ah, bl) + Math.imul(al, bh) + a1 * b1 + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff)) >>> 0;
+}
+// ((ah, al) + lane (bh, bl) * P2) rotated left by 31, times P1: a lane's round.
+function round(ah: number, al: number, bh: number, bl: number) {
+  mul(bh, bl, 1);
+  const lo = al + L, hi = ah + H + +(lo > 0xffffffff);
+  mul((hi << 31) | (lo >>> 1), (lo << 31) | (hi >>> 1), 0);
+}
 function xxh64(b: Uint8Array): number {
   const d = new DataView(b.buffer, b.byteOffset, b.length), n = b.length;
-  let i = 0, h = P5;
+  let i = 0, h = P[8], l = P[9];
+  // h = (h ^ (H, L)) rotated left by r (0 < r < 32, or none), times prime k, plus prime a (if a < 5)
+  const step = (r: number, k: number, a: number) => {
+    const x = h ^ H, y = l ^ L;
+    r ? mul((x << r) | (y >>> (32 - r)), (y << r) | (x >>> (32 - r)), k) : mul(x, y, k);
+    l = L + (a < 5 ? P[2 * a + 1] : 0);
+    h = (H + (a < 5 ? P[2 * a] : 0) + +(l > 0xffffffff)) >>> 0;
+    l >>>= 0;
+  };
   if (n >= 32) {
-    const v = [(P1 + P2) & M64, P2, 0n, M64 + 1n - P1];
-    for (; i + 32 <= n; i += 32) for (let k = 0; k < 4; k++) v[k] = round(v[k], d.getBigUint64(i + 8 * k, true));
-    h = (rotl(v[0], 1n) + rotl(v[1], 7n) + rotl(v[2], 12n) + rotl(v[3], 18n)) & M64;
-    for (const x of v) h = ((h ^ round(0n, x)) * P1 + P4) & M64;
+    const v = [0x60ea27ee, 0xadc0b5d6, P[2], P[3], 0, 0, 0x61c8864e, 0x7a143579];
+    // The stripes: round() written out, the hot loop on large payloads.
+    for (; i + 32 <= n; i += 32)
+      for (let k = 0; k < 8; k += 2) {
+        // lane * P2 + v[k], rotated left by 31, times P1
+        let ah = d.getUint32(i + 4 * k + 4, true), al = d.getUint32(i + 4 * k, true), a1 = al >>> 16, a0 = al & 0xffff;
+        let mid = a1 * 0xeb4f + a0 * 0x27d4, low = a0 * 0xeb4f + (mid & 0xffff) * 65536;
+        const lo = (low >>> 0) + v[k + 1];
+        const hi = Math.imul(ah, 0x27d4eb4f) + Math.imul(al, 0xc2b2ae3d) + a1 * 0x27d4 + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff) + v[k] + +(lo > 0xffffffff);
+        (ah = (hi << 31) | (lo >>> 1)), (al = (lo << 31) | (hi >>> 1)), (a1 = al >>> 16), (a0 = al & 0xffff);
+        (mid = a1 * 0xca87 + a0 * 0x85eb), (low = a0 * 0xca87 + (mid & 0xffff) * 65536);
+        v[k] = (Math.imul(ah, 0x85ebca87) + Math.imul(al, 0x9e3779b1) + a1 * 0x85eb + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff)) >>> 0;
+        v[k + 1] = low >>> 0;
+      }
+    // h = the sum of v[k] rotated by 1, 7, 12, 18; then each merged: h = (h ^ round(0, v[k])) * P1 + P4
+    h = l = 0;
+    for (let k = 0; k < 8; k += 2) {
+      const x = v[k], y = v[k + 1], r = [1, 7, 12, 18][k / 2], lo = l + (((y << r) | (x >>> (32 - r))) >>> 0);
+      h = (h + (((x << r) | (y >>> (32 - r))) >>> 0) + +(lo > 0xffffffff)) >>> 0;
+      l = lo >>> 0;
+    }
+    for (let k = 0; k < 8; k += 2) round(0, 0, v[k], v[k + 1]), step(0, 0, 3);
   }
-  h = (h + BigInt(n)) & M64;
-  for (; i + 8 <= n; i += 8) h = (rotl(h ^ round(0n, d.getBigUint64(i, true)), 27n) * P1 + P4) & M64;
-  if (i + 4 <= n) (h = (rotl(h ^ ((BigInt(d.getUint32(i, true)) * P1) & M64), 23n) * P2 + P3) & M64), (i += 4);
-  for (; i < n; i++) h = (rotl(h ^ ((BigInt(b[i]) * P5) & M64), 11n) * P1) & M64;
-  h = ((h ^ (h >> 33n)) * P2) & M64;
-  h = ((h ^ (h >> 29n)) * P3) & M64;
-  return Number((h ^ (h >> 32n)) & 0xffffffffn);
+  l += n;
+  h = (h + +(l > 0xffffffff)) >>> 0;
+  l >>>= 0;
+  for (; i + 8 <= n; i += 8) round(0, 0, d.getUint32(i + 4, true), d.getUint32(i, true)), step(27, 0, 3);
+  if (i + 4 <= n) mul(0, d.getUint32(i, true), 0), step(23, 1, 2), (i += 4);
+  for (; i < n; i++) mul(0, b[i], 4), step(11, 0, 5);
+  mul(h, l ^ (h >>> 1), 1);
+  mul(H ^ (H >>> 29), L ^ ((L >>> 29) | (H << 3)), 2);
+  return (H ^ L) >>> 0;
 }
 
 // ---------------------------------------------------------------------------------------------
 // The binary form: header, payload version 1 (lossless), trailer, pyramid records.
 
 function binary(b: Uint8Array): SvecImage {
-  const n = Math.min(b.length, 8);
-  if (MAGIC.some((x, i) => b[i] !== x)) {
-    if (n > 0 && n < 8 && MAGIC.slice(0, n).every((x, i) => b[i] === x))
-      fail(`truncated .svec header: ${b.length} bytes, the header needs ${HEADER}`);
-    fail(`not a .svec file: wrong magic bytes (${hex(b.subarray(0, n))}, expected ${hex(MAGIC)})`);
-  }
+  if (b.subarray(0, 8).some((x, i) => x !== MAGIC[i]))
+    fail(`not a .svec file: wrong magic bytes (${hex(b.subarray(0, 8))}, expected ${hex(MAGIC)})`);
   if (b.length < HEADER) fail(`truncated .svec header: ${b.length} bytes, the header needs ${HEADER}`);
   const h = new DataView(b.buffer, b.byteOffset, HEADER);
   const version = h.getUint32(8, true), flags = h.getUint32(12, true);
@@ -196,18 +238,17 @@ function binary(b: Uint8Array): SvecImage {
 
   const c = new Cursor(unzstd(b.subarray(HEADER), Number(size)));
   c.what = 'image size';
-  const width = c.i32(), height = c.i32(), levels: Level[] = [];
+  const width = c.i32(), height = c.i32(), levels: Level[] = [], topologies: Topology[] = [];
   const nl = c.count('levels', 20, MAX_LEVELS);
   if (version > 1 && (width < 1 || height < 1 || width > MAX_DIMENSION || height > MAX_DIMENSION))
     fail(`image size ${width} x ${height} is out of range (1 to ${MAX_DIMENSION} a side)`);
-  for (let l = 0; l < nl; l++) levels.push(version > 1 ? compactLevel(c, l, width, height, version) : losslessLevel(c, l));
+  for (let l = 0; l < nl; l++) levels.push(version > 1 ? compactLevel(c, l, width, height, version, topologies) : losslessLevel(c, l));
 
   const strokes: Stroke[] = [], metadata: Array<[string, string]> = [];
   for (let i = 0, n = c.count('strokes', 28); i < n; i++) {
     const what = (c.what = `stroke ${i}`);
     const level = c.i32(), width = c.f32(), color: [number, number, number] = [c.f32(), c.f32(), c.f32()], taper = c.f32();
-    const points = new Float64Array(2 * c.count(`${what} points`, 16)).map(() => c.f64());
-    strokes.push({ level, points, width, color, taper });
+    strokes.push({ level, points: c.array(Float64Array, 2 * c.count(`${what} points`, 16), 8), width, color, taper });
   }
   for (let i = 0, n = c.count('metadata entries', 8); i < n; i++)
     metadata.push([c.string(`metadata entry ${i} key`), c.string(`metadata entry ${i} value`)]);
@@ -227,8 +268,8 @@ function binary(b: Uint8Array): SvecImage {
         if (Math.abs(delta) > 2 ** 32 || base + delta < 0 || base + delta > 2 ** 31 - 1) fail(`${what}: a vertex index is out of range`);
         return base + delta;
       };
-      let previous = 0;
-      const parents = new Int32Array(c.count(`${what} parent vertices`, 1)).map(() => (previous = index(previous, c.varint())));
+      const parents = new Int32Array(c.count(`${what} parent vertices`, 1));
+      for (let k = 0, previous = 0; k < parents.length; k++) parents[k] = previous = index(previous, c.varint());
       const collapses = new Int32Array(2 * c.count(`${what} collapses`, 2));
       for (let k = 0; k < collapses.length; k += 2) {
         collapses[k] = index(0, 2 * Math.min(c.varint(), 2 ** 40));
@@ -239,7 +280,7 @@ function binary(b: Uint8Array): SvecImage {
   }
   if (c.left()) fail(`${c.left()} unexpected bytes after the payload's pyramid records`);
   const image = { width, height, levels, strokes, metadata };
-  validate(image, records);
+  validate(image, records, topologies);
   return image;
 }
 
@@ -249,21 +290,18 @@ function losslessLevel(c: Cursor, l: number): Level {
   const [nv, nc, nt, nr, nf] = ([['vertices', 16], ['colors', 12], ['triangles', 24], ['creases', 8], ['features', 16]] as const).map(
     ([what, min]) => c.count(at + what, min),
   );
-  const read = <T extends Float64Array | Float32Array | Int32Array>(what: string, array: T, value: () => number) => {
-    c.what = at + what;
-    return array.map(value) as T;
-  };
+  const read = <T>(what: string, type: new (b: ArrayBuffer) => T, n: number, size = 4) => ((c.what = at + what), c.array(type, n, size));
   const level: Level = {
-    positions: read('vertices', new Float64Array(2 * nv), () => c.f64()),
-    colors: read('colors', new Float32Array(3 * nc), () => c.f32()),
-    triangles: read('triangles', new Int32Array(3 * nt), () => c.i32()),
-    triangleColors: read('triangle colors', new Int32Array(3 * nt), () => c.i32()),
-    creases: read('creases', new Int32Array(2 * nr), () => c.i32()),
+    positions: read('vertices', Float64Array, 2 * nv, 8),
+    colors: read('colors', Float32Array, 3 * nc),
+    triangles: read('triangles', Int32Array, 3 * nt),
+    triangleColors: read('triangle colors', Int32Array, 3 * nt),
+    creases: read('creases', Int32Array, 2 * nr),
     features: [],
   };
   for (let i = 0; i < nf; i++) {
     const what = (c.what = `${at}feature ${i}`), id = c.i32(), saliency = c.f64();
-    level.features.push({ id, saliency, vertices: new Int32Array(c.count(`${what} vertices`, 4)).map(() => c.i32()) });
+    level.features.push({ id, saliency, vertices: c.array(Int32Array, c.count(`${what} vertices`, 4), 4) });
   }
   return level;
 }
@@ -271,179 +309,189 @@ function losslessLevel(c: Cursor, l: number): Level {
 // ---------------------------------------------------------------------------------------------
 // Compact levels (versions 2 and 3): the symbols of six kinds, from varint sections (version 2)
 // or one range-coded stream (version 3); the traversal, predictions and canonical colors decode
-// them alike.
+// them alike. Each pass with a hot loop is a function of its own (the engine optimizes them one
+// by one).
 
 const SECTIONS = ['connectivity', 'split offsets', 'positions', 'features', 'feature steps', 'colors'];
 const CONNECTIVITY = 0, SPLITS = 1, POSITIONS = 2, FEATURES = 3, STEPS = 4, COLORS = 5;
-const C = 0, L = 1, R = 2, E = 3; // and S = 4
+const C = 0, L_ = 1, R = 2, E = 3; // and S = 4
+// Version 3's number models.
+const VIRTUAL = 0, SPLIT = 1, X = 2, STEP_FIRST = 4, STEP_NEXT = 5, ID = 6, LENGTH = 7, COLOR = 8; // + 5 channel + activity
 
 interface Source {
+  /** The most connectivity operations the bytes can hold. */
+  ops: number;
   begin(section: number): void;
   end(section: number): void;
-  virtual(): number;
+  /** A number: from its section (version 2; `what` names what it starts), or of its model. */
+  read(section: number, model: number, signed?: boolean, what?: string): number;
   op(triangle: boolean, fanU: number, fanW: number): number;
-  split(): number;
-  position(k: number): number;
   vertex(): number;
-  step(first: boolean): number;
-  id(what: string): number;
   saliency(what: string): number;
   length(what: string): number;
-  color(channel: number, activity: number): number;
   finish(): void;
 }
 
-function varintSource(c: Cursor, name: string, nv: number): Source {
-  const s: Cursor[] = [];
-  let ops = 0, packed = 0;
-  return {
-    begin(k) {
-      const label = name + SECTIONS[k], n = c.count(label, 1, MAX_ELEMENTS * 64);
-      c.what = label;
-      (s[k] = new Cursor(c.bytes(n))).what = label;
-      const expected = Math.ceil((2 * nv - 3) / 3);
-      if (k === CONNECTIVITY && n !== expected) fail(`${name}connectivity: ${n} bytes for ${nv} vertices (expected ${expected})`);
-    },
-    end(k) {
-      if (s[k].left()) fail(`${s[k].left()} unexpected bytes at the end of ${name}${SECTIONS[k]}`);
-    },
-    virtual: () => s[SPLITS].varint(),
-    op() {
-      if (ops % 3 === 0 && (packed = s[CONNECTIVITY].u8()) >= 125) fail(`${name}connectivity: byte ${ops / 3} is not three operations`);
-      ops++;
-      const op = packed % 5;
-      packed = (packed / 5) | 0;
-      return op;
-    },
-    split: () => s[SPLITS].varint(),
-    position: () => s[POSITIONS].svarint(),
-    vertex: () => s[FEATURES].varint(),
-    step: () => s[STEPS].varint(),
-    id(what) {
-      s[FEATURES].what = name + what;
-      return s[FEATURES].svarint();
-    },
-    saliency(what) {
-      const f = s[FEATURES], tag = f.u8();
-      if (tag === 1) return f.f32();
-      if (tag === 2) return f.f64();
-      return tag ? fail(`${name}${what}: unknown saliency tag ${tag}`) : 0;
-    },
-    length(what) {
-      const n = s[FEATURES].varint();
-      if (n > s[STEPS].left()) fail(`${name}${what}: ${n + 2} vertices, too few bytes`);
-      return n;
-    },
-    color: () => s[COLORS].svarint(),
-    finish() {},
-  };
+// Classes, not closures: one method of each for all levels, which the engine optimizes once.
+class Varints implements Source {
+  #s: Cursor[] = [];
+  #ops = 0;
+  #packed = 0;
+  #c: Cursor;
+  #name: string;
+  #nv: number;
+  ops: number;
+  constructor(c: Cursor, name: string, nv: number) {
+    (this.#c = c), (this.#name = name), (this.#nv = nv), (this.ops = 3 * c.left());
+  }
+  begin(k: number) {
+    const c = this.#c, name = this.#name, nv = this.#nv, label = name + SECTIONS[k], n = c.count(label, 1, MAX_ELEMENTS * 64);
+    c.what = label;
+    (this.#s[k] = new Cursor(c.bytes(n))).what = label;
+    const expected = Math.ceil((2 * nv - 3) / 3);
+    if (k === CONNECTIVITY && n !== expected) fail(`${name}connectivity: ${n} bytes for ${nv} vertices (expected ${expected})`);
+  }
+  end(k: number) {
+    const left = this.#s[k].left();
+    if (left) fail(`${left} unexpected bytes at the end of ${this.#name}${SECTIONS[k]}`);
+  }
+  read(k: number, _: number, signed?: boolean, what?: string) {
+    const s = this.#s[k];
+    if (what) s.what = this.#name + what;
+    return signed ? s.svarint() : s.varint();
+  }
+  op() {
+    if (this.#ops % 3 === 0 && (this.#packed = this.#s[CONNECTIVITY].u8()) >= 125)
+      fail(`${this.#name}connectivity: byte ${this.#ops / 3} is not three operations`);
+    this.#ops++;
+    const op = this.#packed % 5;
+    this.#packed = (this.#packed / 5) | 0;
+    return op;
+  }
+  vertex() {
+    return this.#s[FEATURES].varint();
+  }
+  saliency(what: string) {
+    const f = this.#s[FEATURES], tag = f.u8();
+    if (tag === 1) return f.f32();
+    if (tag === 2) return f.f64();
+    return tag ? fail(`${this.#name}${what}: unknown saliency tag ${tag}`) : 0;
+  }
+  length(what: string) {
+    const n = this.#s[FEATURES].varint();
+    if (n > this.#s[STEPS].left()) fail(`${this.#name}${what}: ${n + 2} vertices, too few bytes`);
+    return n;
+  }
+  finish() {}
 }
 
 // Contexts of version 3 (docs/format.md, "Payload, version 3"), in one array: the operations, 23
 // number models, the saliency's.
 const OP_C = 1, OP_R = 9, OP_L = 17; // context 0: C or E on a loop of 3; then 8 fans each
-const NUMBER = (model: number) => 25 + 170 * model; // zero, sign, prefix[56], suffix[56][2]
-const VIRTUAL = 0, SPLIT = 1, X = 2, STEP_FIRST = 4, STEP_NEXT = 5, ID = 6, LENGTH = 7, COLOR = 8; // + 5 channel + activity
-const SALIENCY = NUMBER(23); // nonzero, wide, then top[2][4096], then mantissa[2][4]
-const CONTEXTS = SALIENCY + 2 + 8192 + 8;
+const SALIENCY = 25 + 170 * 23; // nonzero, wide, then top[2][4096], then mantissa[2][4]
 
-function rangeSource(bytes: Uint8Array, name: string, nv: number): Source {
-  const what = `${name}stream`, vertexBits = 32 - Math.clz32(nv - 1);
-  const p = new Uint16Array(CONTEXTS).fill(2048), seen = new Uint8Array(CONTEXTS);
-  let range = 0xffffffff, code = 0, pos = 0, overread = 0, context = 'header';
-  const next = () => {
-    if (pos < bytes.length) return bytes[pos++];
-    if (++overread > 4) fail(`${what} ${context}: the coded data ends early (${bytes.length} bytes)`);
+class RangeCoded implements Source {
+  #range = 0xffffffff;
+  #code = 0;
+  #pos = 0;
+  #overread = 0;
+  #context = 'header';
+  #p = new Uint16Array(SALIENCY + 8202).fill(2048);
+  #seen = new Uint8Array(SALIENCY + 8202);
+  #what: string;
+  #vertexBits: number;
+  // Each operation takes a decision, which leaves at most 4065/4096 of the range; each byte
+  // widens it 256 times: some 730 decisions a byte at most.
+  ops: number;
+  #b: Uint8Array;
+  constructor(bytes: Uint8Array, name: string, nv: number) {
+    this.#b = bytes;
+    this.#what = `${name}stream`;
+    this.#vertexBits = 32 - Math.clz32(nv - 1);
+    this.ops = 1024 * (bytes.length + 8);
+    for (let i = 0; i < 4; i++) this.#code = ((this.#code << 8) | this.#next()) >>> 0;
+    if (this.#code >= this.#range) fail(`${this.#what}: corrupt coded data (bad first bytes)`);
+  }
+  #next() {
+    if (this.#pos < this.#b.length) return this.#b[this.#pos++];
+    if (++this.#overread > 4) fail(`${this.#what} ${this.#context}: the coded data ends early (${this.#b.length} bytes)`);
     return 0;
-  };
-  const normalize = () => {
-    while (range < 2 ** 24) (range = (range << 8) >>> 0), (code = ((code << 8) | next()) >>> 0);
-  };
-  // A decision in context i; p adapts by 1/2^shift, shift = min(n + 2, 5) after n updates.
-  const bit = (i: number) => {
-    const bound = (range >>> 12) * p[i], shift = Math.min(seen[i] + 2, 5);
-    if (seen[i] < 3) seen[i]++;
-    const b = +(code >= bound);
-    if (b) (code -= bound), (range -= bound), (p[i] -= p[i] >> shift);
-    else (range = bound), (p[i] += (4096 - p[i]) >> shift);
-    normalize();
+  }
+  // A decision in context i; p adapts by 1/2^shift, shift = min(k + 2, 5) after k updates.
+  #bit(i: number) {
+    const p = this.#p, k = this.#seen[i], bound = (this.#range >>> 12) * p[i];
+    let b = 0;
+    if (k < 3) this.#seen[i] = k + 1;
+    if (this.#code >= bound) (this.#code -= bound), (this.#range -= bound), (p[i] -= p[i] >> (k + 2)), (b = 1);
+    else (this.#range = bound), (p[i] += (4096 - p[i]) >> (k + 2));
+    while (this.#range < 2 ** 24) (this.#range = (this.#range << 8) >>> 0), (this.#code = ((this.#code << 8) | this.#next()) >>> 0);
     return b;
-  };
-  const direct = (n: number) => {
+  }
+  #direct(k: number) {
     let v = 0;
-    while (n--) {
-      range >>>= 1;
-      const b = +(code >= range);
-      if (b) code -= range;
+    while (k--) {
+      const b = +(this.#code >= (this.#range >>>= 1));
+      if (b) this.#code -= this.#range;
       v = v * 2 + b;
-      normalize();
+      while (this.#range < 2 ** 24) (this.#range = (this.#range << 8) >>> 0), (this.#code = ((this.#code << 8) | this.#next()) >>> 0);
     }
     return v;
-  };
-  // Exp-Golomb over decisions: k ones then a zero (prefix[i]), then the k low bits of n + 1,
-  // the top two in suffix[k][j], the rest equiprobable.
-  const unsigned = (model: number) => {
-    const m = NUMBER(model);
+  }
+  begin(k: number) {
+    this.#context = SECTIONS[k];
+  }
+  end() {}
+  // A number of its model m (zero, sign, prefix[56], suffix[56][2]): a signed one is zero or has
+  // a sign; then Exp-Golomb over decisions: k ones then a zero (prefix[i]), then the k low bits
+  // of n + 1, the top two in suffix[k][j], the rest equiprobable.
+  read(_: number, model: number, signed?: boolean) {
+    const m = 25 + 170 * model;
+    if (signed && !this.#bit(m)) return 0;
+    const negative = signed && this.#bit(m + 1);
     let k = 0, v = 1;
-    while (bit(m + 2 + k)) if (++k === 56) fail(`${what} ${context}: a number of more than 56 bits`);
-    for (let j = 0; j < k; j++) v = v * 2 + (j < 2 ? bit(m + 58 + 2 * k + j) : direct(1));
-    return v - 1;
-  };
-  const signed = (model: number) => {
-    if (!bit(NUMBER(model))) return 0;
-    const negative = bit(NUMBER(model) + 1), magnitude = unsigned(model) + 1;
-    return negative ? -magnitude : magnitude;
-  };
-  for (let i = 0; i < 4; i++) code = ((code << 8) | next()) >>> 0;
-  if (code >= range) fail(`${what}: corrupt coded data (bad first bytes)`);
-  return {
-    begin(k) {
-      context = SECTIONS[k];
-    },
-    end() {},
-    virtual: () => unsigned(VIRTUAL),
-    op(triangle, fanU, fanW) {
-      if (triangle) return bit(0) ? E : C;
-      if (!bit(OP_C + fanW)) return C;
-      if (!bit(OP_R + fanW)) return R;
-      return bit(OP_L + fanU) ? 4 : L;
-    },
-    split: () => unsigned(SPLIT),
-    position: (k) => signed(X + k),
-    vertex: () => direct(vertexBits),
-    step: (first) => unsigned(first ? STEP_FIRST : STEP_NEXT),
-    id: () => signed(ID),
-    // A bit tree over sign and exponent (node 1 first, node 2i + bit after i), four modeled
-    // mantissa bits, the rest equiprobable; f32 or f64.
-    saliency() {
-      if (!bit(SALIENCY)) return 0;
-      const wide = bit(SALIENCY + 1), top = wide ? 12 : 9, view = new DataView(new ArrayBuffer(8));
-      let node = 1;
-      for (let i = 0; i < top; i++) node = 2 * node + bit(SALIENCY + 2 + 4096 * wide + node);
-      let high = node - 2 ** top;
-      for (let k = 0; k < 4; k++) high = 2 * high + bit(SALIENCY + 8194 + 4 * wide + k);
-      if (!wide) return view.setUint32(0, high * 2 ** 19 + direct(19)), view.getFloat32(0);
-      view.setUint32(0, high * 2 ** 16 + direct(16));
-      view.setUint32(4, direct(32));
-      return view.getFloat64(0);
-    },
-    length: () => unsigned(LENGTH),
-    color: (channel, activity) => signed(COLOR + 5 * channel + activity),
-    finish() {
-      if (pos < bytes.length) fail(`${bytes.length - pos} unexpected bytes at the end of ${what}`);
-      if (code >= range) fail(`${what}: corrupt coded data (the code leaves its interval)`);
-    },
-  };
+    while (this.#bit(m + 2 + k)) if (++k === 56) fail(`${this.#what} ${this.#context}: a number of more than 56 bits`);
+    for (let j = 0; j < k; j++) v = v * 2 + (j < 2 ? this.#bit(m + 58 + 2 * k + j) : this.#direct(1));
+    return !signed ? v - 1 : negative ? -v : v;
+  }
+  op(triangle: boolean, fanU: number, fanW: number) {
+    if (triangle) return this.#bit(0) ? E : C;
+    if (!this.#bit(OP_C + fanW)) return C;
+    if (!this.#bit(OP_R + fanW)) return R;
+    return this.#bit(OP_L + fanU) ? 4 : L_;
+  }
+  vertex() {
+    return this.#direct(this.#vertexBits);
+  }
+  // A bit tree over sign and exponent (node 1 first, node 2i + bit after i), four modeled
+  // mantissa bits, the rest equiprobable; f32 or f64.
+  saliency() {
+    if (!this.#bit(SALIENCY)) return 0;
+    const wide = this.#bit(SALIENCY + 1), top = wide ? 12 : 9, view = new DataView(new ArrayBuffer(8));
+    let node = 1;
+    for (let i = 0; i < top; i++) node = 2 * node + this.#bit(SALIENCY + 2 + 4096 * wide + node);
+    let high = node - 2 ** top;
+    for (let k = 0; k < 4; k++) high = 2 * high + this.#bit(SALIENCY + 8194 + 4 * wide + k);
+    if (!wide) return view.setUint32(0, high * 2 ** 19 + this.#direct(19)), view.getFloat32(0);
+    view.setUint32(0, high * 2 ** 16 + this.#direct(16));
+    view.setUint32(4, this.#direct(32));
+    return view.getFloat64(0);
+  }
+  length() {
+    return this.read(0, LENGTH);
+  }
+  finish() {
+    const left = this.#b.length - this.#pos;
+    if (left > 0) fail(`${left} unexpected bytes at the end of ${this.#what}`);
+    if (this.#code >= this.#range) fail(`${this.#what}: corrupt coded data (the code leaves its interval)`);
+  }
 }
 
-// ⌊(2·s + n) / (2·n)⌋, the rounded mean of n integers summing to s; BigInt where doubles could
-// round.
-function mean(terms: number[]): number {
-  const n = terms.length;
-  let s = 0, bound = 0;
-  for (const t of terms) (s += t), (bound += Math.abs(t));
-  if (bound < 2 ** 50) return Math.floor((2 * s + n) / (2 * n));
-  const num = 2n * terms.reduce((a, t) => a + BigInt(t), 0n) + BigInt(n), den = BigInt(2 * n), q = num / den;
+// ⌊(2·s + n) / (2·n)⌋, the rounded mean of the n integers t[0..n) summing to s, in BigInt: for
+// terms of 2^50 and more in all, where doubles could round (the callers take the other case).
+function mean(t: Float64Array, n: number): number {
+  let sum = 0n;
+  for (let i = 0; i < n; i++) sum += BigInt(t[i]);
+  const num = 2n * sum + BigInt(n), den = BigInt(2 * n), q = num / den;
   return Number(num % den && num < 0n ? q - 1n : q);
 }
 
@@ -451,25 +499,166 @@ function mean(terms: number[]): number {
 const exact = (a: number, b: number, c: number, d: number) =>
   Math.abs(a * b) + Math.abs(c * d) < 2 ** 53 ? a * b + c * d : Number(BigInt(a) * BigInt(b) + BigInt(c) * BigInt(d));
 
-// The neighbors of each of n vertices in increasing order (CSR), from triangles, 3 per face.
-function neighbors(t: Int32Array, n: number): [Int32Array, Int32Array] {
-  const a = new Int32Array(2 * t.length), b = new Int32Array(2 * t.length);
-  t.forEach((x, h) => {
-    const y = t[h - (h % 3) + ((h + 1) % 3)];
-    (a[2 * h] = b[2 * h + 1] = x), (b[2 * h] = a[2 * h + 1] = y);
-  });
-  const [order, start] = sortPairs(a, b, n), offsets = new Int32Array(n + 1), list: number[] = [];
-  for (let v = 0; v < n; v++) {
-    for (let i = start[v]; i < start[v + 1]; i++) {
-      const y = b[order[i]];
-      if (list.length === offsets[v] || list[list.length - 1] !== y) list.push(y);
+// 1-2. Connectivity: the traversal of the mesh closed by the virtual vertex, 2V - 3 operations
+// after the seed (0, 1, 2). Vertices get decode numbers as C meets them. Returns the level's
+// triangles (the visited ones without the virtual vertex, in visit order, numbered without it),
+// the gate u, w and apex each decode number was met across, and the virtual vertex.
+function traverse(src: Source, nv: number, ntriangles: number, corrupt: (message: string) => never): [Int32Array, Int32Array, number] {
+  src.begin(CONNECTIVITY);
+  src.begin(SPLITS);
+  const virt = src.read(SPLITS, VIRTUAL);
+  if (virt < 3 || virt > nv) corrupt(`virtual vertex ${virt} out of range`);
+  // The arrays hold what the operations the bytes can code can make.
+  const nops = 2 * nv - 3, room = Math.min(nops, src.ops) + 3;
+  const visits = new Int32Array(Math.min(nv + 1, room)), basis = new Int32Array(3 * visits.length).fill(-1), faces = new Int32Array(3 * room);
+  // The frontier: cyclic lists of entries, each the edge to the next one, with the apex (third
+  // vertex) of the visited triangle across it; the current loop starts at its gate, the others
+  // wait on the stack (gate, size). At the start the loop is 1, 0, 2.
+  const vertex = new Int32Array(room), next = new Int32Array(room), prev = new Int32Array(room), apex = new Int32Array(room), stack = new Int32Array(2 * room);
+  vertex.set([1, 0, 2]), next.set([1, 2, 0]), prev.set([2, 0, 1]), apex.set([2, 1, 0]), faces.set([0, 1, 2]), visits.set([1, 1, 1]);
+  let gate = 0, size = 3, done = false, nd = 3, entries = 3, top = 0;
+  for (let i = 0; i < nops; i++) {
+    if (done) corrupt('the traversal ends before the last operation');
+    if (i + 3 >= room) corrupt('the operations outrun the stream'); // cannot happen: see Source.ops
+    const g = gate, n = next[g], u = vertex[g], w = vertex[n];
+    const op = src.op(size === 3, u === virt ? 7 : Math.min(visits[u], 6), w === virt ? 7 : Math.min(visits[w], 6));
+    let x: number;
+    if (op === C) {
+      // x new, between u and w
+      if (nd > nv) corrupt(`more vertices than the ${nv} declared`);
+      x = nd++;
+      (basis[3 * x] = u), (basis[3 * x + 1] = w), (basis[3 * x + 2] = apex[g]);
+      apex[g] = w;
+      (vertex[entries] = x), (next[entries] = n), (prev[entries] = g), (apex[entries] = u);
+      gate = next[g] = prev[n] = entries++;
+      size++;
+    } else if (op === E) {
+      // the loop is u, w, x: done; continue with the one on top of the stack
+      if (size !== 3) corrupt(`operation ${i} closes a loop of ${size} edges`);
+      x = vertex[next[n]];
+      if (!(done = !top)) (size = stack[--top]), (gate = stack[--top]);
+    } else if (op === R || op === L_) {
+      // x after w (w leaves the loop), or before u (u leaves)
+      if (size <= 3) corrupt(`operation ${i} on a loop of 3 edges`);
+      const p = prev[g], k = op === R ? n : g; // k leaves
+      x = vertex[op === R ? next[n] : p];
+      apex[op === R ? g : p] = op === R ? w : u;
+      next[prev[k]] = next[k];
+      prev[next[k]] = prev[k];
+      size--;
+      if (op === L_) gate = p;
+    } else {
+      // x pos entries on: the loop splits into x, w, ... (current) and u, x, ... (put aside)
+      const code = src.read(SPLITS, SPLIT), half = Math.floor(code / 2), pos = code % 2 ? size - 2 - half : half + 3;
+      if (pos < 3 || pos > size - 2) corrupt('split offset out of range');
+      let at = g;
+      if (pos <= size / 2) for (let k = 0; k < pos; k++) at = next[at];
+      else for (let k = pos; k < size; k++) at = prev[at];
+      x = vertex[at];
+      (vertex[entries] = x), (next[entries] = n), (prev[entries] = prev[at]), (apex[entries] = u);
+      gate = next[prev[at]] = prev[n] = entries++;
+      next[g] = at;
+      prev[at] = g;
+      apex[g] = w;
+      (stack[top++] = g), (stack[top++] = size - pos + 1);
+      size = pos;
     }
-    offsets[v + 1] = list.length;
+    if (x === u || x === w) corrupt(`operation ${i} makes a degenerate triangle`);
+    visits[u]++, visits[w]++, visits[x]++;
+    (faces[3 * i + 3] = u), (faces[3 * i + 4] = w), (faces[3 * i + 5] = x);
   }
-  return [offsets, Int32Array.from(list)];
+  if (!done) corrupt('the traversal leaves triangles unvisited');
+  if (nd !== nv + 1) corrupt(`${nd - 1} vertices, but ${nv} are declared`);
+  src.end(CONNECTIVITY);
+  src.end(SPLITS);
+  let nh = 0;
+  for (let h = 0; h < 3 * nops + 3; h += 3)
+    if (faces[h] !== virt && faces[h + 1] !== virt && faces[h + 2] !== virt)
+      for (let k = 0; k < 3; k++) faces[nh++] = faces[h + k] - +(faces[h + k] > virt);
+  if (nh / 3 !== ntriangles) corrupt(`${nh / 3} triangles, but ${ntriangles} are declared`);
+  return [faces.slice(0, nh), basis, virt];
 }
 
-function compactLevel(c: Cursor, l: number, width: number, height: number, version: number): Level {
+// 3. Positions on the 2^-p grid, by vertex in decode order, each predicted from those before it:
+// the mean of the parallelograms a + b - c over triangles (x, a, b) and (b, a, c), else from the
+// gate it was met across; clamped to [0, max].
+function predict(
+  src: Source, t: Int32Array, [corners, start]: Int32Array[], twin: Int32Array, basis: Int32Array, virt: number, max: number[], what: string,
+): Float64Array[] {
+  const nv = start.length - 2, p = [new Float64Array(nv), new Float64Array(nv)], [px, py] = p, tx = new Float64Array(nv), ty = new Float64Array(nv);
+  let previousX = 0, previousY = 0;
+  src.begin(POSITIONS);
+  for (let v = 0; v < nv; v++) {
+    let n = 0, sx = 0, sy = 0, bx = 0, by = 0, qx: number, qy: number;
+    for (let i = start[v]; i < start[v + 1]; i++) {
+      const h = corners[i], ab = h % 3 === 2 ? h - 2 : h + 1, a = t[ab], b = t[h % 3 ? h - 1 : h + 2], o = twin[ab];
+      const c = o < 0 ? v + 1 : t[o % 3 ? o - 1 : o + 2];
+      if (a > v || b > v || c > v) continue;
+      const x = px[a] + px[b] - px[c], y = py[a] + py[b] - py[c];
+      (sx += tx[n] = x), (sy += ty[n] = y), (bx += Math.abs(x)), (by += Math.abs(y)), n++;
+    }
+    const d = v + +(v >= virt), u = basis[3 * d], w = basis[3 * d + 1], a = basis[3 * d + 2];
+    const U = u - +(u > virt), W = w - +(w > virt), A = a - +(a > virt);
+    if (n) {
+      qx = bx < 2 ** 50 ? Math.floor((2 * sx + n) / (2 * n)) : mean(tx, n);
+      qy = by < 2 ** 50 ? Math.floor((2 * sy + n) / (2 * n)) : mean(ty, n);
+    } else if (u < 0) (qx = previousX), (qy = previousY);
+    else if (u === virt) (qx = px[W]), (qy = py[W]);
+    else if (w === virt) (qx = px[U]), (qy = py[U]);
+    else if (a === virt) {
+      // Across a border edge: the apex of an equilateral triangle on its inner side.
+      qx = Math.floor((px[U] + px[W]) / 2) - Math.floor(((py[W] - py[U]) * 7) / 8);
+      qy = Math.floor((py[U] + py[W]) / 2) + Math.floor(((px[W] - px[U]) * 7) / 8);
+    } else (qx = px[U] + px[W] - px[A]), (qy = py[U] + py[W] - py[A]);
+    const rx = src.read(POSITIONS, X, true), ry = src.read(POSITIONS, X + 1, true);
+    if (Math.abs(rx) > 2 ** 40 || Math.abs(ry) > 2 ** 40) fail(`${what}positions: residual out of range`);
+    previousX = px[v] = Math.min(Math.max(qx, 0), max[0]) + rx;
+    previousY = py[v] = Math.min(Math.max(qy, 0), max[1]) + ry;
+  }
+  src.end(POSITIONS);
+  return p;
+}
+
+// 5. Colors: one value per wedge (tc, nc), numbered canonically; each predicted by the rounded
+// mean of the known values it shares a triangle with (those numbered before it; else the
+// previous one), coded as d_G, d_R - d_G, d_B - d_G in contexts of the neighbors' residuals.
+// Values on the 2^-cb grid, returned in units.
+function decodeColors(src: Source, tc: Int32Array, nc: number, cb: number, what: string): Float32Array {
+  const [wedge, start] = sortBy(tc, nc), adjacent = new Int32Array(nc), terms = new Float64Array(nc), seen = new Int32Array(nc);
+  const rgb = new Float64Array(3 * nc), activity = new Float64Array(3 * nc), colors = new Float32Array(3 * nc);
+  const mid = Math.round(128 * 2 ** cb), last = [mid, mid, mid], q = [0, 0, 0], d = [0, 0, 0];
+  src.begin(COLORS);
+  for (let ci = 0; ci < nc; ci++) {
+    let n = 0;
+    for (let i = start[ci]; i < start[ci + 1]; i++) {
+      const h = wedge[i], j = tc[h % 3 === 2 ? h - 2 : h + 1], k = tc[h % 3 ? h - 1 : h + 2];
+      if (j < ci && seen[j] <= ci) (seen[j] = ci + 1), (adjacent[n++] = j);
+      if (k < ci && seen[k] <= ci) (seen[k] = ci + 1), (adjacent[n++] = k);
+    }
+    for (let ch = 0; ch < 3; ch++) {
+      let s = 0, bound = 0, act = 0;
+      for (let k = 0; k < n; k++) {
+        const j = 3 * adjacent[k] + ch;
+        (s += terms[k] = rgb[j]), (bound += Math.abs(rgb[j])), (act += activity[j]);
+      }
+      q[ch] = !n ? last[ch] : bound < 2 ** 50 ? Math.floor((2 * s + n) / (2 * n)) : mean(terms, n);
+      d[ch] = src.read(COLORS, COLOR + 5 * ch + (n ? Math.min((33 - Math.clz32(Math.floor(act / n))) >> 1, 4) : 0), true);
+    }
+    for (let ch = 0; ch < 3; ch++) {
+      if (Math.abs(d[ch]) > 2 ** 48) fail(`${what}colors: residual out of range`);
+      activity[3 * ci + ch] = Math.min(Math.abs(d[ch]), 65535);
+    }
+    for (let ch = 0; ch < 3; ch++) {
+      if (Math.abs(q[ch]) > 2 ** 48) fail(`${what}colors: value out of range`);
+      last[ch] = rgb[3 * ci + ch] = q[ch] + (ch === 1 ? d[0] : d[ch || 1] + d[0]);
+      colors[3 * ci + ch] = last[ch] * 2 ** -cb;
+    }
+  }
+  src.end(COLORS);
+  return colors;
+}
+
+function compactLevel(c: Cursor, l: number, width: number, height: number, version: number, topologies: Topology[]): Level {
   const name = `level ${l} `;
   c.what = `${name}counts`;
   const [nv, ncolors, ntriangles, ncreases, nfeatures] = ['vertices', 'colors', 'triangles', 'creases', 'features'].map((w) => c.count(name + w, 0));
@@ -478,163 +667,48 @@ function compactLevel(c: Cursor, l: number, width: number, height: number, versi
   if (pb > 12 || cb < -4 || cb > 12) fail(`${name}precision: position bits ${pb}, color bits ${cb} (expected 0 to 12 and -4 to 12)`);
   if (nv < 3) fail(`${name}vertices: ${nv} (a level has at least 3)`);
   let src: Source;
-  if (version === 2) src = varintSource(c, name, nv);
+  if (version === 2) src = new Varints(c, name, nv);
   else {
     const label = `${name}stream`, n = c.count(label, 1, MAX_ELEMENTS * 64);
     c.what = label;
-    src = rangeSource(c.bytes(n), name, nv);
+    src = new RangeCoded(c.bytes(n), name, nv);
   }
 
-  // 1-2. Connectivity: the traversal of the mesh closed by the virtual vertex, 2V - 3 operations
-  // after the seed (0, 1, 2). Vertices get decode numbers as C meets them.
-  const corrupt = (message: string): never => fail(`${name}connectivity: ${message}`);
-  src.begin(CONNECTIVITY);
-  src.begin(SPLITS);
-  const virt = src.virtual();
-  if (virt < 3 || virt > nv) corrupt(`virtual vertex ${virt} out of range`);
-  const basis = [-1, -1, -1, -1, -1, -1, -1, -1, -1]; // per decode number: gate u, w and apex when met
-  const faces = [0, 1, 2], visits = [1, 1, 1];
-  const fan = (v: number) => (v === virt ? 7 : Math.min(visits[v], 6));
-  // The frontier: cyclic lists of entries, each the edge to the next one, with the apex (third
-  // vertex) of the visited triangle across it; the current loop starts at its gate, the others
-  // wait on the stack (gate, size). At the start the loop is 1, 0, 2.
-  const vertex = [1, 0, 2], next = [1, 2, 0], prev = [2, 0, 1], apex = [2, 1, 0], stack: number[] = [];
-  let gate = 0, size = 3, done = false;
-  const entry = (v: number, n: number, p: number, a: number) => {
-    next[p] = prev[n] = vertex.length;
-    next.push(n), prev.push(p), apex.push(a);
-    return vertex.push(v) - 1;
-  };
-  const unlink = (k: number) => {
-    next[prev[k]] = next[k];
-    prev[next[k]] = prev[k];
-    size--;
-  };
-  for (let i = 0; i < 2 * nv - 3; i++) {
-    if (done) corrupt('the traversal ends before the last operation');
-    const g = gate, n = next[g], u = vertex[g], w = vertex[n], op = src.op(size === 3, fan(u), fan(w));
-    let x: number;
-    if (op === C) {
-      // x new, between u and w
-      if (visits.length > nv) corrupt(`more vertices than the ${nv} declared`);
-      basis.push(u, w, apex[g]);
-      x = visits.push(0) - 1;
-      apex[g] = w;
-      gate = entry(x, n, g, u);
-      size++;
-    } else if (op === E) {
-      // the loop is u, w, x: done; continue with the one on top of the stack
-      if (size !== 3) corrupt(`operation ${i} closes a loop of ${size} edges`);
-      x = vertex[next[n]];
-      if (!(done = !stack.length)) (size = stack.pop()!), (gate = stack.pop()!);
-    } else if (op === R || op === L) {
-      // x after w (w leaves the loop), or before u (u leaves)
-      if (size <= 3) corrupt(`operation ${i} on a loop of 3 edges`);
-      const p = prev[g];
-      x = vertex[op === R ? next[n] : p];
-      op === R ? ((apex[g] = w), unlink(n)) : ((apex[p] = u), unlink(g), (gate = p));
-    } else {
-      // x pos entries on: the loop splits into x, w, ... (current) and u, x, ... (put aside)
-      const code = src.split(), half = Math.floor(code / 2), pos = code % 2 ? size - 2 - half : half + 3;
-      if (pos < 3 || pos > size - 2) corrupt('split offset out of range');
-      let at = g;
-      if (pos <= size / 2) for (let k = 0; k < pos; k++) at = next[at];
-      else for (let k = pos; k < size; k++) at = prev[at];
-      x = vertex[at];
-      gate = entry(x, n, prev[at], u);
-      next[g] = at;
-      prev[at] = g;
-      apex[g] = w;
-      stack.push(g, size - pos + 1);
-      size = pos;
-    }
-    if (x === u || x === w) corrupt(`operation ${i} makes a degenerate triangle`);
-    visits[u]++, visits[w]++, visits[x]++;
-    faces.push(u, w, x);
-  }
-  if (!done) corrupt('the traversal leaves triangles unvisited');
-  if (visits.length !== nv + 1) corrupt(`${visits.length - 1} vertices, but ${nv} are declared`);
-  src.end(CONNECTIVITY);
-  src.end(SPLITS);
-
-  // The level's vertices are the decode numbers without the virtual one; its triangles the
-  // visited ones without it, in visit order.
-  const nd = nv + 1, vertexOf = (d: number) => (d < virt ? d : d - 1), decodeOf = (v: number) => (v < virt ? v : v + 1);
-  const real: number[] = [];
-  for (let f = 0; f < faces.length; f += 3) if (faces[f] !== virt && faces[f + 1] !== virt && faces[f + 2] !== virt) real.push(f / 3);
-  if (real.length !== ntriangles) corrupt(`${real.length} triangles, but ${ntriangles} are declared`);
-  const triangles = new Int32Array(3 * real.length);
-  real.forEach((f, i) => triangles.set(faces.slice(3 * f, 3 * f + 3).map(vertexOf), 3 * i));
-
-  // 3. Positions on the 2^-p grid by decode number, each predicted from those before it: the
-  // mean of the parallelograms a + b - c over triangles (x, a, b) and (b, a, c), else from the
-  // gate it was met across; clamped to the image.
-  src.begin(POSITIONS);
-  const px = new Float64Array(nd), py = new Float64Array(nd), ha = new Int32Array(3 * real.length), hb = new Int32Array(3 * real.length);
-  real.forEach((f, i) => {
-    for (let k = 0; k < 3; k++) (ha[3 * i + k] = faces[3 * f + k]), (hb[3 * i + k] = faces[3 * f + ((k + 1) % 3)]);
-  });
-  // Half-edges by (from, to): the faces around a vertex (its outgoing half-edges) and the face
-  // holding a given half-edge.
-  const [order, start] = sortPairs(ha, hb, nd);
-  const face = (a: number, b: number) => {
-    for (let i = start[a]; i < start[a + 1]; i++) if (hb[order[i]] === b) return real[(order[i] / 3) | 0];
-    return -1;
-  };
-  const maxX = width * 2 ** pb, maxY = height * 2 ** pb, tx: number[] = [], ty: number[] = [];
-  let previousX = 0, previousY = 0;
-  for (let d = 0; d < nd; d++) {
-    if (d === virt) continue;
-    tx.length = ty.length = 0;
-    for (let i = start[d]; i < start[d + 1]; i++) {
-      const a = hb[order[i]], f = real[(order[i] / 3) | 0], b = faces.slice(3 * f, 3 * f + 3).find((v) => v !== d && v !== a)!;
-      if (a > d || b > d) continue;
-      const o = face(b, a);
-      if (o < 0) continue;
-      const third = faces.slice(3 * o, 3 * o + 3).find((v) => v !== a && v !== b)!;
-      if (third > d) continue;
-      tx.push(px[a] + px[b] - px[third]), ty.push(py[a] + py[b] - py[third]);
-    }
-    let qx: number, qy: number;
-    const [u, w, a] = basis.slice(3 * d, 3 * d + 3);
-    if (tx.length) (qx = mean(tx)), (qy = mean(ty));
-    else if (u < 0) (qx = previousX), (qy = previousY);
-    else if (u === virt) (qx = px[w]), (qy = py[w]);
-    else if (w === virt) (qx = px[u]), (qy = py[u]);
-    else if (a === virt) {
-      // Across a border edge: the apex of an equilateral triangle on its inner side.
-      qx = Math.floor((px[u] + px[w]) / 2) - Math.floor(((py[w] - py[u]) * 7) / 8);
-      qy = Math.floor((py[u] + py[w]) / 2) + Math.floor(((px[w] - px[u]) * 7) / 8);
-    } else (qx = px[u] + px[w] - px[a]), (qy = py[u] + py[w] - py[a]);
-    const rx = src.position(0), ry = src.position(1);
-    if (Math.abs(rx) > 2 ** 40 || Math.abs(ry) > 2 ** 40) fail(`${name}positions: residual out of range`);
-    previousX = px[d] = Math.min(Math.max(qx, 0), maxX) + rx;
-    previousY = py[d] = Math.min(Math.max(qy, 0), maxY) + ry;
-  }
-  src.end(POSITIONS);
-  const fx = new Float64Array(nv).map((_, v) => px[decodeOf(v)]), fy = new Float64Array(nv).map((_, v) => py[decodeOf(v)]);
-  const positions = new Float64Array(2 * nv).map((_, i) => (i % 2 ? fy : fx)[i >> 1] * 2 ** -pb);
+  const [triangles, basis, virt] = traverse(src, nv, ntriangles, (message) => fail(`${name}connectivity: ${message}`));
+  // The corners by vertex; the edges (whose problems are reported after the features, as C++
+  // finds them; until then, no twins).
+  const corners = sortBy(triangles, nv), found = edges(triangles, nv);
+  const twin = typeof found === 'string' ? new Int32Array(triangles.length).fill(-1) : found.twin;
+  const [px, py] = predict(src, triangles, corners, twin, basis, virt, [width * 2 ** pb, height * 2 ** pb], name);
+  const positions = new Float64Array(2 * nv);
+  for (let v = 0; v < nv; v++) (positions[2 * v] = px[v] * 2 ** -pb), (positions[2 * v + 1] = py[v] * 2 ** -pb);
 
   // 4. Creases and features: a first vertex, then each next one as its rank among the current
   // vertex's neighbors, by number for the first step, after that straightest first (exact
   // integer dot products, one rounding, as in C++).
   src.begin(FEATURES);
   src.begin(STEPS);
-  const [offsets, list] = neighbors(triangles, nv);
+  const stamp = new Int32Array(nv), score = new Float64Array(nv);
+  let stamps = 0;
   const checked = (v: number, what: string) => (v >= nv ? fail(`${name}${what}: vertex ${v} out of range`) : v);
   const step = (from: number, at: number, first: boolean, what: string) => {
-    let ranked = Array.from(list.subarray(offsets[at], offsets[at + 1]));
-    if (from >= 0) {
-      const dx = fx[at] - fx[from], dy = fy[at] - fy[from];
-      ranked = ranked
-        .map((q) => {
-          const ex = fx[q] - fx[at], ey = fy[q] - fy[at], len = Math.sqrt(exact(ex, ex, ey, ey));
-          return [len > 0 ? -exact(dx, ex, dy, ey) / len : 0, q];
-        })
-        .sort((s, t) => s[0] - t[0] || s[1] - t[1])
-        .map((k) => k[1]);
+    const ranked: number[] = [];
+    stamps++;
+    for (let i = corners[1][at]; i < corners[1][at + 1]; i++)
+      for (let k = 0; k < 2; k++) {
+        const q = triangles[k ? prev3(corners[0][i]) : next3(corners[0][i])];
+        if (stamp[q] !== stamps) (stamp[q] = stamps), ranked.push(q);
+      }
+    if (from < 0) ranked.sort((q, r) => q - r);
+    else {
+      const dx = px[at] - px[from], dy = py[at] - py[from];
+      for (const q of ranked) {
+        const ex = px[q] - px[at], ey = py[q] - py[at], len = Math.sqrt(exact(ex, ex, ey, ey));
+        score[q] = len > 0 ? -exact(dx, ex, dy, ey) / len : 0;
+      }
+      ranked.sort((q, r) => score[q] - score[r] || q - r);
     }
-    const r = src.step(first);
+    const r = src.read(STEPS, first ? STEP_FIRST : STEP_NEXT);
     return r >= ranked.length ? fail(`${name}${what}: step ${r} out of range`) : ranked[r];
   };
   const creases: number[] = [], features: Feature[] = [];
@@ -643,47 +717,25 @@ function compactLevel(c: Cursor, l: number, width: number, height: number, versi
     creases.push(a, step(-1, a, true, `crease ${i}`));
   }
   for (let i = 0, previous = -1; i < nfeatures; i++) {
-    const what = `feature ${i}`, id = (previous += 1 + src.id(what));
+    const what = `feature ${i}`, id = (previous += 1 + src.read(FEATURES, ID, true, what));
     if (id < -(2 ** 31) || id > 2 ** 31 - 1) fail(`${name}${what}: id out of range`);
     const saliency = src.saliency(what), n = src.length(what);
-    if (n > nv) fail(`${name}${what}: ${n + 2} vertices, more than the level has`);
-    const v = [checked(src.vertex(), what)];
-    for (let k = 0; k <= n; k++) v.push(step(v.length >= 2 ? v[v.length - 2] : -1, v[v.length - 1], k === 0, what));
-    features.push({ id, saliency, vertices: Int32Array.from(v) });
+    if (n > Math.min(nv, MAX_ELEMENTS - 2)) fail(`${name}${what}: ${n + 2} vertices, more than the level has`);
+    const v = new Int32Array(n + 2);
+    v[0] = checked(src.vertex(), what);
+    for (let k = 0; k <= n; k++) v[k + 1] = step(k ? v[k - 1] : -1, v[k], !k, what);
+    features.push({ id, saliency, vertices: v });
   }
   src.end(FEATURES);
   src.end(STEPS);
 
-  // 5. Colors: one value per wedge (the tears are known now), numbered canonically; each
-  // predicted by the rounded mean of the known values it shares a triangle with (else the
-  // previous one), coded as d_G, d_R - d_G, d_B - d_G in contexts of the neighbors' residuals.
-  src.begin(COLORS);
+  // The tears are known now: the wedges, and their colors.
   const level: Level = { positions, colors: new Float32Array(0), triangles, triangleColors: triangles, creases: Int32Array.from(creases), features };
-  const [triangleColors, nc] = wedges(level, topology(level, nv));
+  const topo = (topologies[l] = topology(level, nv, '', found)), [triangleColors, nc] = wedges(level, topo);
   if (nc !== ncolors) fail(`${name}colors: the tears give ${nc} color values, but ${ncolors} are declared`);
-  const [coffsets, clist] = neighbors(triangleColors, nc);
-  const rgb = new Float64Array(3 * nc), activity = new Float64Array(3 * nc), known = new Uint8Array(nc);
-  const mid = Math.round(128 * 2 ** cb), last = [mid, mid, mid];
-  for (let ci = 0; ci < nc; ci++) {
-    const adjacent = Array.from(clist.subarray(coffsets[ci], coffsets[ci + 1])).filter((j) => known[j]), n = adjacent.length;
-    const q = [0, 1, 2].map((ch) => (n ? mean(adjacent.map((j) => rgb[3 * j + ch])) : last[ch]));
-    const d = [0, 1, 2].map((ch) => {
-      const mean = Math.floor(adjacent.reduce((s, j) => s + activity[3 * j + ch], 0) / n);
-      return src.color(ch, n ? Math.min((33 - Math.clz32(mean)) >> 1, 4) : 0);
-    });
-    d.forEach((r, ch) => {
-      if (Math.abs(r) > 2 ** 48) fail(`${name}colors: residual out of range`);
-      activity[3 * ci + ch] = Math.min(Math.abs(r), 65535);
-    });
-    [d[1] + d[0], d[0], d[2] + d[0]].forEach((r, ch) => {
-      if (Math.abs(q[ch]) > 2 ** 48) fail(`${name}colors: value out of range`);
-      last[ch] = rgb[3 * ci + ch] = q[ch] + r;
-    });
-    known[ci] = 1;
-  }
-  src.end(COLORS);
+  const colors = decodeColors(src, triangleColors, nc, cb, name);
   src.finish();
-  return { ...level, colors: Float32Array.from(rgb, (v) => v * 2 ** -cb), triangleColors };
+  return { ...level, colors, triangleColors };
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -934,7 +986,7 @@ export function decode(bytes: Uint8Array | ArrayBuffer, name?: string): SvecImag
     return other ? fail(other) : binary(b);
   } catch (e) {
     const message = e instanceof SvecError ? e.message : `internal error: ${e instanceof Error ? e.message : String(e)}`;
-    throw new SvecError(oneLine(name ? `${name}: ${message}` : message));
+    throw new SvecError(escape(name ? `${name}: ${message}` : message));
   }
 }
 
@@ -956,7 +1008,7 @@ export async function load(source: string | URL | Blob | ArrayBuffer | Uint8Arra
       bytes = await source.arrayBuffer();
     } else bytes = source;
   } catch (e) {
-    throw new SvecError(oneLine(`${name ? `${name}: ` : ''}${e instanceof Error ? e.message : String(e)}`));
+    throw new SvecError(escape(`${name ? `${name}: ` : ''}${e instanceof Error ? e.message : String(e)}`));
   }
   return decode(bytes, name);
 }
