@@ -41,6 +41,10 @@ struct Editor::Session {
     int vertex = -1, feature = -1;
     std::unique_ptr<subvec::ShapeEditor> shape;
     std::vector<Vec2> preview;
+    // The last target the preview accepted (it starts at the press point): a release the mesh
+    // cannot take commits this one instead.
+    Vec2 last_to;
+    double last_rotate = 0;
   };
   std::unique_ptr<Drag> drag;
 };
@@ -62,6 +66,19 @@ uint8_t to_byte(float v) {
 
 // apply_edit_ops names the operation of its ops file ("ops[0] (drag): ..."); the page applies one
 // operation at a time, so the prefix says nothing there.
+// What an edit was, for the undo and redo messages: "color blend at (223, 262)".
+std::string edit_label(const EditOp& op) {
+  const auto at = [](Vec2 p) {
+    return " at (" + std::to_string(std::lround(p.x)) + ", " + std::to_string(std::lround(p.y)) + ")";
+  };
+  switch (op.kind) {
+    case EditOp::Kind::kDrag: return "drag" + at(op.from);
+    case EditOp::Kind::kMoveFeature: return "feature move" + at(op.at);
+    case EditOp::Kind::kColor: return op.name() + at(op.at);
+  }
+  return op.name();
+}
+
 std::string without_op_prefix(const std::string& line) {
   if (line.rfind("ops[0] (", 0) != 0) return line;
   const size_t end = line.find("): ");
@@ -453,6 +470,7 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
   auto drag = std::make_unique<Session::Drag>();
   drag->start = start;
   drag->start.at = clamp_to_image(start.at, image_.width, image_.height);
+  drag->last_to = drag->start.at;
   drag->version = version;
   SelectResult result;
   if (!start.move_feature && start.select == EditSelect::kVertex) {
@@ -520,6 +538,8 @@ Delta Editor::drag_move_locked(Session& session, Vec2 to, double rotate) {
   } catch (const Error& e) {
     refuse_edit(e);
   }
+  drag.last_to = to;
+  drag.last_rotate = rotate;
   if (!session.view || session.view->mesh.level != drag.start.level) {
     Delta none;
     return none;
@@ -539,29 +559,61 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
     throw RequestError(kBadRequest, "drag target must be finite");
   }
   to = clamp_to_image(to, image_.width, image_.height);
-  EditOp op;
-  op.level = drag->start.level;
-  op.region = drag->start.region;
-  if (drag->start.move_feature) {
-    op.kind = EditOp::Kind::kMoveFeature;
-    op.at = drag->start.at;
-    op.translate = {to.x - drag->start.at.x, to.y - drag->start.at.y};
-    op.rotate = rotate;
-  } else {
-    op.kind = EditOp::Kind::kDrag;
-    op.select = drag->vertex >= 0 ? EditSelect::kVertex : EditSelect::kFeature;
-    op.from = drag->start.at;
-    op.to = to;
-    op.sigma = drag->start.sigma;
-  }
+  const auto op_to = [&](Vec2 target, double angle) {
+    EditOp op;
+    op.level = drag->start.level;
+    op.region = drag->start.region;
+    if (drag->start.move_feature) {
+      op.kind = EditOp::Kind::kMoveFeature;
+      op.at = drag->start.at;
+      op.translate = {target.x - drag->start.at.x, target.y - drag->start.at.y};
+      op.rotate = angle;
+    } else {
+      op.kind = EditOp::Kind::kDrag;
+      op.select = drag->vertex >= 0 ? EditSelect::kVertex : EditSelect::kFeature;
+      op.from = drag->start.at;
+      op.to = target;
+      op.sigma = drag->start.sigma;
+    }
+    return op;
+  };
+  // The release position, or else the last one the preview took: a drag that cannot go all the
+  // way stops where it last could (issue 29), and says so. The page's message is plain: what
+  // moved and by how much (the library's line names vertex counts and solver figures).
+  const auto said = [&](Vec2 target, double angle) {
+    const auto px = [](double v) {
+      std::string t = std::to_string(std::lround(v * 10) / 10.0);
+      t.erase(t.find_last_not_of('0') + 1);
+      if (t.back() == '.') t.pop_back();
+      return t == "-0" ? std::string("0") : t;
+    };
+    const std::string by =
+        "(" + px(target.x - drag->start.at.x) + ", " + px(target.y - drag->start.at.y) + ") px";
+    if (!drag->start.move_feature) return "dragged by " + by;
+    return "moved by " + by + (angle != 0 ? ", rotated by " + px(angle) + "°" : std::string());
+  };
   VectorImage edited = image_;
+  EditOp op = op_to(to, rotate);
   try {
-    const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
-    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
+    subvec::apply_edit_ops(edited, std::span(&op, 1));
+    log = said(to, rotate);
   } catch (const Error& e) {
-    refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+    const bool moved = drag->last_to.x != drag->start.at.x || drag->last_to.y != drag->start.at.y ||
+                       drag->last_rotate != 0;
+    if (e.code() != ErrorCode::kInvalidArgument || !moved) {
+      refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+    }
+    edited = image_;
+    op = op_to(drag->last_to, drag->last_rotate);
+    try {
+      subvec::apply_edit_ops(edited, std::span(&op, 1));
+      log = "stopped at the last position the mesh could take: " +
+            said(drag->last_to, drag->last_rotate);
+    } catch (const Error&) {
+      refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+    }
   }
-  commit_locked(std::move(edited));
+  commit_locked(std::move(edited), edit_label(op));
   return delta_locked(session, nullptr, false);
 }
 
@@ -570,8 +622,8 @@ void Editor::drag_cancel(const std::string& session_id) {
   session_locked(session_id).drag.reset();
 }
 
-void Editor::commit_locked(VectorImage image) {
-  undo_.push_back(std::move(image_));
+void Editor::commit_locked(VectorImage image, std::string label) {
+  undo_.push_back({std::move(image_), std::move(label)});
   if (static_cast<int>(undo_.size()) > kMaxUndo) undo_.erase(undo_.begin());
   redo_.clear();
   image_ = std::move(image);
@@ -591,7 +643,7 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   } catch (const Error& e) {
     refuse_edit(Error(e.code(), without_op_prefix(e.what())));
   }
-  commit_locked(std::move(edited));
+  commit_locked(std::move(edited), edit_label(op));
   return delta_locked(session, nullptr, false);
 }
 
@@ -618,7 +670,7 @@ Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
   log = std::to_string(report.strokes) + " strokes on " +
         std::to_string(report.above + report.chosen) + " of " + std::to_string(report.in_region) +
         " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")";
-  commit_locked(std::move(edited));
+  commit_locked(std::move(edited), "stylize");
   return delta_locked(session, nullptr, true);
 }
 
@@ -661,7 +713,7 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
     }
   }
   VectorImage start = continues ? std::move(filter_base_) : image_;
-  commit_locked(std::move(filtered));
+  commit_locked(std::move(filtered), identity ? "filter off" : "filter");
   filter_base_ = std::move(start);
   filter_version_ = version_;
   filter_ = request;
@@ -678,25 +730,26 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
   return delta_locked(session, nullptr, false);
 }
 
-Delta Editor::undo(const std::string& session_id, int64_t version) {
-  return step_history(session_id, version, undo_, redo_, "nothing to undo");
+Delta Editor::undo(const std::string& session_id, int64_t version, std::string& label) {
+  return step_history(session_id, version, undo_, redo_, "nothing to undo", label);
 }
 
-Delta Editor::redo(const std::string& session_id, int64_t version) {
-  return step_history(session_id, version, redo_, undo_, "nothing to redo");
+Delta Editor::redo(const std::string& session_id, int64_t version, std::string& label) {
+  return step_history(session_id, version, redo_, undo_, "nothing to redo", label);
 }
 
 // Undo takes from the undo stack and keeps the current image on the redo stack; redo the reverse.
 Delta Editor::step_history(const std::string& session_id, int64_t version,
-                           std::vector<VectorImage>& from, std::vector<VectorImage>& to,
-                           const char* empty_message) {
+                           std::vector<HistoryStep>& from, std::vector<HistoryStep>& to,
+                           const char* empty_message, std::string& label) {
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
   if (from.empty()) throw RequestError(kConflict, empty_message);
-  const bool strokes_changed = from.back().strokes.size() != image_.strokes.size();
-  to.push_back(std::move(image_));
-  image_ = std::move(from.back());
+  const bool strokes_changed = from.back().image.strokes.size() != image_.strokes.size();
+  label = from.back().label;
+  to.push_back({std::move(image_), label});
+  image_ = std::move(from.back().image);
   from.pop_back();
   ++version_;
   session.drag.reset();

@@ -208,8 +208,9 @@ class Editor {
   // started from, so eta = 1 everywhere gives that image back exactly. Each one is an undo step.
   Delta filter(const std::string& session, int64_t version, const FilterRequest& request,
                std::string& log);
-  Delta undo(const std::string& session, int64_t version);
-  Delta redo(const std::string& session, int64_t version);
+  // `label` gets the edit undone or redone.
+  Delta undo(const std::string& session, int64_t version, std::string& label);
+  Delta redo(const std::string& session, int64_t version, std::string& label);
 
  private:
   struct Session;
@@ -217,16 +218,22 @@ class Editor {
   Session& session_locked(const std::string& id);
   void check_version_locked(int64_t version) const;
   void check_level_locked(int level) const;
-  void commit_locked(VectorImage image);
+  void commit_locked(VectorImage image, std::string label);
   Delta drag_move_locked(Session& session, Vec2 to, double rotate);
   Delta delta_locked(Session& session, const std::vector<Vec2>* preview, bool strokes_changed);
-  Delta step_history(const std::string& session, int64_t version, std::vector<VectorImage>& from,
-                     std::vector<VectorImage>& to, const char* empty_message);
+  // An undo or redo step: the image on the other side of it, and the edit it is ("color blend at
+  // (223, 262)"), which the page shows as "undid: ...".
+  struct HistoryStep {
+    VectorImage image;
+    std::string label;
+  };
+  Delta step_history(const std::string& session, int64_t version, std::vector<HistoryStep>& from,
+                     std::vector<HistoryStep>& to, const char* empty_message, std::string& label);
 
   mutable std::mutex mutex_;
   VectorImage image_;
   int64_t version_ = 1;
-  std::vector<VectorImage> undo_, redo_;
+  std::vector<HistoryStep> undo_, redo_;
   // The image the current run of filters started from, valid while version_ == filter_version_.
   VectorImage filter_base_;
   int64_t filter_version_ = 0;

@@ -638,9 +638,10 @@ void EditorServer::Impl::edit_routes() {
     return [this, undo](const httplib::Request& req, httplib::Response& res) {
       const json j = body_json(req);
       std::shared_ptr<Editor> doc = ready_editor();
-      const Delta d = undo ? doc->undo(text(j, "session"), integer(j, "version"))
-                           : doc->redo(text(j, "session"), integer(j, "version"));
-      res.set_content(delta_frame(d, {{"version", doc->version()}}),
+      std::string label;
+      const Delta d = undo ? doc->undo(text(j, "session"), integer(j, "version"), label)
+                           : doc->redo(text(j, "session"), integer(j, "version"), label);
+      res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", label}}),
                       "application/octet-stream");
     };
   };

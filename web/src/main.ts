@@ -1,9 +1,11 @@
 // The subvec editor page: tools, view, and the conversation with `subvec serve` (docs/serve.md).
 //
 // State. The server owns the document and its version; this page owns a session (its refined
-// view of one level at the depth its zoom needs) and the last version it drew. Every edit sends
-// that version; a 409 answer means another tab changed the document, and the page reloads.
-// A poll of /api/status notices changes made elsewhere the same way.
+// view of one level at the depth its zoom needs) and the last version it drew. Every request that
+// changes the document or the session's view runs in one queue, one at a time, in the order the
+// user asked (enqueue): each sends the version its predecessor left, so only another tab's edit
+// can make a 409 conflict, and the page then reloads. A poll of /api/status notices changes made
+// elsewhere the same way.
 
 import { ApiError, Frame, getJson, postFrame, postJson } from './api';
 import { Renderer, Transform, softwareWebGL } from './gl';
@@ -41,12 +43,8 @@ const state = {
   view: { id: 0, depth: -1, partial: false, window: null as number[] | null, zoom: 0 },
   transform: { zoom: 1, panX: 0, panY: 0 } as Transform,
   overlays: { mesh: false, features: false },
-  busy: 0,           // requests that change the document, in flight
-  drag: null as null | {
-    pointer: number; start: [number, number]; target: [number, number]; rotate: number;
-    shiftX: number; sentAt: number; pending: boolean; inFlight: Promise<void> | null; ok: boolean;
-    eventTime: number;
-  },
+  busy: 0,           // tasks queued or running (enqueue): never negative
+  drag: null as Drag | null,  // the drag the pointer holds (its task may still be queued)
   pan: null as null | { x: number; y: number; panX: number; panY: number },
   space: false,
   viewTimer: 0,
@@ -54,7 +52,44 @@ const state = {
   latencies: [] as number[],
 };
 
+// A drag or move, from press to release. Its task (runDrag) holds the queue from the press
+// until the end is committed; previews go out one at a time, the latest pointer position winning.
+interface Drag {
+  pointer: number;
+  press: [number, number];   // canvas pixels
+  moved: boolean;            // the pointer went CLICK_SLOP pixels from the press: a click is no drag
+  start: [number, number];   // image pixels
+  target: [number, number];
+  rotate: number;
+  shiftX: number;
+  pending: boolean;          // a position not sent as a preview yet
+  inFlight: Promise<void> | null;
+  ok: boolean;               // the server took the start
+  previewed: boolean;        // a preview was drawn
+  released: boolean;
+  release: (commit: boolean) => void;
+  done: Promise<boolean>;    // true: released (commit), false: cancelled
+  eventTime: number;
+}
+const CLICK_SLOP = 3;  // CSS pixels
+
 let renderer: Renderer;
+
+// The queue: task after task, each started when the one before it settled.
+let queue: Promise<void> = Promise.resolve();
+function enqueue(task: () => Promise<void>): Promise<void> {
+  state.busy++;
+  const run = async () => {
+    try {
+      await task();
+    } finally {
+      state.busy--;
+    }
+  };
+  const done = queue.then(run);
+  queue = done.catch(() => undefined);
+  return done;
+}
 
 // Refinement target: refined edges at most this many canvas pixels long, and MSAA. A GPU draws
 // the fine setting for nothing; a software WebGL pays per triangle, so it gets the coarse one
@@ -163,44 +198,32 @@ function scheduleView() {
   if (!state.doc || !state.session) return;
   clearTimeout(state.viewTimer);
   state.viewTimer = window.setTimeout(() => {
-    if (state.drag || viewLoads > 0) return scheduleView();
+    if (state.drag || state.busy > 0) return scheduleView();
     if (!viewCovers(wantedView())) void loadView();
   }, 120);
 }
 
-// View loads run one at a time, in order, and edits wait for them: the server keeps one view per
-// session and answers edits with deltas against it, so the page must always hold the view the
-// server holds. A delta for another view (a race lost anyway) makes the page load the view again.
-let viewChain: Promise<void> = Promise.resolve();
-let viewLoads = 0;
-function loadView(): Promise<void> {
-  viewLoads++;
-  state.busy++;
-  const run = async () => {
-    try {
-      const want = wantedView();
-      const frame = await postFrame('/api/view', {
-        session: state.session, level: state.level, window: want.window, scale: want.zoom,
-        max_edge_pixels: quality.edge, have: state.view.id,
-      });
-      // "unchanged": the view held (`have`) already covers this one; nothing was sent.
-      if (!frame.header.unchanged) {
-        renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
-      }
-      state.view = {
-        id: frame.header.view, depth: frame.header.depth, partial: frame.header.partial,
-        window: want.window, zoom: want.zoom,
-      };
-      updateZoomLabel();
-      redraw();
-    } finally {
-      viewLoads--;
-      state.busy--;
-    }
+// View loads go through the queue like edits: the server keeps one view per session and answers
+// edits with deltas against it, so the page must always hold the view the server holds. A delta
+// for another view makes the page load the view again. fetchView runs inside a task.
+async function fetchView(): Promise<void> {
+  const want = wantedView();
+  const frame = await postFrame('/api/view', {
+    session: state.session, level: state.level, window: want.window, scale: want.zoom,
+    max_edge_pixels: quality.edge, have: state.view.id,
+  });
+  // "unchanged": the view held (`have`) already covers this one; nothing was sent.
+  if (!frame.header.unchanged) {
+    renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
+  }
+  state.view = {
+    id: frame.header.view, depth: frame.header.depth, partial: frame.header.partial,
+    window: want.window, zoom: want.zoom,
   };
-  viewChain = viewChain.then(run, run);
-  return viewChain;
+  updateZoomLabel();
+  redraw();
 }
+const loadView = () => enqueue(fetchView);
 
 async function loadControl() {
   const c = await getJson(`/api/control?level=${state.level}`);
@@ -261,9 +284,10 @@ function updateHistoryButtons() {
   $<HTMLButtonElement>('redo').disabled = !doc || doc.redo === 0;
 }
 
+// Inside a task (or before the page takes input).
 async function reloadAll(message?: string) {
   await loadDocument();
-  await Promise.all([loadView(), loadControl(), loadStrokes()]);
+  await Promise.all([fetchView(), loadControl(), loadStrokes()]);
   renderer.setHighlight([], []);
   redraw();
   if (message) status(message);
@@ -281,26 +305,29 @@ async function refreshCounts() {
   showFilter(doc);
 }
 
-// Runs an edit; on a version conflict reloads from the server, on other errors reports them.
-async function edit(run: () => Promise<void>) {
-  state.busy++;
+// Runs an edit inside a task: on a version conflict (another tab's edit) reloads from the server,
+// on other errors reports them.
+async function runEdit(run: () => Promise<void>) {
   try {
-    await viewChain.catch(() => undefined);
     await run();
     await refreshCounts();
   } catch (e) {
-    if (e instanceof ApiError && e.status === 409 && /another tab/.test(e.message)) {
-      await reloadAll();
-      status(e.message, true);
-    } else if (e instanceof ApiError && e.status === 404 && /session/.test(e.message)) {
-      await startSession();
-      status('the session had expired: reloaded', true);
-    } else {
-      status(e instanceof Error ? e.message : String(e), true);
-    }
+    await reportError(e);
   } finally {
-    state.busy--;
     redraw();
+  }
+}
+const edit = (run: () => Promise<void>) => enqueue(() => runEdit(run));
+
+async function reportError(e: unknown) {
+  if (e instanceof ApiError && e.status === 409 && /another tab/.test(e.message)) {
+    await reloadAll();
+    status('the document changed in another tab: reloaded it, try again', true);
+  } else if (e instanceof ApiError && e.status === 404 && /session/.test(e.message)) {
+    await startSession();
+    status('the session had expired: reloaded', true);
+  } else {
+    status(e instanceof Error ? e.message : String(e), true);
   }
 }
 
@@ -314,15 +341,19 @@ function setTool(tool: Tool) {
   canvas.classList.toggle('pan', tool === 'pan');
 }
 
+// Select changes nothing, so it skips the queue; of quick clicks, the last one's answer shows.
+let selectSeq = 0;
 async function doSelect(at: [number, number]) {
+  const seq = ++selectSeq;
   try {
     const r = await postJson('/api/select', { level: state.level, select: pick(), at, radius: num('radius') });
+    if (seq !== selectSeq) return;
     renderer.setHighlight(r.chain, r.region);
     status(r.feature >= 0
       ? `feature ${r.feature} (${r.chain.length} control vertices, ${r.distance.toFixed(1)} px away); region of ${r.colors} color values`
       : `vertex ${r.vertex} (${r.distance.toFixed(1)} px away); region of ${r.colors} color values`);
   } catch (e) {
-    status(e instanceof Error ? e.message : String(e), true);
+    if (seq === selectSeq) status(e instanceof Error ? e.message : String(e), true);
   }
   redraw();
 }
@@ -424,12 +455,17 @@ async function doFilter(reset = false) {
   });
 }
 
+// Quick presses queue up; those past the end of the history say so instead of asking.
 async function doHistory(kind: 'undo' | 'redo') {
   await edit(async () => {
+    if (state.doc && state.doc[kind] === 0) {
+      status(`nothing to ${kind}`);
+      return;
+    }
     const f = await postFrame(`/api/${kind}`, { session: state.session, version: state.version });
     applyDelta(f);
     renderer.setHighlight([], []);
-    status(`${kind} (version ${state.version})`);
+    status(f.header.log ? `${kind === 'undo' ? 'undid' : 'redid'}: ${f.header.log}` : kind === 'undo' ? 'undone' : 'redone');
   });
 }
 
@@ -450,7 +486,7 @@ async function doSave() {
   }
   await edit(async () => {
     const r = await postJson('/api/save', { version: state.version });
-    status(`saved ${r.saved} (version ${r.version})`);
+    status(`saved ${r.saved}`);
   });
 }
 
@@ -460,67 +496,109 @@ async function setLevel(level: number) {
   $<HTMLInputElement>('level').value = String(level);
   describeLevel();
   renderer.setHighlight([], []);
-  await Promise.all([loadView(), loadControl(), loadStrokes()]);
+  await enqueue(() => Promise.all([fetchView(), loadControl(), loadStrokes()]).then(() => undefined));
   status(`level ${level}`);
 }
 
-// Drag and move: start picks the handle on the server (and factors the ARAP system), moves are
-// previews (one request in flight; the latest mouse position wins), the release commits.
-async function dragStart(e: PointerEvent) {
-  const at = toImage(canvasPoint(e));
-  const drag = {
-    pointer: e.pointerId, start: at, target: at, rotate: 0, shiftX: canvasPoint(e)[0], sentAt: 0,
-    pending: false, inFlight: null as Promise<void> | null, ok: false, eventTime: 0,
+// Drag and move. The press queues the drag's task (runDrag), which picks the handle on the
+// server (and factors the ARAP system), sends previews while the pointer moves (one in flight; the
+// latest position wins) and, on release, commits the end; a release the server refuses commits
+// the last position the preview took. A press released without moving is a click: nothing is
+// sent (or the started drag is cancelled), and no undo step is made.
+function dragStart(e: PointerEvent) {
+  const p = canvasPoint(e);
+  const at = toImage(p);
+  let release!: (commit: boolean) => void;
+  const done = new Promise<boolean>((r) => { release = r; });
+  const drag: Drag = {
+    pointer: e.pointerId, press: p, moved: false, start: at, target: at, rotate: 0, shiftX: p[0],
+    pending: false, inFlight: null, ok: false, previewed: false, released: false, release, done,
+    eventTime: 0,
   };
   state.drag = drag;
   canvas.setPointerCapture(e.pointerId);
-  state.busy++;
+  void enqueue(() => runDrag(drag));
+}
+
+async function runDrag(drag: Drag) {
+  if (drag.released && !drag.moved) return;  // a click, released before its turn came
   try {
-    await viewChain.catch(() => undefined);
     const r = await postJson('/api/drag/start', {
       session: state.session, version: state.version, level: state.level, tool: state.tool,
-      select: state.tool === 'move' ? 'feature' : pick(), at, sigma: num('sigma'), region: num('region'),
+      select: state.tool === 'move' ? 'feature' : pick(), at: drag.start, sigma: num('sigma'), region: num('region'),
     });
     renderer.setHighlight(r.chain, r.vertex >= 0 ? [r.vertex] : []);
     drag.ok = true;
-    status(r.feature >= 0 ? `dragging feature ${r.feature}` : `dragging vertex ${r.vertex}`);
-    pump();
+    status(r.feature >= 0 ? 'dragging a feature' : 'dragging a control point');
   } catch (e) {
-    state.drag = null;
-    state.busy--;
-    if (e instanceof ApiError && e.status === 409) await reloadAll();
-    status(e instanceof Error ? e.message : String(e), true);
+    if (state.drag === drag) state.drag = null;
+    await reportError(e);
+    return;
   }
+  pump(drag);
+  const commit = await drag.done;
+  while (drag.inFlight) await drag.inFlight;
+  if (!commit || !drag.moved) {
+    try {
+      await postJson('/api/drag/cancel', { session: state.session });
+      if (drag.previewed) await Promise.all([fetchView(), loadControl()]);
+      status(commit ? 'a click: press and drag to move' : 'drag cancelled');
+    } catch (e) {
+      await reportError(e);
+    }
+    redraw();
+    return;
+  }
+  await runEdit(async () => {
+    let f: Frame;
+    try {
+      f = await postFrame('/api/drag/end', {
+        session: state.session, version: state.version, to: drag.target, rotate: drag.rotate,
+      });
+    } catch (e) {
+      // Refused: the document did not change, so drop the preview.
+      await Promise.all([fetchView(), loadControl()]);
+      throw e;
+    }
+    applyDelta(f);
+    status(f.header.log);
+    if (state.view.partial) await fetchView();
+  });
 }
 
-function pump() {
-  const drag = state.drag;
-  if (!drag || !drag.ok || drag.inFlight || !drag.pending) return;
+function pump(drag: Drag) {
+  if (!drag.ok || drag.inFlight || !drag.pending || drag.released) return;
   drag.pending = false;
   const eventTime = drag.eventTime;
   drag.inFlight = (async () => {
     try {
       const f = await postFrame('/api/drag/move', { session: state.session, to: drag.target, rotate: drag.rotate });
       applyDelta(f);
+      drag.previewed = true;
       renderer.draw(state.transform, state.overlays);
       if (state.measure) {
         renderer.readPixel(0, 0);  // waits until the frame is drawn
         state.latencies.push(performance.now() - eventTime);
       }
+      status('dragging');
     } catch (e) {
-      // A preview the mesh cannot take (a flip): keep the last good one, say why.
-      status(e instanceof Error ? e.message : String(e), true);
+      // A preview the mesh cannot take: keep the last good one, say why in plain words.
+      status(e instanceof ApiError && e.status === 422
+        ? 'the mesh cannot follow further: release to keep the last position it took'
+        : e instanceof Error ? e.message : String(e), true);
     } finally {
       drag.inFlight = null;
-      pump();
+      pump(drag);
     }
   })();
 }
 
-function dragMove(e: PointerEvent) {
-  const drag = state.drag;
-  if (!drag || e.pointerId !== drag.pointer) return;
+// The pointer's position into the drag (not sent).
+function track(drag: Drag, e: PointerEvent) {
   const p = canvasPoint(e);
+  const dpr = window.devicePixelRatio || 1;
+  if (!drag.moved && Math.hypot(p[0] - drag.press[0], p[1] - drag.press[1]) < CLICK_SLOP * dpr) return;
+  drag.moved = true;
   if (state.tool === 'move' && e.shiftKey) {
     drag.rotate = (p[0] - drag.shiftX) * 0.5;
   } else {
@@ -529,45 +607,23 @@ function dragMove(e: PointerEvent) {
   }
   drag.pending = true;
   drag.eventTime = e.timeStamp || performance.now();
-  pump();
 }
 
-async function dragEnd(e: PointerEvent | null, cancel = false) {
+function dragMove(e: PointerEvent) {
+  const drag = state.drag;
+  if (!drag || e.pointerId !== drag.pointer) return;
+  track(drag, e);
+  pump(drag);
+}
+
+// Release (commit) or cancel: the pointer is free at once; the drag's task finishes in the queue.
+function dragEnd(e: PointerEvent | null, cancel = false) {
   const drag = state.drag;
   if (!drag || (e && e.pointerId !== drag.pointer)) return;
-  if (e) dragMove(e);
-  while (!drag.ok && state.drag === drag) await new Promise((r) => setTimeout(r, 10));
-  if (state.drag !== drag) return;
-  drag.pending = false;
-  while (drag.inFlight) await drag.inFlight;
+  if (e && !cancel) track(drag, e);
   state.drag = null;
-  try {
-    if (cancel) {
-      await postJson('/api/drag/cancel', { session: state.session });
-      await loadView();
-      await loadControl();
-      status('drag cancelled');
-      return;
-    }
-    await edit(async () => {
-      let f: Frame;
-      try {
-        f = await postFrame('/api/drag/end', {
-          session: state.session, version: state.version, to: drag.target, rotate: drag.rotate,
-        });
-      } catch (e) {
-        // Refused (a flip, say): the document did not change, so drop the preview.
-        await Promise.all([loadView(), loadControl()]);
-        throw e;
-      }
-      applyDelta(f);
-      status(f.header.log);
-      if (state.view.partial) await loadView();
-    });
-  } finally {
-    state.busy--;
-    redraw();
-  }
+  drag.released = true;
+  drag.release(!cancel);
 }
 
 // ---- input ---------------------------------------------------------------------------------
@@ -583,6 +639,11 @@ canvas.addEventListener('pointerdown', (e) => {
   }
   if (e.button !== 0 || state.drag) return;
   const at = toImage(canvasPoint(e));
+  const { width, height } = state.doc;
+  if (state.tool !== 'select' && !(at[0] >= 0 && at[1] >= 0 && at[0] <= width && at[1] <= height)) {
+    status('outside the image: nothing to pick there');
+    return;
+  }
   if (state.tool === 'select') void doSelect(at);
   else if (state.tool === 'color') void doColor(at);
   else void dragStart(e);
@@ -603,10 +664,10 @@ const release = (e: PointerEvent) => {
     state.pan = null;
     return;
   }
-  void dragEnd(e);
+  dragEnd(e);
 };
 canvas.addEventListener('pointerup', release);
-canvas.addEventListener('pointercancel', (e) => { state.pan = null; void dragEnd(e, true); });
+canvas.addEventListener('pointercancel', (e) => { state.pan = null; dragEnd(e, true); });
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
 canvas.addEventListener('wheel', (e) => {
   e.preventDefault();
@@ -642,7 +703,7 @@ window.addEventListener('keydown', (e) => {
   if (key === '2') { toggleCheck('show-features'); return; }
   if (key === '[') { void setLevel(state.level - 1); return; }
   if (key === ']') { void setLevel(state.level + 1); return; }
-  if (key === 'escape' && state.drag) { void dragEnd(null, true); }
+  if (key === 'escape' && state.drag) dragEnd(null, true);
 });
 window.addEventListener('keyup', (e) => {
   if (e.key === ' ') { state.space = false; canvas.classList.toggle('pan', state.tool === 'pan'); }
@@ -720,7 +781,9 @@ async function poll() {
   try {
     const s = await getJson('/api/status');
     if (s.state === 'ready' && s.version > state.version && state.busy === 0 && !state.drag) {
-      await reloadAll(`the document changed in another tab: now version ${s.version}`);
+      await enqueue(async () => {
+        if (s.version > state.version) await reloadAll('the document changed in another tab: reloaded');
+      });
     }
   } catch {
     // the server may be gone; keep trying quietly

@@ -69,7 +69,8 @@ TEST(ServeEditor, StaleVersionIsRefusedAndNothingChanges) {
   EXPECT_EQ(status_of([&] { editor.apply(b, 1, color_op({48, 48}, {255, 0, 0}), log); }), kConflict);
   EXPECT_EQ(editor.version(), 2);
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_a.levels[0].colors);
-  EXPECT_EQ(status_of([&] { editor.undo(b, 1); }), kConflict);
+  std::string label;
+  EXPECT_EQ(status_of([&] { editor.undo(b, 1, label); }), kConflict);
   EXPECT_EQ(status_of([&] { editor.apply("nope", 2, color_op({48, 48}, {}), log); }), kNotFound);
 }
 
@@ -81,12 +82,15 @@ TEST(ServeEditor, UndoRedoRestoreExactly) {
   editor.apply(s, 1, color_op({48, 48}, {0, 0, 255}), log);
   const VectorImage edited = editor.snapshot().first;
   ASSERT_NE(edited.levels[0].colors, original.levels[0].colors);
-  editor.undo(s, 2);
+  std::string label;
+  editor.undo(s, 2, label);
+  EXPECT_EQ(label, "color blend at (48, 48)");  // what the page says: "undid: color blend ..."
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, original.levels[0].colors);
   EXPECT_EQ(editor.info().redo, 1);
-  editor.redo(s, 3);
+  editor.redo(s, 3, label);
+  EXPECT_EQ(label, "color blend at (48, 48)");
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, edited.levels[0].colors);
-  EXPECT_EQ(status_of([&] { editor.redo(s, 4); }), kConflict);  // nothing to redo
+  EXPECT_EQ(status_of([&] { editor.redo(s, 4, label); }), kConflict);  // nothing to redo
 }
 
 // The committed drag is exactly what `subvec edit` makes of the same operation, and the last
@@ -122,6 +126,39 @@ TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   subvec::apply_edit_ops(expected, std::span(&op, 1));
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
   EXPECT_EQ(commit.control_positions.size(), expected.levels[0].positions.size() * 2);
+}
+
+// A release the mesh cannot take commits the last position the preview took, and says so; a
+// drag refused from its first move changes nothing.
+TEST(ServeEditor, RefusedReleaseCommitsTheLastPreview) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  DragStart start;
+  start.at = {76, 48};
+  start.sigma = 30;
+  editor.drag_start(s, 1, start);
+  editor.drag_move(s, {80, 48}, 0);
+  // Through the disk and out of its other side: the ring of triangles inside folds.
+  const Vec2 far{4, 48};
+  EXPECT_EQ(status_of([&] { editor.drag_move(s, far, 0); }), kUnprocessable);
+  std::string log;
+  editor.drag_end(s, 1, far, 0, log);
+  EXPECT_EQ(log.rfind("stopped at the last position the mesh could take: ", 0), 0u) << log;
+  EXPECT_EQ(editor.version(), 2);
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kDrag;
+  op.select = subvec::EditSelect::kFeature;
+  op.from = {76, 48};
+  op.to = {80, 48};
+  op.sigma = 30;
+  VectorImage expected = original;
+  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
+
+  editor.drag_start(s, 2, start);
+  EXPECT_EQ(status_of([&] { editor.drag_end(s, 2, far, 0, log); }), kUnprocessable);
+  EXPECT_EQ(editor.version(), 2);
 }
 
 // The move tool: translate and rotate a whole feature, committed as `subvec edit`'s move-feature.
@@ -257,7 +294,9 @@ TEST(ServeEditor, FilterIsAbsoluteUndoableAndVersioned) {
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, original.levels[0].colors);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, original.levels[0].positions);
   EXPECT_EQ(editor.info().undo, 3);
-  editor.undo(s, 4);
+  std::string label;
+  editor.undo(s, 4, label);
+  EXPECT_EQ(label, "filter off");
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected2.levels[0].positions);
   // Stale versions, bad eta lists and images without a pyramid are refused.
   EXPECT_EQ(status_of([&] { editor.filter(s, 4, smooth, log); }), kConflict);

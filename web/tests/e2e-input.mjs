@@ -1,0 +1,157 @@
+// Quick input in the editor page (issue 29, problems 1-3 and 10), in headless Chromium with software
+// WebGL: the page queues its requests, so quick clicks with every tool make exactly the edits they
+// ask for (a click is no drag), quick undos raise no conflict, a drag the mesh refuses at its end
+// commits where it last fitted, a press outside the image grabs nothing, and the status line speaks
+// plainly. Asserts on the document's version and history, the status line and canvas pixels.
+//
+//   node web/tests/e2e-input.mjs BUILD/bin/subvec
+//
+// Exit status 0: all passed; 1: a check failed; 77: skipped (no Chromium or no node_modules).
+import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { client, findChromium, idle, launch, openEditor, pixel, serve, stop } from './harness.mjs';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const root = join(here, '..', '..');
+const binary = process.argv[2];
+
+if (!findChromium()) {
+  console.log('SKIPPED: no Chromium found (scripts/setup installs Debian\'s chromium; or set CHROMIUM)');
+  process.exit(77);
+}
+if (!existsSync(join(here, '..', 'node_modules', 'playwright-core'))) {
+  console.log('SKIPPED: web/node_modules is missing (run: cd web && npm ci)');
+  process.exit(77);
+}
+if (!binary || !existsSync(binary)) {
+  console.log(`usage: node web/tests/e2e-input.mjs PATH/TO/subvec (got '${binary}')`);
+  process.exit(2);
+}
+
+let passed = 0;
+let failed = 0;
+function check(name, ok, detail = '') {
+  if (ok) passed++;
+  else failed++;
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${ok ? '' : ` ${detail}`}`);
+}
+const diff = (a, b) => Math.max(...[0, 1, 2].map((i) => Math.abs(a[i] - b[i])));
+
+// The disk example: a closed tear of radius 28 around (48, 48) in a 96 x 96 image.
+const onTear = (degrees) => [48 + 28 * Math.cos((degrees * Math.PI) / 180), 48 + 28 * Math.sin((degrees * Math.PI) / 180)];
+const dir = mkdtempSync(join(tmpdir(), 'subvec-e2e-input-'));
+const input = join(dir, 'disk.svec.json');
+writeFileSync(input, readFileSync(join(root, 'examples', '01-disk.svec.json')));
+
+const server = await serve(binary, [input]);
+const browser = await launch(findChromium());
+try {
+  const { page, errors } = await openEditor(browser, server.url);
+  const doc = () => page.evaluate(() => ({
+    version: window.subvec.state.version,
+    undo: window.subvec.state.doc.undo,
+    busy: window.subvec.state.busy,
+    status: document.getElementById('status').textContent,
+    error: document.getElementById('status').classList.contains('error'),
+  }));
+  // Clicks as fast as the mouse sends them: no wait for the page between them.
+  const clicks = async (points) => {
+    for (const p of points) {
+      const [x, y] = await client(page, ...p);
+      await page.mouse.click(x, y);
+    }
+    await idle(page);
+  };
+  const start = await doc();
+  const probe = await pixel(page, 80, 48);
+
+  // Problem 1: ten quick clicks 5 degrees apart along the tear, then ten on one spot, with each
+  // tool that presses on the image. None of them is an edit; the page stays in step.
+  for (const [key, tool] of [['d', 'drag'], ['m', 'move'], ['v', 'select'], ['h', 'pan']]) {
+    await page.keyboard.press(key);
+    await clicks([...Array.from({ length: 10 }, (_, i) => onTear(-20 + 5 * i)), ...Array(10).fill(onTear(0))]);
+    const d = await doc();
+    check(`${tool}: 20 quick clicks make no edit`, d.version === start.version && d.undo === 0,
+      `version ${start.version} -> ${d.version}, ${d.undo} undo steps, status "${d.status}"`);
+    check(`${tool}: the page is in step after them`, d.busy === 0 && !d.error, `busy ${d.busy}, status "${d.status}"`);
+  }
+  check('the image is unchanged by the clicks', diff(await pixel(page, 80, 48), probe) < 2);
+
+  // Problem 2: twenty quick color clicks are twenty edits, none refused as another tab's.
+  await page.keyboard.press('c');
+  await page.evaluate(() => {
+    for (const [id, v] of [['amount', '0.2'], ['radius', '40']]) {
+      const el = document.getElementById(id);
+      el.value = v;
+      el.dispatchEvent(new Event('input'));
+    }
+  });
+  await clicks(Array.from({ length: 20 }, (_, i) => [44 + (i % 5) * 2, 44 + Math.floor(i / 5) * 2]));
+  let d = await doc();
+  check('color: 20 quick clicks are 20 edits', d.version === start.version + 20 && d.undo === 20,
+    `version ${start.version} -> ${d.version}, ${d.undo} undo steps, status "${d.status}"`);
+  check('color: no conflict and no error', !d.error && !/another tab/.test(d.status), `status "${d.status}"`);
+
+  // A real drag after all that: 8 px to the right, committed once.
+  await page.keyboard.press('d');
+  const drag = async (from, to, steps = 10) => {
+    const [sx, sy] = await client(page, ...from);
+    await page.mouse.move(sx, sy);
+    await page.mouse.down();
+    for (let i = 1; i <= steps; ++i) {
+      const [x, y] = await client(page, from[0] + ((to[0] - from[0]) * i) / steps, from[1] + ((to[1] - from[1]) * i) / steps);
+      await page.mouse.move(x, y);
+      await page.waitForTimeout(15);
+    }
+    await page.mouse.up();
+    await idle(page);
+    return doc();
+  };
+  d = await drag([76, 48], [84, 48]);
+  check('drag: one edit', d.version === start.version + 21 && d.undo === 21 && /dragged/.test(d.status),
+    `version ${d.version}, ${d.undo} undo steps, status "${d.status}"`);
+
+  // Twenty-five quick undos: 21 steps back to the start, then "nothing to undo"; no conflict.
+  for (let i = 0; i < 25; i++) await page.keyboard.press('Control+z');
+  await idle(page);
+  d = await doc();
+  check('undo: 25 quick presses undo all 21 edits', d.undo === 0 && d.version === start.version + 42,
+    `${d.undo} undo steps left, version ${d.version}, status "${d.status}"`);
+  check('undo: no conflict, and the last press says why it did nothing',
+    !d.error && d.status === 'nothing to undo', `status "${d.status}"`);
+  check('undo: the image is back', diff(await pixel(page, 80, 48), probe) < 2);
+  await page.keyboard.press('Control+Shift+z');
+  await idle(page);
+  d = await doc();
+  check('redo names the edit in plain words', /^redid: color blend at \(\d+, \d+\)$/.test(d.status), `status "${d.status}"`);
+  await page.keyboard.press('Control+z');
+  await idle(page);
+
+  // Problem 3: a drag through the disk and out of its other side. The preview stops where the
+  // mesh folds; the release commits that last position and says so.
+  const before = await doc();
+  const inside = await pixel(page, 73, 48);  // just inside the tear
+  d = await drag([76, 48], [4, 48], 24);
+  check('refused drag: committed at its last valid position', d.version === before.version + 1 && d.undo === before.undo + 1,
+    `version ${before.version} -> ${d.version}, status "${d.status}"`);
+  check('refused drag: says it stopped', /^stopped at the last position the mesh could take: dragged/.test(d.status), `status "${d.status}"`);
+  const moved = await pixel(page, 73, 48);
+  check('refused drag: the feature moved left', diff(moved, inside) > 20, `${inside} -> ${moved}`);
+
+  // A press outside the image grabs nothing.
+  const outsideBefore = await doc();
+  d = await drag([-2, 60], [30, 60]);  // in the margin left of the image
+  check('a drag that starts outside the image does nothing', d.version === outsideBefore.version && /outside the image/.test(d.status),
+    `version ${outsideBefore.version} -> ${d.version}, status "${d.status}"`);
+
+  check('no page errors', errors.length === 0, errors.join('; '));
+} catch (e) {
+  check('the test ran', false, e.stack);
+} finally {
+  await browser.close();
+  await stop(server);
+}
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);
