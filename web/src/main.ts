@@ -469,19 +469,62 @@ async function doHistory(kind: 'undo' | 'redo') {
   });
 }
 
-function download(format: string) {
-  const a = document.createElement('a');
-  a.href = `/api/download?format=${format}&level=${state.level}`;
-  a.download = '';
-  document.body.appendChild(a);
-  a.click();
-  a.remove();
+// A download with a progress line: the server prepares the file (a PDF or SVG export takes a
+// moment), the page shows what arrives, then hands the bytes to the browser as a file. It reads the
+// document and changes nothing, so it does not wait in the queue.
+const FORMAT_NAMES: Record<string, string> = { svec: '.svec', 'svec.json': '.svec.json', png: 'PNG', pdf: 'PDF', svg: 'SVG' };
+let downloads = 0;
+async function download(format: string) {
+  const what = FORMAT_NAMES[format] ?? format;
+  const mb = (n: number) => (n / 1e6).toFixed(n < 1e7 ? 1 : 0);
+  downloads++;
+  status(`preparing the ${what}…`);
+  try {
+    const response = await fetch(`/api/download?format=${format}&level=${state.level}`, { cache: 'no-store' });
+    if (!response.ok || !response.body) {
+      let message = `${response.status} ${response.statusText}`;
+      try {
+        message = (await response.json()).error ?? message;
+      } catch {
+        // not JSON: the status line
+      }
+      throw new Error(`download failed: ${message}`);
+    }
+    const total = Number(response.headers.get('X-Decoded-Length')) || 0;
+    const name = /filename="([^"]+)"/.exec(response.headers.get('Content-Disposition') ?? '')?.[1] ?? `image.${format}`;
+    const reader = response.body.getReader();
+    const chunks: Uint8Array<ArrayBuffer>[] = [];
+    let received = 0;
+    let shown = 0;
+    for (;;) {
+      const { done, value } = await reader.read();
+      if (done) break;
+      chunks.push(value);
+      received += value.length;
+      if (performance.now() - shown > 100) {
+        shown = performance.now();
+        status(`downloading the ${what}: ${mb(received)}${total ? ` of ${mb(total)}` : ''} MB`);
+      }
+    }
+    const url = URL.createObjectURL(new Blob(chunks, { type: response.headers.get('Content-Type') ?? '' }));
+    const a = document.createElement('a');
+    a.href = url;
+    a.download = name;
+    document.body.appendChild(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 60000);
+    status(`downloaded ${name} (${mb(received)} MB)`);
+  } catch (e) {
+    status(e instanceof Error ? e.message : String(e), true);
+  } finally {
+    downloads--;
+  }
 }
 
 async function doSave() {
   if (!state.doc?.save_to) {
-    download('svec');
-    status('downloading the .svec');
+    await download('svec');
     return;
   }
   await edit(async () => {
@@ -746,7 +789,7 @@ function wireControls() {
   $('filter-color').addEventListener('change', () => void doFilter());
   $('filter-reset').addEventListener('click', () => void doFilter(true));
   document.querySelectorAll<HTMLAnchorElement>('.downloads a').forEach((a) =>
-    a.addEventListener('click', (e) => { e.preventDefault(); download(a.dataset.format!); }));
+    a.addEventListener('click', (e) => { e.preventDefault(); void download(a.dataset.format!); }));
   setTool('drag');
 }
 
@@ -818,7 +861,7 @@ window.subvec = {
     const t = state.transform;
     return [r.left + (x * t.zoom + t.panX) / dpr, r.top + (y * t.zoom + t.panY) / dpr];
   },
-  idle() { return state.busy === 0 && !state.drag; },
+  idle() { return state.busy === 0 && !state.drag && downloads === 0; },
   measure(on: boolean) { state.measure = on; state.latencies = []; },
   latencies() { return state.latencies.slice(); },
 };
