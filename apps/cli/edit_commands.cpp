@@ -94,16 +94,15 @@ void run_stylize(const StylizeArgs& a) {
                 "--level " + std::to_string(a.level) + " is out of range: '" + a.input + "' has " +
                     std::to_string(num_levels) + (num_levels == 1 ? " level" : " levels"));
   }
-  subvec::StylizeReport report;
-  std::vector<subvec::Stroke> strokes = subvec::stylize(image, options, &report);
-  image.strokes.insert(image.strokes.end(), strokes.begin(), strokes.end());
+  const subvec::StylizeReport report = subvec::apply_stylize(image, options);
   subvec::write_svec(a.output, image);
   std::printf(
       "%d strokes on %d of %d features in the region (threshold %.1f: %d at or above, %d of %d "
-      "below chosen with seed %llu)\n",
+      "below chosen with seed %llu)%s\n",
       report.strokes, report.above + report.chosen, report.in_region, report.threshold,
       report.above, report.chosen, report.in_region - report.above,
-      static_cast<unsigned long long>(a.seed));
+      static_cast<unsigned long long>(a.seed),
+      report.replaced > 0 ? ("; replacing " + std::to_string(report.replaced) + " earlier strokes").c_str() : "");
 }
 
 }  // namespace

@@ -582,7 +582,7 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
   // moved and by how much (the library's line names vertex counts and solver figures).
   const auto said = [&](Vec2 target, double angle) {
     const auto px = [](double v) {
-      std::string t = std::to_string(std::lround(v * 10) / 10.0);
+      std::string t = std::to_string(static_cast<double>(std::lround(v * 10)) / 10);
       t.erase(t.find_last_not_of('0') + 1);
       if (t.back() == '.') t.pop_back();
       return t == "-0" ? std::string("0") : t;
@@ -613,8 +613,11 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
       refuse_edit(Error(e.code(), without_op_prefix(e.what())));
     }
   }
+  // The level's strokes moved with it (apply_edit_ops carries them along).
+  const bool strokes_moved = std::any_of(edited.strokes.begin(), edited.strokes.end(),
+                                         [&](const subvec::Stroke& s) { return s.level == op.level; });
   commit_locked(std::move(edited), edit_label(op));
-  return delta_locked(session, nullptr, false);
+  return delta_locked(session, nullptr, strokes_moved);
 }
 
 void Editor::drag_cancel(const std::string& session_id) {
@@ -662,14 +665,15 @@ Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
   subvec::StylizeReport report;
   VectorImage edited = image_;
   try {
-    std::vector<subvec::Stroke> strokes = subvec::stylize(edited, options, &report);
-    edited.strokes.insert(edited.strokes.end(), strokes.begin(), strokes.end());
+    report = subvec::apply_stylize(edited, options);
   } catch (const Error& e) {
     refuse_edit(e);
   }
   log = std::to_string(report.strokes) + " strokes on " +
         std::to_string(report.above + report.chosen) + " of " + std::to_string(report.in_region) +
-        " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")";
+        " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")" +
+        (report.replaced > 0 ? ", replacing the " + std::to_string(report.replaced) + " before"
+                             : std::string());
   commit_locked(std::move(edited), "stylize");
   return delta_locked(session, nullptr, true);
 }
@@ -746,7 +750,8 @@ Delta Editor::step_history(const std::string& session_id, int64_t version,
   Session& session = session_locked(session_id);
   check_version_locked(version);
   if (from.empty()) throw RequestError(kConflict, empty_message);
-  const bool strokes_changed = from.back().image.strokes.size() != image_.strokes.size();
+  // Strokes move with shape edits, so any may differ: the page reloads them when there are any.
+  const bool strokes_changed = !from.back().image.strokes.empty() || !image_.strokes.empty();
   label = from.back().label;
   to.push_back({std::move(image_), label});
   image_ = std::move(from.back().image);

@@ -569,7 +569,8 @@ void def_edit_parts(PyVectorImage& vi) {
 
 // Stylization, saliency, subdivision, the pyramid's filter and pickling.
 void def_analysis(PyVectorImage& vi) {
-  // Stylization (edit/stylize.h): adds the strokes to the image and reports what it did.
+  // Stylization (edit/stylize.h, apply_stylize): replaces the level's strokes in the region with
+  // new ones and reports what it did.
   vi.def(
           "stylize",
           [](VectorImage& v, int level, std::optional<std::array<double, 4>> roi,
@@ -584,12 +585,11 @@ void def_analysis(PyVectorImage& vi) {
             subvec::StylizeReport report;
             {
               py::gil_scoped_release release;
-              std::vector<subvec::Stroke> strokes = subvec::stylize(v, options, &report);
-              v.strokes.insert(v.strokes.end(), strokes.begin(), strokes.end());
+              report = subvec::apply_stylize(v, options);
             }
             return py::dict("threshold"_a = report.threshold, "in_region"_a = report.in_region,
                             "above"_a = report.above, "chosen"_a = report.chosen,
-                            "strokes"_a = report.strokes);
+                            "strokes"_a = report.strokes, "replaced"_a = report.replaced);
           },
           py::kw_only(), "level"_a = 0, "roi"_a = py::none(), "threshold"_a = py::none(),
           "seed"_a = 1, "probability"_a = 0.3)

@@ -402,6 +402,17 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
       if (message.rfind(where, 0) == 0) throw;
       refuse(where, message);
     }
+    // Strokes on the level follow a shape edit (issue 29): each point keeps its place in its
+    // control triangle.
+    if (op.kind != EditOp::Kind::kColor) {
+      int carried = 0;
+      for (Stroke& stroke : image.strokes) {
+        if (stroke.level != op.level) continue;
+        transport_points(image.levels[op.level].positions, mesh.positions, mesh.triangles, stroke.points);
+        ++carried;
+      }
+      if (carried > 0) done += "; " + std::to_string(carried) + (carried == 1 ? " stroke" : " strokes") + " carried along";
+    }
     image.levels[op.level] = std::move(mesh);
     log.push_back(where + ": " + done);
   }

@@ -2,7 +2,9 @@
 #include "subvec/edit/shape.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <numbers>
 #include <string>
@@ -189,6 +191,98 @@ int ShapeEditor::first_flip(const std::vector<Vec2>& p) const {
     if (!((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0)) return static_cast<int>(f);
   }
   return -1;
+}
+
+namespace {
+
+// Barycentric coordinates of p in (a, b, c), a triangle of positive area.
+std::array<double, 3> barycentric(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
+  const double d = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  const double la = ((b.x - p.x) * (c.y - p.y) - (b.y - p.y) * (c.x - p.x)) / d;
+  const double lb = ((c.x - p.x) * (a.y - p.y) - (c.y - p.y) * (a.x - p.x)) / d;
+  return {la, lb, 1 - la - lb};
+}
+
+// How far p lies outside the triangle with these coordinates (0 inside): the most negative one.
+double outside(const std::array<double, 3>& l) { return -std::min({l[0], l[1], l[2], 0.0}); }
+
+}  // namespace
+
+void transport_points(const std::vector<Vec2>& rest, const std::vector<Vec2>& moved,
+                      const std::vector<Tri>& triangles, std::span<Vec2> points) {
+  if (rest.size() != moved.size()) invalid("transport_points: rest and moved differ in size");
+  if (triangles.empty() || points.empty()) return;
+  for (const Tri& t : triangles) {
+    for (int32_t v : t) {
+      if (v < 0 || v >= static_cast<int32_t>(rest.size())) invalid("transport_points: vertex out of range");
+    }
+  }
+  // A uniform grid over the triangles' boxes, about two triangles per cell.
+  double x0 = rest[triangles[0][0]].x, y0 = rest[triangles[0][0]].y, x1 = x0, y1 = y0;
+  for (const Tri& t : triangles) {
+    for (int32_t v : t) {
+      x0 = std::min(x0, rest[v].x), x1 = std::max(x1, rest[v].x);
+      y0 = std::min(y0, rest[v].y), y1 = std::max(y1, rest[v].y);
+    }
+  }
+  const double span_x = std::max(x1 - x0, 1e-9), span_y = std::max(y1 - y0, 1e-9);
+  const double cells = std::max(1.0, std::ceil(static_cast<double>(triangles.size()) / 2));
+  const int nx = std::clamp(static_cast<int>(std::sqrt(cells * span_x / span_y)), 1, 4096);
+  const int ny = std::clamp(static_cast<int>(cells / nx), 1, 4096);
+  const auto cell_x = [&](double x) { return std::clamp(static_cast<int>((x - x0) / span_x * nx), 0, nx - 1); };
+  const auto cell_y = [&](double y) { return std::clamp(static_cast<int>((y - y0) / span_y * ny), 0, ny - 1); };
+  std::vector<int32_t> start(static_cast<size_t>(nx) * ny + 1, 0), entries;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (size_t f = 0; f < triangles.size(); ++f) {
+      const Tri& t = triangles[f];
+      const Vec2 a = rest[t[0]], b = rest[t[1]], c = rest[t[2]];
+      const int cx0 = cell_x(std::min({a.x, b.x, c.x})), cx1 = cell_x(std::max({a.x, b.x, c.x}));
+      const int cy0 = cell_y(std::min({a.y, b.y, c.y})), cy1 = cell_y(std::max({a.y, b.y, c.y}));
+      for (int cy = cy0; cy <= cy1; ++cy) {
+        for (int cx = cx0; cx <= cx1; ++cx) {
+          const size_t cell = static_cast<size_t>(cy) * nx + cx;
+          if (pass == 0) ++start[cell + 1];
+          else entries[fill[cell]++] = static_cast<int32_t>(f);
+        }
+      }
+    }
+    if (pass == 0) {
+      for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+      entries.resize(start.back());
+    }
+  }
+  const auto coordinates = [&](size_t f, Vec2 p) {
+    const Tri& t = triangles[f];
+    return barycentric(p, rest[t[0]], rest[t[1]], rest[t[2]]);
+  };
+  for (Vec2& p : points) {
+    // The containing triangle of p's cell (the first, in triangle order: the map is continuous,
+    // so a point on a shared edge goes to the same place either way); else the least outside of
+    // all triangles, its coordinates clamped.
+    size_t best = 0;
+    double best_out = std::numeric_limits<double>::infinity();
+    const size_t cell = static_cast<size_t>(cell_y(p.y)) * nx + cell_x(p.x);
+    for (int32_t i = start[cell]; i < start[cell + 1] && best_out > 0; ++i) {
+      const double o = outside(coordinates(entries[i], p));
+      if (o < best_out) best = entries[i], best_out = o;
+    }
+    if (best_out > 1e-12) {
+      for (size_t f = 0; f < triangles.size(); ++f) {
+        const double o = outside(coordinates(f, p));
+        if (o < best_out) best = f, best_out = o;
+      }
+    }
+    std::array<double, 3> l = coordinates(best, p);
+    if (best_out > 0) {
+      for (double& x : l) x = std::max(x, 0.0);
+      const double sum = l[0] + l[1] + l[2];
+      for (double& x : l) x /= sum;
+    }
+    const Tri& t = triangles[best];
+    p = {l[0] * moved[t[0]].x + l[1] * moved[t[1]].x + l[2] * moved[t[2]].x,
+         l[0] * moved[t[0]].y + l[1] * moved[t[1]].y + l[2] * moved[t[2]].y};
+  }
 }
 
 }  // namespace subvec

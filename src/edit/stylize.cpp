@@ -103,6 +103,9 @@ std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& opti
   }
   if (!(options.taper >= 0 && options.taper <= 0.5f)) invalid("taper " + num(options.taper) + " is outside [0, 0.5]");
   if (options.threshold && !std::isfinite(*options.threshold)) invalid("the threshold is not finite");
+  if (options.threshold && *options.threshold < 0) {
+    invalid("the threshold " + num(*options.threshold) + " is negative (saliency is 0 or more)");
+  }
 
   const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
   const auto curves = feature_curves(mesh, topology);
@@ -170,6 +173,26 @@ std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& opti
   r.strokes = static_cast<int>(strokes.size());
   if (report) *report = r;
   return strokes;
+}
+
+StylizeReport apply_stylize(VectorImage& image, const StylizeOptions& options) {
+  StylizeReport report;
+  std::vector<Stroke> strokes = stylize(image, options, &report);
+  const Rect roi = options.roi.value_or(Rect{0, 0, double(image.width), double(image.height)});
+  const auto in_region = [&](const Stroke& s) {
+    if (s.level != options.level) return false;
+    size_t inside = 0;
+    for (Vec2 p : s.points) {
+      inside += p.x >= roi.x && p.x <= roi.x + roi.width && p.y >= roi.y && p.y <= roi.y + roi.height;
+    }
+    return 2 * inside >= s.points.size();
+  };
+  const auto old = std::remove_if(image.strokes.begin(), image.strokes.end(), in_region);
+  report.replaced = static_cast<int>(image.strokes.end() - old);
+  image.strokes.erase(old, image.strokes.end());
+  image.strokes.insert(image.strokes.end(), std::make_move_iterator(strokes.begin()),
+                       std::make_move_iterator(strokes.end()));
+  return report;
 }
 
 }  // namespace subvec

@@ -130,6 +130,37 @@ try {
   await page.keyboard.press('Control+z');
   await idle(page);
 
+  // Problem 8: Stylize twice gives one stroke along the outline, and a drag carries it along;
+  // undo brings it back.
+  const strokes = () => page.evaluate(async () => (await (await fetch('/api/strokes?level=0')).json()).length);
+  await page.keyboard.press('y');
+  await idle(page);
+  const once = await strokes();
+  await page.keyboard.press('y');
+  await idle(page);
+  check('stylize twice: the strokes are replaced, not doubled', once > 0 && (await strokes()) === once, `${once} then ${await strokes()}`);
+  // The stroke runs just inside the outline; a closed one tapers to nothing at its first vertex
+  // (angle 0 here), so it is looked for on the left, along row 48: where is it darkest?
+  const strokeX = async () => {
+    let best = [Infinity, 0];
+    for (let x = 14; x <= 40; x += 0.25) {
+      const p = await pixel(page, x, 48);
+      if (Math.max(...p.slice(0, 3)) < best[0]) best = [Math.max(...p.slice(0, 3)), x];
+    }
+    return best[0] < 80 ? best[1] : NaN;
+  };
+  const x0 = await strokeX();
+  d = await drag([21, 48], [29, 48]);
+  const x1 = await strokeX();
+  check('a drag moves its stroke', x1 - x0 > 6 && x1 - x0 < 10, `stroke at x ${x0} -> ${x1} after a drag of 8 px`);
+  await page.keyboard.press('Control+z');
+  await idle(page);
+  const x2 = await strokeX();
+  check('undo puts the stroke back', x2 === x0, `stroke at x ${x2}, was ${x0}`);
+  await page.keyboard.press('Control+z');
+  await page.keyboard.press('Control+z');
+  await idle(page);
+
   // Problem 3: a drag through the disk and out of its other side. The preview stops where the
   // mesh folds; the release commits that last position and says so.
   const before = await doc();

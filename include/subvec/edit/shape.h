@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <list>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "subvec/edit/arap.h"
@@ -53,6 +54,15 @@ Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 cente
 // by `translate`. Positive angles turn from +x towards +y: clockwise on screen (y points down).
 Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 translate,
                      double degrees);
+
+// Carries points through a shape edit: each point keeps its barycentric coordinates in the control
+// triangle of `triangles` that holds it at `rest` and takes them to the same triangle at `moved`
+// (both #V; the triangles cover the image, so every point inside it has one; a point outside, or
+// on no triangle through rounding, takes the nearest triangle's clamped coordinates). The map is
+// piecewise affine and continuous, the identity where nothing moved, and exact for a rigid motion
+// of the whole mesh. It is how strokes follow a drag (apply_edit_ops).
+void transport_points(const std::vector<Vec2>& rest, const std::vector<Vec2>& moved,
+                      const std::vector<Tri>& triangles, std::span<Vec2> points);
 
 class ShapeEditor {
  public:

@@ -46,6 +46,7 @@ struct StylizeReport {
   int above = 0;         // ... with saliency >= threshold (all stroked)
   int chosen = 0;        // ... below it and chosen at random
   int strokes = 0;       // strokes made (a feature split at corners gives one per piece)
+  int replaced = 0;      // strokes of the level in the region that apply_stylize removed
 };
 
 // Saliency of every feature of `level`: the stored value where non-zero, else eq. 2 as above.
@@ -54,8 +55,15 @@ std::vector<double> feature_saliency(const VectorImage& image, int level,
 
 // The strokes for `options` (not added to the image). Deterministic: the same image and options
 // give the same strokes. Throws Error(kInvalidArgument) for a level out of range, an empty or
-// non-finite region, a probability outside [0, 1] or non-positive widths.
+// non-finite region, a negative or non-finite threshold, a probability outside [0, 1] or
+// non-positive widths.
 std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& options,
                             StylizeReport* report = nullptr);
+
+// Stylizes `image` in place, the one policy of `subvec stylize`, the editor's Stylize and the
+// Python module: the strokes of options.level with at least half their points in the region are
+// replaced by the ones stylize() makes; other strokes stay. So stylizing twice gives the same
+// image as once, and a second region adds to the first.
+StylizeReport apply_stylize(VectorImage& image, const StylizeOptions& options);
 
 }  // namespace subvec

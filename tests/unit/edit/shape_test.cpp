@@ -9,6 +9,7 @@
 
 #include "subvec/core/error.h"
 #include "subvec/edit/arap.h"
+#include "subvec/edit/ops.h"
 #include "subvec/edit/selection.h"
 #include "subvec/edit/shape.h"
 #include "subvec/mesh/curves.h"
@@ -57,6 +58,91 @@ void expect_feature_curves_are_bsplines(const VectorImage& image) {
     }
   }
   EXPECT_LT(worst, 2e-3);
+}
+
+// transport_points against the obvious reference: every triangle tried in order, the first that
+// holds the point (to 1e-12) gives its barycentric coordinates.
+TEST(Shape, TransportPointsMatchesABruteForceSearch) {
+  const VectorImage img = image_with_features();
+  const ControlMesh& mesh = img.levels[0];
+  ShapeEditor editor(mesh, img.width, img.height);
+  const FeaturePick pick = nearest_feature(mesh, validate_level(mesh, img.width, img.height), {80, 64});
+  ASSERT_GE(pick.feature, 0);
+  const std::vector<Vec2> moved = editor.deform(drag_feature(mesh, mesh.features[pick.feature], {80, 64}, {6, -4}, 20));
+  std::vector<Vec2> points;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 32; ++j) points.push_back({i * 4.0, j * 4.0});  // the border and corners too
+  std::vector<Vec2> fast = points;
+  transport_points(mesh.positions, moved, mesh.triangles, fast);
+  double worst = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const Vec2 p = points[k];
+    bool found = false;
+    for (const Tri& t : mesh.triangles) {
+      const Vec2 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+      const double d = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+      const double la = ((b.x - p.x) * (c.y - p.y) - (b.y - p.y) * (c.x - p.x)) / d;
+      const double lb = ((c.x - p.x) * (a.y - p.y) - (c.y - p.y) * (a.x - p.x)) / d;
+      const double lc = 1 - la - lb;
+      if (la < -1e-12 || lb < -1e-12 || lc < -1e-12) continue;
+      const Vec2 q{la * moved[t[0]].x + lb * moved[t[1]].x + lc * moved[t[2]].x,
+                   la * moved[t[0]].y + lb * moved[t[1]].y + lc * moved[t[2]].y};
+      worst = std::max(worst, std::hypot(q.x - fast[k].x, q.y - fast[k].y));
+      found = true;
+      break;
+    }
+    EXPECT_TRUE(found) << "no triangle holds (" << p.x << ", " << p.y << ")";
+  }
+  EXPECT_LT(worst, 1e-9);
+  // Nothing moved: the identity; a translation of everything: exact.
+  std::vector<Vec2> same = points;
+  transport_points(mesh.positions, mesh.positions, mesh.triangles, same);
+  std::vector<Vec2> shifted_positions = mesh.positions;
+  for (Vec2& v : shifted_positions) v = {v.x + 3.5, v.y - 2};
+  std::vector<Vec2> shifted = points;
+  transport_points(mesh.positions, shifted_positions, mesh.triangles, shifted);
+  for (size_t k = 0; k < points.size(); ++k) {
+    EXPECT_NEAR(same[k].x, points[k].x, 1e-9);
+    EXPECT_NEAR(same[k].y, points[k].y, 1e-9);
+    EXPECT_NEAR(shifted[k].x, points[k].x + 3.5, 1e-9);
+    EXPECT_NEAR(shifted[k].y, points[k].y - 2, 1e-9);
+  }
+}
+
+// A shape edit carries the level's strokes along (apply_edit_ops); a color edit and another
+// level's strokes leave them where they are.
+TEST(Shape, StrokesFollowShapeEdits) {
+  VectorImage img = image_with_features();
+  const ControlMesh before = img.levels[0];
+  const Feature& f = before.features[0];
+  Stroke along;  // on the feature's control points, as stylize's strokes run along features
+  for (int32_t v : f.vertices) along.points.push_back(before.positions[v]);
+  Stroke elsewhere = along;
+  elsewhere.level = 1;
+  img.levels.push_back(before);
+  img.strokes = {along, elsewhere};
+  EditOp op;
+  op.kind = EditOp::Kind::kMoveFeature;
+  op.at = before.positions[f.vertices[f.vertices.size() / 2]];
+  op.translate = {3, 2};
+  const std::vector<std::string> log = apply_edit_ops(img, std::span(&op, 1));
+  EXPECT_NE(log[0].find("1 stroke carried along"), std::string::npos) << log[0];
+  std::vector<Vec2> expected = along.points;
+  transport_points(before.positions, img.levels[0].positions, before.triangles, expected);
+  EXPECT_EQ(img.strokes[0].points, expected);
+  // The feature's own vertices moved by the translation, and so did the stroke over them.
+  for (size_t i = 0; i < f.vertices.size(); ++i) {
+    EXPECT_NEAR(img.strokes[0].points[i].x, along.points[i].x + 3, 1e-6);
+    EXPECT_NEAR(img.strokes[0].points[i].y, along.points[i].y + 2, 1e-6);
+  }
+  EXPECT_EQ(img.strokes[1].points, elsewhere.points);
+  EditOp color;
+  color.kind = EditOp::Kind::kColor;
+  color.at = {20, 20};
+  color.color = {255, 0, 0};
+  const std::vector<Vec2> moved = img.strokes[0].points;
+  apply_edit_ops(img, std::span(&color, 1));
+  EXPECT_EQ(img.strokes[0].points, moved);
 }
 
 TEST(Shape, FeatureDragMeetsItsConstraintsAndIsMoreRigidThanTheFalloffAlone) {

@@ -2,6 +2,7 @@
 // strokes showing up in renders.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <vector>
 
@@ -179,6 +180,48 @@ TEST(Stylize, BadOptionsAreRefused) {
   o.roi.reset();
   o.probability = 2;
   EXPECT_THROW(stylize(image(), o), Error);
+  o.probability = 0.3;
+  o.threshold = -5;  // saliency is never negative: the editor accepted this before (issue 29)
+  try {
+    stylize(image(), o);
+    ADD_FAILURE() << "a negative threshold was accepted";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "stylize: the threshold -5 is negative (saliency is 0 or more)");
+  }
+}
+
+// apply_stylize replaces the level's strokes in the region: twice is once, a second region adds
+// to the first, another level's strokes stay.
+TEST(Stylize, ApplyReplacesTheStrokesOfTheRegion) {
+  StylizeOptions o;
+  VectorImage once = image_with_saliency();
+  const StylizeReport first = apply_stylize(once, o);
+  ASSERT_GT(first.strokes, 0);
+  EXPECT_EQ(first.replaced, 0);
+  VectorImage twice = once;
+  const StylizeReport second = apply_stylize(twice, o);
+  EXPECT_EQ(second.replaced, first.strokes);
+  ASSERT_EQ(twice.strokes.size(), once.strokes.size());
+  for (size_t i = 0; i < once.strokes.size(); ++i) EXPECT_EQ(twice.strokes[i].points, once.strokes[i].points);
+
+  VectorImage halves = image_with_saliency();
+  StylizeOptions left = o, right = o;
+  left.roi = Rect{0, 0, 100, 160};
+  right.roi = Rect{100, 0, 100, 160};
+  const StylizeReport a = apply_stylize(halves, left);
+  const StylizeReport b = apply_stylize(halves, right);
+  EXPECT_GT(a.strokes, 0);
+  EXPECT_GT(b.strokes, 0);
+  EXPECT_EQ(static_cast<int>(halves.strokes.size()), a.strokes + b.strokes - b.replaced);
+
+  VectorImage other = image_with_saliency();
+  Stroke kept;
+  kept.level = 1;
+  kept.points = {{10, 10}, {50, 50}};
+  other.strokes.push_back(kept);
+  apply_stylize(other, o);
+  apply_stylize(other, o);
+  EXPECT_EQ(std::count_if(other.strokes.begin(), other.strokes.end(), [](const Stroke& s) { return s.level == 1; }), 1);
 }
 
 }  // namespace
