@@ -639,13 +639,27 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(op.level);
+  if (op.kind != EditOp::Kind::kColor) throw RequestError(kBadRequest, "not a color edit");
   VectorImage edited = image_;
   try {
-    const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
-    log = lines.empty() ? std::string() : without_op_prefix(lines.front());
+    subvec::apply_edit_ops(edited, std::span(&op, 1));
   } catch (const Error& e) {
     refuse_edit(Error(e.code(), without_op_prefix(e.what())));
   }
+  // The page's line, in plain words: what changed and how much (the library's line names the
+  // seed vertex and its color value).
+  const std::vector<subvec::Color>& before = image_.levels[op.level].colors;
+  const std::vector<subvec::Color>& after = edited.levels[op.level].colors;
+  int changed = 0;
+  for (size_t i = 0; i < before.size(); ++i) {
+    changed += before[i].r != after[i].r || before[i].g != after[i].g || before[i].b != after[i].b;
+  }
+  const auto rgb = [](subvec::Color c) {
+    return "(" + std::to_string(std::lround(c.r)) + ", " + std::to_string(std::lround(c.g)) + ", " +
+           std::to_string(std::lround(c.b)) + ")";
+  };
+  log = edit_label(op) + ": " + std::to_string(changed) + " control colors " +
+        (op.mode == subvec::ColorMode::kBlend ? "moved toward " : "mapped onto ") + rgb(op.color);
   commit_locked(std::move(edited), edit_label(op));
   return delta_locked(session, nullptr, false);
 }
@@ -727,10 +741,8 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
                        (request.geometry && request.color ? "geometry and color"
                         : request.geometry              ? "geometry"
                                                         : "color") +
-                       (report.restored_vertices > 0
-                            ? ", " + std::to_string(report.restored_vertices) +
-                                  " vertices held back from folding"
-                            : std::string());
+                       (report.restored_vertices > 0 ? ", held back where it would fold"
+                                                     : std::string());
   return delta_locked(session, nullptr, false);
 }
 

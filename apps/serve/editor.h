@@ -198,7 +198,8 @@ class Editor {
                  std::string& log);
   void drag_cancel(const std::string& session);
 
-  // A color edit or any op through apply_edit_ops; the delta for the session's view.
+  // A color edit (op.kind == kColor) through apply_edit_ops; the delta for the session's view, and
+  // `log`, the page's line: "color blend at (50, 46): 34 control colors moved toward (0, 255, 0)".
   Delta apply(const std::string& session, int64_t version, const subvec::EditOp& op,
               std::string& log);
   Delta stylize(const std::string& session, int64_t version, int level, std::optional<double> threshold,

@@ -46,6 +46,7 @@ const state = {
   busy: 0,           // tasks queued or running (enqueue): never negative
   drag: null as Drag | null,  // the drag the pointer holds (its task may still be queued)
   pan: null as null | { x: number; y: number; panX: number; panY: number },
+  fitted: true,      // the view is the fitted one: a resize fits again, until the user zooms or pans
   space: false,
   viewTimer: 0,
   measure: false,
@@ -134,6 +135,7 @@ function resize() {
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
+    if (state.fitted) fit();
     scheduleView();
   }
   redraw();
@@ -144,6 +146,7 @@ function fit() {
   const { width, height } = state.doc;
   const zoom = Math.min(canvas.width / width, canvas.height / height) * 0.96;
   state.transform = { zoom, panX: (canvas.width - width * zoom) / 2, panY: (canvas.height - height * zoom) / 2 };
+  state.fitted = true;
   updateZoomLabel();
   scheduleView();
   redraw();
@@ -349,9 +352,8 @@ async function doSelect(at: [number, number]) {
     const r = await postJson('/api/select', { level: state.level, select: pick(), at, radius: num('radius') });
     if (seq !== selectSeq) return;
     renderer.setHighlight(r.chain, r.region);
-    status(r.feature >= 0
-      ? `feature ${r.feature} (${r.chain.length} control vertices, ${r.distance.toFixed(1)} px away); region of ${r.colors} color values`
-      : `vertex ${r.vertex} (${r.distance.toFixed(1)} px away); region of ${r.colors} color values`);
+    status(`${r.feature >= 0 ? `the nearest feature, ${r.distance.toFixed(1)} px away (pink)` : `the nearest control point, ${r.distance.toFixed(1)} px away`}; ` +
+      `a color edit here changes the ${r.colors} control colors shown white`);
   } catch (e) {
     if (seq === selectSeq) status(e instanceof Error ? e.message : String(e), true);
   }
@@ -370,7 +372,7 @@ async function doColor(at: [number, number]) {
       radius: num('radius'), mode: mode(), color: hexColor(), amount: num('amount'),
     });
     applyDelta(f);
-    status(`${mode()}: ${f.header.log}`);
+    status(f.header.log);
   });
 }
 
@@ -696,6 +698,7 @@ canvas.addEventListener('pointermove', (e) => {
     const [x, y] = canvasPoint(e);
     state.transform.panX = state.pan.panX + x - state.pan.x;
     state.transform.panY = state.pan.panY + y - state.pan.y;
+    state.fitted = false;
     redraw();
     scheduleView();
     return;
@@ -721,6 +724,7 @@ canvas.addEventListener('wheel', (e) => {
   t.panX = x - ((x - t.panX) * zoom) / t.zoom;
   t.panY = y - ((y - t.panY) * zoom) / t.zoom;
   t.zoom = zoom;
+  state.fitted = false;
   updateZoomLabel();
   redraw();
   scheduleView();
@@ -735,6 +739,7 @@ window.addEventListener('keydown', (e) => {
   if (ctrl && key === 'y') { e.preventDefault(); void doHistory('redo'); return; }
   if (ctrl && key === 's') { e.preventDefault(); void doSave(); return; }
   if (ctrl || e.altKey) return;
+  if (e.key === 'Tab' && document.activeElement === document.body) { e.preventDefault(); togglePanel(); return; }
   if (e.key === ' ') { state.space = true; canvas.classList.add('pan'); e.preventDefault(); return; }
   const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color' };
   if (tools[key]) { setTool(tools[key]); return; }
@@ -751,6 +756,12 @@ window.addEventListener('keydown', (e) => {
 window.addEventListener('keyup', (e) => {
   if (e.key === ' ') { state.space = false; canvas.classList.toggle('pan', state.tool === 'pan'); }
 });
+
+// The panel folds away in narrow windows (style.css); the toggle and Tab show or hide it.
+function togglePanel(open = !document.body.classList.contains('panel-open')) {
+  document.body.classList.toggle('panel-open', open);
+  $('panel-toggle').setAttribute('aria-expanded', String(open));
+}
 
 function toggleRadio(name: string) {
   const inputs = Array.from(document.querySelectorAll<HTMLInputElement>(`input[name=${name}]`));
@@ -781,6 +792,8 @@ function wireControls() {
   $('show-mesh').addEventListener('change', () => { state.overlays.mesh = $<HTMLInputElement>('show-mesh').checked; redraw(); });
   $('show-features').addEventListener('change', () => { state.overlays.features = $<HTMLInputElement>('show-features').checked; redraw(); });
   $('fit').addEventListener('click', fit);
+  $('panel-toggle').addEventListener('click', () => togglePanel());
+  canvas.addEventListener('pointerdown', () => togglePanel(false));
   $('undo').addEventListener('click', () => void doHistory('undo'));
   $('redo').addEventListener('click', () => void doHistory('redo'));
   $('save').addEventListener('click', () => void doSave());
@@ -884,7 +897,7 @@ async function main() {
     await Promise.all([loadView(), loadControl(), loadStrokes()]);
     const doc = state.doc!;
     const l = doc.levels[state.level];
-    status(`${doc.name}: ${l.vertices} control vertices, ${l.features} features. Pick a tool on the left; its description appears below the buttons.`);
+    status(`${doc.name}: ${l.vertices} control vertices, ${l.features} features. Pick a tool in the panel; its description appears below the buttons.`);
     window.subvec.ready = true;
     setTimeout(poll, 1000);
   } catch (e) {

@@ -1,4 +1,4 @@
-// Quick input in the editor page (issue 29, problems 1-3, 6 and 10), in headless Chromium with
+// Quick input in the editor page (issue 29, problems 1-3, 6, 8, 9 and 10), in headless Chromium with
 // software WebGL: the page queues its requests, so quick clicks with every tool make exactly the
 // edits they ask for (a click is no drag), quick undos raise no conflict, a drag the mesh refuses
 // at its end commits where it last fitted, a press outside the image grabs nothing, the status
@@ -65,6 +65,12 @@ try {
     }
     await idle(page);
   };
+  // Every status line the page shows, for problem 10 (no internal terms).
+  await page.evaluate(() => {
+    window.statuses = [];
+    new MutationObserver(() => window.statuses.push(document.getElementById('status').textContent))
+      .observe(document.getElementById('status'), { childList: true, characterData: true, subtree: true });
+  });
   const start = await doc();
   const probe = await pixel(page, 80, 48);
 
@@ -177,6 +183,45 @@ try {
   d = await drag([-2, 60], [30, 60]);  // in the margin left of the image
   check('a drag that starts outside the image does nothing', d.version === outsideBefore.version && /outside the image/.test(d.status),
     `version ${outsideBefore.version} -> ${d.version}, status "${d.status}"`);
+
+  // Problem 9: the image re-fits when the window changes size, until the user zooms; below 800 px
+  // the panel folds away and the canvas takes the width.
+  const layout = () => page.evaluate(() => {
+    const c = document.getElementById('canvas');
+    const { width, height } = window.subvec.state.doc;
+    const t = window.subvec.state.transform;
+    const fitZoom = Math.min(c.width / width, c.height / height) * 0.96;
+    return { canvas: c.getBoundingClientRect().width, fitted: Math.abs(t.zoom - fitZoom) < 1e-9, zoom: t.zoom };
+  });
+  await page.setViewportSize({ width: 1200, height: 760 });
+  await page.waitForTimeout(300);
+  const wide = await layout();
+  await page.setViewportSize({ width: 400, height: 300 });
+  await page.waitForTimeout(300);
+  const narrow = await layout();
+  check('resize: the image re-fits', wide.fitted && narrow.fitted && narrow.zoom < wide.zoom, JSON.stringify([wide, narrow]));
+  check('resize: at 400 px the panel folds away', narrow.canvas === 400, `canvas ${narrow.canvas} px wide`);
+  await page.click('#panel-toggle');
+  await page.waitForTimeout(300);
+  const panelOpen = await page.evaluate(() => document.getElementById('panel').getBoundingClientRect().right > 200);
+  await page.click('#panel-toggle');
+  check('resize: the toggle shows the panel', panelOpen);
+  const [wx, wy] = await client(page, 48, 48);
+  await page.mouse.move(wx, wy);
+  await page.mouse.wheel(0, -200);
+  await page.waitForTimeout(100);
+  const zoomed = await layout();
+  await page.setViewportSize({ width: 700, height: 500 });
+  await page.waitForTimeout(300);
+  const kept = await layout();
+  check('resize: after a zoom the view is kept', !zoomed.fitted && kept.zoom === zoomed.zoom, JSON.stringify([zoomed, kept]));
+  await page.setViewportSize({ width: 1000, height: 700 });
+
+  // Problem 10: the status lines of all of the above speak plainly: no versions, vertex or
+  // triangle numbers or solver internals.
+  const lines = [...new Set(await page.evaluate(() => window.statuses))];
+  const internal = lines.filter((l) => /version|vertex \d|triangle \d|feature \d|id \d|scale adjustment|held back|handle vertices/.test(l));
+  check(`status lines are plain (${lines.length} different ones)`, lines.length > 10 && internal.length === 0, internal.join(' | '));
 
   check('no page errors', errors.length === 0, errors.join('; '));
 } catch (e) {

@@ -80,6 +80,8 @@ TEST(ServeEditor, UndoRedoRestoreExactly) {
   const std::string s = editor.new_session();
   std::string log;
   editor.apply(s, 1, color_op({48, 48}, {0, 0, 255}), log);
+  EXPECT_EQ(log.rfind("color blend at (48, 48): ", 0), 0u) << log;
+  EXPECT_NE(log.find(" control colors moved toward (0, 0, 255)"), std::string::npos) << log;
   const VectorImage edited = editor.snapshot().first;
   ASSERT_NE(edited.levels[0].colors, original.levels[0].colors);
   std::string label;
