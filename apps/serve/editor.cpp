@@ -460,12 +460,6 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(start.level);
-  if (!(start.sigma > 0) || !std::isfinite(start.sigma)) {
-    throw RequestError(kBadRequest, "sigma must be a positive number of pixels");
-  }
-  if (!(start.region >= 0) || !std::isfinite(start.region)) {
-    throw RequestError(kBadRequest, "region must be a non-negative number of pixels");
-  }
   const ControlMesh& mesh = image_.levels[start.level];
   auto drag = std::make_unique<Session::Drag>();
   drag->start = start;
@@ -492,6 +486,20 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
     result.distance = pick.distance;
     result.chain = mesh.features[pick.feature].vertices;
   }
+  // What the user left to the editor: an extent local to what was grabbed.
+  if (start.auto_sigma || start.auto_region) {
+    const subvec::DragExtent e = subvec::suggested_drag_extent(mesh, drag->feature, drag->vertex);
+    if (start.auto_sigma) drag->start.sigma = e.sigma;
+    if (start.auto_region) drag->start.region = e.region;
+  }
+  if (!(drag->start.sigma > 0) || !std::isfinite(drag->start.sigma)) {
+    throw RequestError(kBadRequest, "sigma must be a positive number of pixels");
+  }
+  if (!(drag->start.region >= 0) || !std::isfinite(drag->start.region)) {
+    throw RequestError(kBadRequest, "region must be a non-negative number of pixels");
+  }
+  result.drag_sigma = drag->start.sigma;
+  result.drag_region = drag->start.region;
   try {
     drag->shape = std::make_unique<subvec::ShapeEditor>(mesh, image_.width, image_.height);
   } catch (const Error& e) {

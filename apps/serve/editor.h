@@ -140,6 +140,8 @@ struct DragStart {
   Vec2 at;
   double sigma = 20;
   double region = 0;
+  // Left to the editor ("auto"): subvec::suggested_drag_extent for what is grabbed.
+  bool auto_sigma = false, auto_region = false;
 };
 
 struct SelectRequest {
@@ -155,6 +157,7 @@ struct SelectResult {
   std::vector<int32_t> chain;       // control vertices of the feature (empty for a vertex)
   std::vector<int32_t> region;      // control vertices whose color values the region holds
   int colors = 0;                   // color values in the region
+  double drag_sigma = 0, drag_region = 0;  // a drag's extent, as resolved ("auto" or asked)
 };
 
 class Editor {

@@ -598,11 +598,17 @@ void EditorServer::Impl::drag_routes() {
     d.move_feature = tool == "move";
     d.select = select_mode(j);
     d.at = point(j, "at");
-    d.sigma = number(j, "sigma", 20.0);
-    d.region = number(j, "region", 0.0);
+    // A number, or "auto": the editor picks an extent local to what is grabbed.
+    const auto extent = [&](const char* key, double fallback, bool& is_auto) {
+      is_auto = j.contains(key) && j[key] == "auto";
+      return is_auto ? fallback : number(j, key, fallback);
+    };
+    d.sigma = extent("sigma", 20.0, d.auto_sigma);
+    d.region = extent("region", 0.0, d.auto_region);
     const SelectResult r =
         ready_editor()->drag_start(text(j, "session"), integer(j, "version"), d);
-    send_json(res, {{"vertex", r.vertex}, {"feature", r.feature}, {"chain", r.chain}});
+    send_json(res, {{"vertex", r.vertex}, {"feature", r.feature}, {"chain", r.chain},
+                    {"sigma", r.drag_sigma}, {"region", r.drag_region}});
   });
 
   server.Post("/api/drag/move", [this](const httplib::Request& req, httplib::Response& res) {

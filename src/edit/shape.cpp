@@ -208,6 +208,44 @@ double outside(const std::array<double, 3>& l) { return -std::min({l[0], l[1], l
 
 }  // namespace
 
+DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex) {
+  DragExtent e;
+  if (feature >= 0) {
+    if (feature >= static_cast<int>(mesh.features.size())) {
+      invalid("feature " + std::to_string(feature) + " is out of range");
+    }
+    const Feature& f = mesh.features[feature];
+    double length = 0;
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+    for (size_t i = 0; i < f.vertices.size(); ++i) {
+      const Vec2 p = mesh.positions[f.vertices[i]];
+      x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+      if (i > 0) {
+        const Vec2 q = mesh.positions[f.vertices[i - 1]];
+        length += std::hypot(p.x - q.x, p.y - q.y);
+      }
+    }
+    const double diagonal = std::hypot(x1 - x0, y1 - y0);
+    e.sigma = f.closed() && diagonal <= 60 ? std::max(2 * diagonal, 8.0) : std::clamp(length / 4, 8.0, 60.0);
+    e.region = std::max(3 * e.sigma, 30.0);
+    return e;
+  }
+  if (vertex < 0 || vertex >= mesh.num_vertices()) invalid("vertex " + std::to_string(vertex) + " is out of range");
+  double longest = 0;
+  const Vec2 p = mesh.positions[vertex];
+  for (const Tri& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] != vertex) continue;
+      for (int m = 1; m <= 2; ++m) {
+        const Vec2 q = mesh.positions[t[(k + m) % 3]];
+        longest = std::max(longest, std::hypot(q.x - p.x, q.y - p.y));
+      }
+    }
+  }
+  e.region = std::max(4 * longest, 30.0);
+  return e;
+}
+
 void transport_points(const std::vector<Vec2>& rest, const std::vector<Vec2>& moved,
                       const std::vector<Tri>& triangles, std::span<Vec2> points) {
   if (rest.size() != moved.size()) invalid("transport_points: rest and moved differ in size");

@@ -73,6 +73,14 @@ interface Drag {
   eventTime: number;
 }
 const CLICK_SLOP = 3;  // CSS pixels
+const REGION_WHOLE = 400;  // the region slider's far right: the whole image
+
+// σ and region as the sliders give them: "auto" at the far left (the server sizes them to what is
+// grabbed: subvec::suggested_drag_extent), 0 (the whole image) at the region's far right.
+function dragExtent(): { sigma: number | 'auto'; region: number | 'auto' } {
+  const sigma = num('sigma'), region = num('region');
+  return { sigma: sigma === 0 ? 'auto' : sigma, region: region === 0 ? 'auto' : region >= REGION_WHOLE ? 0 : region };
+}
 
 let renderer: Renderer;
 
@@ -570,11 +578,12 @@ async function runDrag(drag: Drag) {
   try {
     const r = await postJson('/api/drag/start', {
       session: state.session, version: state.version, level: state.level, tool: state.tool,
-      select: state.tool === 'move' ? 'feature' : pick(), at: drag.start, sigma: num('sigma'), region: num('region'),
+      select: state.tool === 'move' ? 'feature' : pick(), at: drag.start, ...dragExtent(),
     });
     renderer.setHighlight(r.chain, r.vertex >= 0 ? [r.vertex] : []);
     drag.ok = true;
-    status(r.feature >= 0 ? 'dragging a feature' : 'dragging a control point');
+    status(`dragging ${r.feature >= 0 ? 'a feature' : 'a control point'}; ` +
+      (r.region > 0 ? `the image follows within ${Math.round(r.region)} px` : 'the whole image follows'));
   } catch (e) {
     if (state.drag === drag) state.drag = null;
     await reportError(e);
@@ -785,8 +794,8 @@ function wireControls() {
   document.querySelectorAll<HTMLButtonElement>('#tools button').forEach((b) =>
     b.addEventListener('click', () => setTool(b.dataset.tool as Tool)));
   bindOutput('radius', (v) => `${v} px`);
-  bindOutput('sigma', (v) => `${v} px`);
-  bindOutput('region', (v) => (v === 0 ? 'whole' : `${v} px`));
+  bindOutput('sigma', (v) => (v === 0 ? 'auto' : `${v} px`));
+  bindOutput('region', (v) => (v === 0 ? 'auto' : v >= REGION_WHOLE ? 'whole' : `${v} px`));
   bindOutput('amount', (v) => v.toFixed(2));
   $('level').addEventListener('input', () => void setLevel(num('level')));
   $('show-mesh').addEventListener('change', () => { state.overlays.mesh = $<HTMLInputElement>('show-mesh').checked; redraw(); });

@@ -55,6 +55,19 @@ Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 cente
 Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 translate,
                      double degrees);
 
+// The extent of a drag the user leaves to the editor (issue 29): an influence local to what was
+// grabbed, so that a small shape moves without the rest of the picture. For a feature, sigma is a
+// quarter of its control polygon's length, within [8, 60] pixels, or, for a closed feature whose
+// bounding box has a diagonal D of 60 pixels or less, 2 D, so that the small closed shape moves
+// nearly as a whole; the region is 3 sigma, at least 30 pixels. For a vertex (feature < 0), the
+// region is 4 times its longest edge, at least 30 pixels (sigma is unused). Throws
+// Error(kInvalidArgument) for an index out of range.
+struct DragExtent {
+  double sigma = 20;
+  double region = 0;
+};
+DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex);
+
 // Carries points through a shape edit: each point keeps its barycentric coordinates in the control
 // triangle of `triangles` that holds it at `rest` and takes them to the same triangle at `moved`
 // (both #V; the triangles cover the image, so every point inside it has one; a point outside, or

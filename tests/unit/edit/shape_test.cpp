@@ -109,6 +109,34 @@ TEST(Shape, TransportPointsMatchesABruteForceSearch) {
   }
 }
 
+// The editor's "auto" extent: local to what is grabbed.
+TEST(Shape, SuggestedDragExtentFollowsTheGrabbedSize) {
+  ControlMesh mesh = image_with_features().levels[0];
+  for (size_t f = 0; f < mesh.features.size(); ++f) {
+    const Feature& feature = mesh.features[f];
+    double length = 0, x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+    for (size_t i = 0; i < feature.vertices.size(); ++i) {
+      const Vec2 p = mesh.positions[feature.vertices[i]];
+      x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+      if (i > 0) {
+        const Vec2 q = mesh.positions[feature.vertices[i - 1]];
+        length += std::hypot(p.x - q.x, p.y - q.y);
+      }
+    }
+    const double diagonal = std::hypot(x1 - x0, y1 - y0);
+    const DragExtent e = suggested_drag_extent(mesh, static_cast<int>(f), -1);
+    const double sigma = feature.closed() && diagonal <= 60 ? std::max(2 * diagonal, 8.0)
+                                                            : std::clamp(length / 4, 8.0, 60.0);
+    EXPECT_DOUBLE_EQ(e.sigma, sigma) << "feature " << f;
+    EXPECT_DOUBLE_EQ(e.region, std::max(3 * sigma, 30.0)) << "feature " << f;
+  }
+  // A vertex: four times its longest edge, at least 30 px.
+  const DragExtent v = suggested_drag_extent(mesh, -1, 0);
+  EXPECT_GE(v.region, 30);
+  EXPECT_THROW(suggested_drag_extent(mesh, static_cast<int>(mesh.features.size()), -1), Error);
+  EXPECT_THROW(suggested_drag_extent(mesh, -1, mesh.num_vertices()), Error);
+}
+
 // A shape edit carries the level's strokes along (apply_edit_ops); a color edit and another
 // level's strokes leave them where they are.
 TEST(Shape, StrokesFollowShapeEdits) {
