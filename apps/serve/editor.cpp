@@ -34,6 +34,7 @@ struct Editor::View {
 
 struct Editor::Session {
   std::string id;
+  std::string tab;
   std::unique_ptr<View> view;
   struct Drag {
     DragStart start;
@@ -111,7 +112,7 @@ std::pair<VectorImage, int64_t> Editor::snapshot() const {
   return {image_, version_};
 }
 
-DocumentInfo Editor::info() const {
+DocumentInfo Editor::info(const std::string& session) const {
   std::lock_guard lock(mutex_);
   DocumentInfo info;
   info.version = version_;
@@ -133,18 +134,29 @@ DocumentInfo Editor::info() const {
     level.mean_edge = mesh.triangles.empty() ? 0 : sum / (3.0 * mesh.num_triangles());
     info.levels.push_back(level);
   }
-  info.undo = static_cast<int>(undo_.size());
-  info.redo = static_cast<int>(redo_.size());
+  // A session's tab counts its own steps (an unknown session: none of them).
+  const auto mine = [&](const std::vector<HistoryStep>& steps) {
+    if (session.empty()) return static_cast<int>(steps.size());
+    std::string tab = "\n";  // matches no step
+    for (const auto& s : sessions_) {
+      if (s->id == session) tab = s->tab;
+    }
+    return static_cast<int>(std::count_if(steps.begin(), steps.end(),
+                                          [&](const HistoryStep& h) { return h.tab == tab; }));
+  };
+  info.undo = mine(undo_);
+  info.redo = mine(redo_);
   info.strokes = static_cast<int>(image_.strokes.size());
   info.bands = subvec::has_pyramid(image_) ? static_cast<int>(image_.levels.size()) - 1 : 0;
   if (filter_version_ == version_) info.filter = filter_;
   return info;
 }
 
-std::string Editor::new_session() {
+std::string Editor::new_session(const std::string& tab) {
   std::lock_guard lock(mutex_);
   auto session = std::make_unique<Session>();
   session->id = "s" + std::to_string(next_session_++);
+  session->tab = tab.empty() ? session->id : tab;
   std::string id = session->id;
   sessions_.insert(sessions_.begin(), std::move(session));
   // The least recently used session goes when there are too many: its tab then gets 404 and
@@ -520,10 +532,12 @@ Delta Editor::drag_move(const std::string& session_id, Vec2 to, double rotate) {
 Delta Editor::drag_move_locked(Session& session, Vec2 to, double rotate) {
   if (!session.drag) throw RequestError(kConflict, "no drag in progress");
   Session::Drag& drag = *session.drag;
+  // Another tab edited while this drag went on: the drag goes on over the edited document (the
+  // topology never changes, so its handle is still valid), and its end applies to that.
   if (drag.version != version_) {
-    const int64_t stale = drag.version;
-    session.drag.reset();
-    check_version_locked(stale);
+    drag.shape = std::make_unique<subvec::ShapeEditor>(image_.levels[drag.start.level],
+                                                       image_.width, image_.height);
+    drag.version = version_;
   }
   if (!std::isfinite(to.x) || !std::isfinite(to.y) || !std::isfinite(rotate)) {
     throw RequestError(kBadRequest, "drag target must be finite");
@@ -561,8 +575,10 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
   Session& session = session_locked(session_id);
   if (!session.drag) throw RequestError(kConflict, "no drag in progress");
   std::unique_ptr<Session::Drag> drag = std::move(session.drag);
-  check_version_locked(version);
-  check_version_locked(drag->version);
+  // The page's version may be behind by another tab's edit made during the drag: the drag applies
+  // to the document as it is now, over that edit, instead of being thrown away.
+  (void)version;
+  drag->version = version_;
   if (!std::isfinite(to.x) || !std::isfinite(to.y) || !std::isfinite(rotate)) {
     throw RequestError(kBadRequest, "drag target must be finite");
   }
@@ -624,7 +640,7 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
   // The level's strokes moved with it (apply_edit_ops carries them along).
   const bool strokes_moved = std::any_of(edited.strokes.begin(), edited.strokes.end(),
                                          [&](const subvec::Stroke& s) { return s.level == op.level; });
-  commit_locked(std::move(edited), edit_label(op));
+  commit_locked(std::move(edited), edit_label(op), session);
   return delta_locked(session, nullptr, strokes_moved);
 }
 
@@ -633,8 +649,8 @@ void Editor::drag_cancel(const std::string& session_id) {
   session_locked(session_id).drag.reset();
 }
 
-void Editor::commit_locked(VectorImage image, std::string label) {
-  undo_.push_back({std::move(image_), std::move(label)});
+void Editor::commit_locked(VectorImage image, std::string label, const Session& by) {
+  undo_.push_back({std::move(image_), std::move(label), by.tab});
   if (static_cast<int>(undo_.size()) > kMaxUndo) undo_.erase(undo_.begin());
   redo_.clear();
   image_ = std::move(image);
@@ -668,7 +684,7 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   };
   log = edit_label(op) + ": " + std::to_string(changed) + " control colors " +
         (op.mode == subvec::ColorMode::kBlend ? "moved toward " : "mapped onto ") + rgb(op.color);
-  commit_locked(std::move(edited), edit_label(op));
+  commit_locked(std::move(edited), edit_label(op), session);
   return delta_locked(session, nullptr, false);
 }
 
@@ -696,7 +712,7 @@ Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
         " features (saliency threshold " + std::to_string(std::lround(report.threshold)) + ")" +
         (report.replaced > 0 ? ", replacing the " + std::to_string(report.replaced) + " before"
                              : std::string());
-  commit_locked(std::move(edited), "stylize");
+  commit_locked(std::move(edited), "stylize", session);
   return delta_locked(session, nullptr, true);
 }
 
@@ -739,7 +755,7 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
     }
   }
   VectorImage start = continues ? std::move(filter_base_) : image_;
-  commit_locked(std::move(filtered), identity ? "filter off" : "filter");
+  commit_locked(std::move(filtered), identity ? "filter off" : "filter", session);
   filter_base_ = std::move(start);
   filter_version_ = version_;
   filter_ = request;
@@ -769,11 +785,18 @@ Delta Editor::step_history(const std::string& session_id, int64_t version,
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
-  if (from.empty()) throw RequestError(kConflict, empty_message);
+  // A tab takes back its own edits only (docs/serve.md, "Two tabs"): the step on top must be its.
+  const bool any = std::any_of(from.begin(), from.end(),
+                               [&](const HistoryStep& h) { return h.tab == session.tab; });
+  if (!any) throw RequestError(kConflict, std::string(empty_message) + " in this tab");
+  if (from.back().tab != session.tab) {
+    throw RequestError(kConflict, std::string(empty_message == std::string("nothing to undo") ? "undo" : "redo") +
+                                      " waits: the last edit was made in another window, which can undo it");
+  }
   // Strokes move with shape edits, so any may differ: the page reloads them when there are any.
   const bool strokes_changed = !from.back().image.strokes.empty() || !image_.strokes.empty();
   label = from.back().label;
-  to.push_back({std::move(image_), label});
+  to.push_back({std::move(image_), label, session.tab});
   image_ = std::move(from.back().image);
   from.pop_back();
   ++version_;

@@ -171,13 +171,16 @@ class Editor {
   Editor(const Editor&) = delete;
   Editor& operator=(const Editor&) = delete;
 
-  DocumentInfo info() const;
+  // `session`: undo and redo count that session's tab's steps (empty: every step).
+  DocumentInfo info(const std::string& session = "") const;
   int64_t version() const;
   // A copy of the document (for saving and exporting) and its version.
   std::pair<VectorImage, int64_t> snapshot() const;
 
   // Sessions: a new one per tab; unknown ids throw RequestError(404).
-  std::string new_session();
+  // `tab`: the browser tab the session serves (the page keeps one id per tab across reloads);
+  // undo and redo take back that tab's edits only. Empty: the session is its own tab.
+  std::string new_session(const std::string& tab = "");
 
   // Control mesh of a level for the overlay: positions, unique edges, feature chains.
   struct ControlData {
@@ -222,7 +225,7 @@ class Editor {
   Session& session_locked(const std::string& id);
   void check_version_locked(int64_t version) const;
   void check_level_locked(int level) const;
-  void commit_locked(VectorImage image, std::string label);
+  void commit_locked(VectorImage image, std::string label, const Session& by);
   Delta drag_move_locked(Session& session, Vec2 to, double rotate);
   Delta delta_locked(Session& session, const std::vector<Vec2>* preview, bool strokes_changed);
   // An undo or redo step: the image on the other side of it, and the edit it is ("color blend at
@@ -230,6 +233,7 @@ class Editor {
   struct HistoryStep {
     VectorImage image;
     std::string label;
+    std::string tab;  // the tab that made the edit: only it may undo or redo it
   };
   Delta step_history(const std::string& session, int64_t version, std::vector<HistoryStep>& from,
                      std::vector<HistoryStep>& to, const char* empty_message, std::string& label);

@@ -477,8 +477,10 @@ void EditorServer::Impl::document_routes() {
     send_json(res, j);
   });
 
-  server.Get("/api/document", [this](const httplib::Request&, httplib::Response& res) {
-    const DocumentInfo info = ready_editor()->info();
+  // ?session=: undo and redo count that session's tab's steps.
+  server.Get("/api/document", [this](const httplib::Request& req, httplib::Response& res) {
+    const DocumentInfo info =
+        ready_editor()->info(req.has_param("session") ? req.get_param_value("session") : "");
     json levels = json::array();
     for (const auto& l : info.levels) {
       levels.push_back({{"vertices", l.vertices},
@@ -511,8 +513,20 @@ void EditorServer::Impl::document_routes() {
                                                   "(vectorize it with --levels 2 or more)"}}}});
   });
 
-  server.Post("/api/session", [this](const httplib::Request&, httplib::Response& res) {
-    send_json(res, {{"session", ready_editor()->new_session()}});
+  // {tab?}: the page's id for its browser tab (kept across reloads), whose edits its undo takes
+  // back: 1 to 64 letters, digits and dashes.
+  server.Post("/api/session", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    std::string tab;
+    if (j.contains("tab")) {
+      tab = text(j, "tab");
+      const bool ok = !tab.empty() && tab.size() <= 64 &&
+                      std::all_of(tab.begin(), tab.end(), [](char c) {
+                        return std::isalnum(static_cast<unsigned char>(c)) || c == '-';
+                      });
+      if (!ok) throw RequestError(kBadRequest, "\"tab\" must be 1 to 64 letters, digits or dashes");
+    }
+    send_json(res, {{"session", ready_editor()->new_session(tab)}});
   });
 
   server.Get("/api/control", [this](const httplib::Request& req, httplib::Response& res) {

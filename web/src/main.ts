@@ -1,7 +1,8 @@
 // The subvec editor page: tools, view, and the conversation with `subvec serve` (docs/serve.md).
 //
-// State. The server owns the document and its version; this page owns a session (its refined
-// view of one level at the depth its zoom needs) and the last version it drew. Every request that
+// State. The server owns the document, its version and its history; this page owns a session (its
+// refined view of one level at the depth its zoom needs, for this browser tab: undo takes back
+// this tab's edits only) and the last version it drew. Every request that
 // changes the document or the session's view runs in one queue, one at a time, in the order the
 // user asked (enqueue): each sends the version its predecessor left, so only another tab's edit
 // can make a 409 conflict, and the page then reloads. A poll of /api/status notices changes made
@@ -261,7 +262,7 @@ function applyDelta(frame: Frame) {
 // ---- document ------------------------------------------------------------------------------
 
 async function loadDocument() {
-  const doc: DocInfo = await getJson('/api/document');
+  const doc: DocInfo = await getJson(`/api/document?session=${state.session}`);
   state.doc = doc;
   state.version = doc.version;
   if (state.level >= doc.levels.length) state.level = 0;
@@ -305,7 +306,7 @@ async function reloadAll(message?: string) {
 }
 
 async function refreshCounts() {
-  const doc: DocInfo = await getJson('/api/document');
+  const doc: DocInfo = await getJson(`/api/document?session=${state.session}`);
   if (state.doc) {
     state.doc.undo = doc.undo;
     state.doc.redo = doc.redo;
@@ -331,7 +332,7 @@ async function runEdit(run: () => Promise<void>) {
 const edit = (run: () => Promise<void>) => enqueue(() => runEdit(run));
 
 async function reportError(e: unknown) {
-  if (e instanceof ApiError && e.status === 409 && /another tab/.test(e.message)) {
+  if (e instanceof ApiError && e.status === 409 && /document changed in another tab/.test(e.message)) {
     await reloadAll();
     status('the document changed in another tab: reloaded it, try again', true);
   } else if (e instanceof ApiError && e.status === 404 && /session/.test(e.message)) {
@@ -817,8 +818,19 @@ function wireControls() {
 
 // ---- start-up and polling ------------------------------------------------------------------
 
+// This browser tab's id, kept across reloads (sessionStorage is per tab): the server lets a tab
+// undo and redo its own edits only, and a reload keeps them.
+function tabId(): string {
+  let id = sessionStorage.getItem('subvec-tab');
+  if (!id) {
+    id = Array.from(crypto.getRandomValues(new Uint8Array(12)), (b) => b.toString(16).padStart(2, '0')).join('');
+    sessionStorage.setItem('subvec-tab', id);
+  }
+  return id;
+}
+
 async function startSession() {
-  state.session = (await postJson('/api/session', {})).session;
+  state.session = (await postJson('/api/session', { tab: tabId() })).session;
   await reloadAll();
 }
 
@@ -900,7 +912,7 @@ async function main() {
   resize();
   try {
     await waitForDocument();
-    state.session = (await postJson('/api/session', {})).session;
+    state.session = (await postJson('/api/session', { tab: tabId() })).session;
     await loadDocument();
     fit();
     await Promise.all([loadView(), loadControl(), loadStrokes()]);

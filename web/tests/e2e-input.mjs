@@ -1,4 +1,4 @@
-// Quick input in the editor page (issue 29, problems 1-3, 6, 8, 9 and 10), in headless Chromium with
+// Quick input in the editor page (issue 29, problems 1-4, 6 and 8-11), in headless Chromium with
 // software WebGL: the page queues its requests, so quick clicks with every tool make exactly the
 // edits they ask for (a click is no drag), quick undos raise no conflict, a drag the mesh refuses
 // at its end commits where it last fitted, a press outside the image grabs nothing, the status
@@ -216,6 +216,51 @@ try {
   const kept = await layout();
   check('resize: after a zoom the view is kept', !zoomed.fitted && kept.zoom === zoomed.zoom, JSON.stringify([zoomed, kept]));
   await page.setViewportSize({ width: 1000, height: 700 });
+
+  // Problem 11: two tabs. Another tab's edit during a drag does not throw the drag away, and undo
+  // takes back a tab's own edits only.
+  await page.keyboard.press('0');
+  await page.keyboard.press('d');
+  await idle(page);
+  const { page: tabB } = await openEditor(browser, server.url);
+  const v0 = (await doc()).version;
+  const [ax, ay] = await client(page, 76, 48);
+  await page.mouse.move(ax, ay);
+  await page.mouse.down();
+  for (let i = 1; i <= 4; i++) {
+    const [x, y] = await client(page, 76 + i, 48);
+    await page.mouse.move(x, y);
+    await page.waitForTimeout(15);
+  }
+  await tabB.keyboard.press('c');
+  const [bx, by] = await client(tabB, 6, 6);
+  await tabB.mouse.click(bx, by);  // tab B recolors the corner while tab A drags
+  await idle(tabB);
+  for (let i = 5; i <= 8; i++) {
+    const [x, y] = await client(page, 76 + i, 48);
+    await page.mouse.move(x, y);
+    await page.waitForTimeout(15);
+  }
+  await page.mouse.up();
+  await idle(page);
+  d = await doc();
+  const cornerA = await pixel(page, 6, 6), cornerB = await pixel(tabB, 6, 6);
+  check('two tabs: a drag outlives the other tab\'s edit', d.version === v0 + 2 && /^dragged by \(8, 0\) px$/.test(d.status),
+    `version ${v0} -> ${d.version}, status "${d.status}"`);
+  check('two tabs: the other tab\'s edit is kept and shown', diff(cornerA, cornerB) < 3, `${cornerA} vs ${cornerB}`);
+  await page.keyboard.press('Control+z');  // undoes A's drag
+  await idle(page);
+  await page.keyboard.press('Control+z');  // B's edit is next: not A's to undo
+  await idle(page);
+  d = await doc();
+  check('two tabs: undo takes back this tab\'s edit and waits at the other\'s', d.version === v0 + 3 &&
+    /^undo waits: the last edit was made in another window/.test(d.status), `version ${d.version}, status "${d.status}"`);
+  await tabB.waitForFunction((v) => window.subvec.state.version === v, d.version, { timeout: 10000 });
+  await tabB.keyboard.press('Control+z');
+  await idle(tabB);
+  const lineB = await tabB.evaluate(() => document.getElementById('status').textContent);
+  check('two tabs: the other tab undoes its own edit', /^undid: color blend at \(6, 6\)$/.test(lineB), `status "${lineB}"`);
+  await tabB.close();
 
   // Problem 10: the status lines of all of the above speak plainly: no versions, vertex or
   // triangle numbers or solver internals.

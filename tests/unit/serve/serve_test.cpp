@@ -95,6 +95,67 @@ TEST(ServeEditor, UndoRedoRestoreExactly) {
   EXPECT_EQ(status_of([&] { editor.redo(s, 4, label); }), kConflict);  // nothing to redo
 }
 
+// Undo is per tab: a tab takes back its own edits, and waits while another tab's edit is on top;
+// a reload (a new session for the same tab) keeps them.
+TEST(ServeEditor, UndoTakesBackThisTabsEditsOnly) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string a = editor.new_session("tab-a"), b = editor.new_session("tab-b");
+  std::string log, label;
+  editor.apply(a, 1, color_op({48, 48}, {0, 255, 0}), log);   // inside the disk
+  const VectorImage after_a = editor.snapshot().first;
+  editor.apply(b, 2, color_op({8, 8}, {255, 0, 0}), log);     // outside it
+  EXPECT_EQ(editor.info(a).undo, 1);
+  EXPECT_EQ(editor.info(b).undo, 1);
+  EXPECT_EQ(editor.info().undo, 2);
+  int status = 0;
+  try {
+    editor.undo(a, 3, label);
+  } catch (const RequestError& e) {
+    status = e.status();
+    EXPECT_STREQ(e.what(), "undo waits: the last edit was made in another window, which can undo it");
+  }
+  EXPECT_EQ(status, kConflict);
+  EXPECT_EQ(editor.version(), 3);
+  editor.undo(b, 3, label);  // b's own edit
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_a.levels[0].colors);
+  const std::string a2 = editor.new_session("tab-a");  // tab a reloaded
+  editor.undo(a2, 4, label);
+  EXPECT_EQ(label, "color blend at (48, 48)");
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, original.levels[0].colors);
+  EXPECT_EQ(status_of([&] { editor.undo(a2, 5, label); }), kConflict);  // nothing to undo in this tab
+  EXPECT_EQ(editor.info(b).redo, 1);
+}
+
+// Another tab's edit during a drag: the drag goes on over the edited document and lands on top of
+// that edit instead of being thrown away.
+TEST(ServeEditor, ADragOutlivesAnotherTabsEdit) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string a = editor.new_session("tab-a"), b = editor.new_session("tab-b");
+  DragStart start;
+  start.at = {76, 48};
+  start.sigma = 30;
+  editor.drag_start(a, 1, start);
+  editor.drag_move(a, {80, 48}, 0);
+  std::string log;
+  editor.apply(b, 1, color_op({8, 8}, {255, 0, 0}), log);
+  const VectorImage after_b = editor.snapshot().first;
+  editor.drag_move(a, {84, 48}, 0);
+  editor.drag_end(a, 1, {84, 48}, 0, log);  // the page still shows version 1
+  EXPECT_EQ(editor.version(), 3);
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kDrag;
+  op.select = subvec::EditSelect::kFeature;
+  op.from = {76, 48};
+  op.to = {84, 48};
+  op.sigma = 30;
+  VectorImage expected = after_b;
+  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
+  EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_b.levels[0].colors);  // b's edit kept
+}
+
 // The committed drag is exactly what `subvec edit` makes of the same operation, and the last
 // preview the page drew is that result.
 TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
