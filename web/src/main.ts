@@ -369,6 +369,60 @@ async function doSelect(at: [number, number]) {
   redraw();
 }
 
+// The new color: the picker, a typed #rrggbb or "r, g, b", and the eyedropper all set it.
+function setColor(rgb: number[]) {
+  const hex = '#' + rgb.map((v) => Math.round(v).toString(16).padStart(2, '0')).join('');
+  $<HTMLInputElement>('color').value = hex;
+  $<HTMLInputElement>('color-text').value = hex;
+  $('color-text').classList.remove('bad');
+}
+function parseColor(text: string): number[] | null {
+  const t = text.trim();
+  const hex = /^#?([0-9a-f]{6})$/i.exec(t);
+  if (hex) return [0, 2, 4].map((i) => parseInt(hex[1].slice(i, i + 2), 16));
+  const parts = t.replace(/^rgb\(|\)$/gi, '').split(/[\s,]+/).filter(Boolean).map(Number);
+  return parts.length === 3 && parts.every((v) => Number.isFinite(v) && v >= 0 && v <= 255) ? parts : null;
+}
+// The eyedropper: the drawn color under the mouse.
+let mouseAt: [number, number] | null = null;
+function eyedropper() {
+  if (!mouseAt) {
+    status('point at the image and press I to take its color');
+    return;
+  }
+  renderer.draw(state.transform, state.overlays);
+  const [r, g, b] = renderer.readPixel(mouseAt[0], mouseAt[1]);
+  setColor([r, g, b]);
+  status(`picked the color (${r}, ${g}, ${b})`);
+}
+
+// The color tool's preview: the region a click would change, shown as the mouse moves (one request
+// in flight; the latest position wins).
+let previewWanted: [number, number] | null = null;
+let previewBusy = false;
+function previewRegion(at: [number, number]) {
+  previewWanted = at;
+  if (previewBusy) return;
+  previewBusy = true;
+  void (async () => {
+    try {
+      while (previewWanted) {
+        const p = previewWanted;
+        previewWanted = null;
+        const r = await postJson('/api/select', { level: state.level, select: pick(), at: p, radius: num('radius') });
+        if (state.tool !== 'color' || state.drag) break;
+        renderer.setHighlight([], r.region);
+        status(`a click here changes the ${r.colors} control colors shown white`);
+        redraw();
+      }
+    } catch {
+      // outside the image or no feature: no preview
+    } finally {
+      previewBusy = false;
+    }
+  })();
+}
+
 function hexColor(): number[] {
   const v = $<HTMLInputElement>('color').value;
   return [1, 3, 5].map((i) => parseInt(v.slice(i, i + 2), 16));
@@ -704,6 +758,11 @@ canvas.addEventListener('pointerdown', (e) => {
   else void dragStart(e);
 });
 canvas.addEventListener('pointermove', (e) => {
+  mouseAt = canvasPoint(e);
+  if (state.tool === 'color' && !state.pan && !state.drag && e.buttons === 0 && state.doc && state.session) {
+    const at = toImage(mouseAt);
+    if (at[0] >= 0 && at[1] >= 0 && at[0] <= state.doc.width && at[1] <= state.doc.height) previewRegion(at);
+  }
   if (state.pan) {
     const [x, y] = canvasPoint(e);
     state.transform.panX = state.pan.panX + x - state.pan.x;
@@ -742,7 +801,7 @@ canvas.addEventListener('wheel', (e) => {
 
 window.addEventListener('keydown', (e) => {
   const target = e.target as HTMLElement;
-  if (target && (target.tagName === 'INPUT' && (target as HTMLInputElement).type === 'number')) return;
+  if (target && target.tagName === 'INPUT' && ['number', 'text'].includes((target as HTMLInputElement).type)) return;
   const ctrl = e.ctrlKey || e.metaKey;
   const key = e.key.toLowerCase();
   if (ctrl && key === 'z') { e.preventDefault(); void doHistory(e.shiftKey ? 'redo' : 'undo'); return; }
@@ -756,6 +815,7 @@ window.addEventListener('keydown', (e) => {
   if (key === 'f') { toggleRadio('pick'); return; }
   if (key === 'b') { toggleRadio('mode'); return; }
   if (key === 'y') { void doStylize(); return; }
+  if (key === 'i') { eyedropper(); return; }
   if (key === '0') { fit(); return; }
   if (key === '1') { toggleCheck('show-mesh'); return; }
   if (key === '2') { toggleCheck('show-features'); return; }
@@ -802,6 +862,18 @@ function wireControls() {
   $('show-mesh').addEventListener('change', () => { state.overlays.mesh = $<HTMLInputElement>('show-mesh').checked; redraw(); });
   $('show-features').addEventListener('change', () => { state.overlays.features = $<HTMLInputElement>('show-features').checked; redraw(); });
   $('fit').addEventListener('click', fit);
+  $('color').addEventListener('input', () => setColor(hexColor()));
+  const colorText = $<HTMLInputElement>('color-text');
+  colorText.addEventListener('change', () => {
+    const rgb = parseColor(colorText.value);
+    if (rgb) {
+      setColor(rgb);
+    } else {
+      colorText.classList.add('bad');
+      status(`"${colorText.value}" is not a color: type #rrggbb or r, g, b (0 to 255)`, true);
+    }
+  });
+  $('eyedropper').addEventListener('click', () => status('point at the image and press I to take its color'));
   $('panel-toggle').addEventListener('click', () => togglePanel());
   canvas.addEventListener('pointerdown', () => togglePanel(false));
   $('undo').addEventListener('click', () => void doHistory('undo'));

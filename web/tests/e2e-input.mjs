@@ -86,8 +86,29 @@ try {
   }
   check('the image is unchanged by the clicks', diff(await pixel(page, 80, 48), probe) < 2);
 
-  // Problem 2: twenty quick color clicks are twenty edits, none refused as another tab's.
+  // Problem 5 (in part): with the color tool, hovering shows the region a click would change;
+  // I takes the color under the mouse; a typed color sets the picker.
   await page.keyboard.press('c');
+  const [hx, hy] = await client(page, 48, 48);
+  await page.mouse.move(hx, hy);
+  await page.waitForFunction(() => /^a click here changes the \d+ control colors shown white$/.test(document.getElementById('status').textContent), null, { timeout: 10000 })
+    .then(() => check('color: hovering previews the region', true), async () => check('color: hovering previews the region', false, `status "${(await doc()).status}"`));
+  await page.keyboard.press('i');
+  const picked = await page.evaluate(() => document.getElementById('color').value);
+  const under = await pixel(page, 48, 48);
+  const pickedRgb = [1, 3, 5].map((i) => parseInt(picked.slice(i, i + 2), 16));
+  check('color: the eyedropper takes the color under the mouse', diff(pickedRgb, under) <= 1, `${picked} vs ${under}`);
+  await page.locator('#color-text').fill('0, 255, 0');
+  await page.locator('#color-text').press('Enter');
+  check('color: a typed color sets the picker', (await page.evaluate(() => document.getElementById('color').value)) === '#00ff00');
+  await page.locator('#color-text').fill('300, 0, 0');
+  await page.locator('#color-text').press('Enter');
+  check('color: a typed non-color is refused', (await page.evaluate(() => document.getElementById('color').value)) === '#00ff00' &&
+    /is not a color/.test((await doc()).status));
+  await page.locator('#canvas').focus().catch(() => undefined);
+  await page.evaluate(() => document.activeElement.blur());
+
+  // Problem 2: twenty quick color clicks are twenty edits, none refused as another tab's.
   await page.evaluate(() => {
     for (const [id, v] of [['amount', '0.2'], ['radius', '40']]) {
       const el = document.getElementById(id);
