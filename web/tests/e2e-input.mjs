@@ -12,24 +12,13 @@ import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { client, findChromium, idle, launch, openEditor, pixel, serve, stop } from './harness.mjs';
+import { client, idle, launch, openEditor, pixel, requireBrowser, serve, stop } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
 const binary = process.argv[2];
 
-if (!findChromium()) {
-  console.log('SKIPPED: no Chromium found (scripts/setup installs Debian\'s chromium; or set CHROMIUM)');
-  process.exit(77);
-}
-if (!existsSync(join(here, '..', 'node_modules', 'playwright-core'))) {
-  console.log('SKIPPED: web/node_modules is missing (run: cd web && npm ci)');
-  process.exit(77);
-}
-if (!binary || !existsSync(binary)) {
-  console.log(`usage: node web/tests/e2e-input.mjs PATH/TO/subvec (got '${binary}')`);
-  process.exit(2);
-}
+const chromium = requireBrowser('e2e-input.mjs', binary);
 
 let passed = 0;
 let failed = 0;
@@ -47,7 +36,7 @@ const input = join(dir, 'disk.svec.json');
 writeFileSync(input, readFileSync(join(root, 'examples', '01-disk.svec.json')));
 
 const server = await serve(binary, [input]);
-const browser = await launch(findChromium());
+const browser = await launch(chromium);
 try {
   const { page, errors } = await openEditor(browser, server.url);
   const doc = () => page.evaluate(() => ({

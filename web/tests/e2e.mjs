@@ -12,26 +12,14 @@ import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync } from 'no
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { findChromium, launch, serve, stop, openEditor, idle, pixel, client } from './harness.mjs';
+import { requireBrowser, launch, serve, stop, openEditor, idle, pixel, client } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
 const binary = process.argv[2];
 const screenshot = process.argv[3];
 
-const chromium = findChromium();
-if (!chromium) {
-  console.log('SKIPPED: no Chromium found (scripts/setup installs Debian\'s chromium; or set CHROMIUM)');
-  process.exit(77);
-}
-if (!existsSync(join(here, '..', 'node_modules', 'playwright-core'))) {
-  console.log('SKIPPED: web/node_modules is missing (run: cd web && npm ci)');
-  process.exit(77);
-}
-if (!binary || !existsSync(binary)) {
-  console.log(`usage: node web/tests/e2e.mjs PATH/TO/subvec (got '${binary}')`);
-  process.exit(2);
-}
+const chromium = requireBrowser('e2e.mjs', binary);
 
 let passed = 0;
 let failed = 0;

@@ -77,3 +77,22 @@ export async function idle(page) {
 
 export const pixel = (page, x, y) => page.evaluate(([px, py]) => window.subvec.pixelAt(px, py), [x, y]);
 export const client = (page, x, y) => page.evaluate(([px, py]) => window.subvec.clientPoint(px, py), [x, y]);
+
+// The start of a browser test of `subvec serve` (SCRIPT BINARY): exits 77 with the reason when
+// Chromium or web/node_modules is missing, 2 without a binary; returns Chromium's path.
+export function requireBrowser(script, binary) {
+  const chromium = findChromium();
+  if (!chromium) {
+    console.log('SKIPPED: no Chromium found (scripts/setup installs Debian\'s chromium; or set CHROMIUM)');
+    process.exit(77);
+  }
+  if (!existsSync(new URL('../node_modules/playwright-core', import.meta.url))) {
+    console.log('SKIPPED: web/node_modules is missing (run: cd web && npm ci)');
+    process.exit(77);
+  }
+  if (!binary || !existsSync(binary)) {
+    console.log(`usage: node web/tests/${script} PATH/TO/subvec (got '${binary}')`);
+    process.exit(2);
+  }
+  return chromium;
+}

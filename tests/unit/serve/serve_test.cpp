@@ -49,6 +49,19 @@ subvec::EditOp color_op(Vec2 at, Color color) {
   return op;
 }
 
+// What `subvec edit` makes of a feature drag from (76, 48) to (to_x, 48), sigma 30: the reference
+// a committed drag of the page must equal.
+VectorImage dragged(VectorImage image, double to_x) {
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kDrag;
+  op.select = subvec::EditSelect::kFeature;
+  op.from = {76, 48};
+  op.to = {to_x, 48};
+  op.sigma = 30;
+  subvec::apply_edit_ops(image, std::span(&op, 1));
+  return image;
+}
+
 int status_of(const std::function<void()>& f) {
   try {
     f();
@@ -144,14 +157,7 @@ TEST(ServeEditor, ADragOutlivesAnotherTabsEdit) {
   editor.drag_move(a, {84, 48}, 0);
   editor.drag_end(a, 1, {84, 48}, 0, log);  // the page still shows version 1
   EXPECT_EQ(editor.version(), 3);
-  subvec::EditOp op;
-  op.kind = subvec::EditOp::Kind::kDrag;
-  op.select = subvec::EditSelect::kFeature;
-  op.from = {76, 48};
-  op.to = {84, 48};
-  op.sigma = 30;
-  VectorImage expected = after_b;
-  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  const VectorImage expected = dragged(after_b, 84);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_b.levels[0].colors);  // b's edit kept
 }
@@ -179,14 +185,7 @@ TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   // Nothing left to redraw after the release: the last preview was the committed shape.
   EXPECT_TRUE(commit.position_indices.empty() && !commit.dense_positions);
 
-  subvec::EditOp op;
-  op.kind = subvec::EditOp::Kind::kDrag;
-  op.select = subvec::EditSelect::kFeature;
-  op.from = {76, 48};
-  op.to = {84, 48};
-  op.sigma = 30;
-  VectorImage expected = original;
-  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  const VectorImage expected = dragged(original, 84);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
   EXPECT_EQ(commit.control_positions.size(), expected.levels[0].positions.size() * 2);
 }
@@ -209,14 +208,7 @@ TEST(ServeEditor, RefusedReleaseCommitsTheLastPreview) {
   editor.drag_end(s, 1, far, 0, log);
   EXPECT_EQ(log.rfind("stopped at the last position the mesh could take: ", 0), 0u) << log;
   EXPECT_EQ(editor.version(), 2);
-  subvec::EditOp op;
-  op.kind = subvec::EditOp::Kind::kDrag;
-  op.select = subvec::EditSelect::kFeature;
-  op.from = {76, 48};
-  op.to = {80, 48};
-  op.sigma = 30;
-  VectorImage expected = original;
-  subvec::apply_edit_ops(expected, std::span(&op, 1));
+  const VectorImage expected = dragged(original, 80);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
 
   editor.drag_start(s, 2, start);
