@@ -8,7 +8,7 @@
 // Exit status 0: all passed; 1: a check failed; 77: skipped (no Chromium or no node_modules),
 // with the reason on stdout. The last line is "N passed, M failed".
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
