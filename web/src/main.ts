@@ -783,6 +783,11 @@ const release = (e: PointerEvent) => {
 };
 canvas.addEventListener('pointerup', release);
 canvas.addEventListener('pointercancel', (e) => { state.pan = null; dragEnd(e, true); });
+// A capture lost without a pointerup (the browser took it away): the drag ends there, so that its
+// task, which holds the queue, cannot wait for a release that never comes.
+canvas.addEventListener('lostpointercapture', (e) => {
+  if (state.drag && e.pointerId === state.drag.pointer) dragEnd(e);
+});
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
 canvas.addEventListener('wheel', (e) => {
   e.preventDefault();

@@ -8,7 +8,7 @@
 //   node web/tests/e2e-input.mjs BUILD/bin/subvec
 //
 // Exit status 0: all passed; 1: a check failed; 77: skipped (no Chromium or no node_modules).
-import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -188,6 +188,25 @@ try {
   const moved = await pixel(page, 73, 48);
   check('refused drag: the feature moved left', diff(moved, inside) > 20, `${inside} -> ${moved}`);
 
+  // A drag whose pointer capture the browser takes away (no pointerup follows) ends there and
+  // commits: its task must not hold the queue waiting for a release.
+  const lost = await doc();
+  const [lx, ly] = await client(page, 76, 48);
+  await page.mouse.move(lx, ly);
+  await page.mouse.down();
+  for (let i = 1; i <= 4; i++) {
+    const [x, y] = await client(page, 76 + i, 48);
+    await page.mouse.move(x, y);
+    await page.waitForTimeout(15);
+  }
+  await page.evaluate(() => document.getElementById('canvas').releasePointerCapture(window.subvec.state.drag.pointer));
+  await page.mouse.move(lx + 40, ly + 40);  // the capture's loss is delivered with the next pointer event
+  await idle(page);
+  d = await doc();
+  await page.mouse.up();
+  check('a lost pointer capture ends the drag', d.version === lost.version + 1 && /dragged by/.test(d.status) && d.busy === 0,
+    `version ${lost.version} -> ${d.version}, status "${d.status}"`);
+
   // A press outside the image grabs nothing.
   const outsideBefore = await doc();
   d = await drag([-2, 60], [30, 60]);  // in the margin left of the image
@@ -361,6 +380,7 @@ try {
 } finally {
   await browser.close();
   await stop(photoServer);
+  rmSync(dir, { recursive: true, force: true });
 }
 console.log(`${passed} passed, ${failed} failed`);
 process.exit(failed ? 1 : 0);
