@@ -771,26 +771,26 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
 }
 
 Delta Editor::undo(const std::string& session_id, int64_t version, std::string& label) {
-  return step_history(session_id, version, undo_, redo_, "nothing to undo", label);
+  return step_history(session_id, version, undo_, redo_, "undo", label);
 }
 
 Delta Editor::redo(const std::string& session_id, int64_t version, std::string& label) {
-  return step_history(session_id, version, redo_, undo_, "nothing to redo", label);
+  return step_history(session_id, version, redo_, undo_, "redo", label);
 }
 
 // Undo takes from the undo stack and keeps the current image on the redo stack; redo the reverse.
 Delta Editor::step_history(const std::string& session_id, int64_t version,
                            std::vector<HistoryStep>& from, std::vector<HistoryStep>& to,
-                           const char* empty_message, std::string& label) {
+                           const char* verb, std::string& label) {
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
   // A tab takes back its own edits only (docs/serve.md, "Two tabs"): the step on top must be its.
   const bool any = std::any_of(from.begin(), from.end(),
                                [&](const HistoryStep& h) { return h.tab == session.tab; });
-  if (!any) throw RequestError(kConflict, std::string(empty_message) + " in this tab");
+  if (!any) throw RequestError(kConflict, std::string("nothing to ") + verb + " in this tab");
   if (from.back().tab != session.tab) {
-    throw RequestError(kConflict, std::string(empty_message == std::string("nothing to undo") ? "undo" : "redo") +
+    throw RequestError(kConflict, std::string(verb) +
                                       " waits: the last edit was made in another window, which can undo it");
   }
   // Strokes move with shape edits, so any may differ: the page reloads them when there are any.

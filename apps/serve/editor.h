@@ -236,7 +236,7 @@ class Editor {
     std::string tab;  // the tab that made the edit: only it may undo or redo it
   };
   Delta step_history(const std::string& session, int64_t version, std::vector<HistoryStep>& from,
-                     std::vector<HistoryStep>& to, const char* empty_message, std::string& label);
+                     std::vector<HistoryStep>& to, const char* verb, std::string& label);
 
   mutable std::mutex mutex_;
   VectorImage image_;

@@ -113,15 +113,22 @@ try {
 
   // A real drag after all that: 8 px to the right, committed once.
   await page.keyboard.press('d');
-  const drag = async (from, to, steps = 10) => {
-    const [sx, sy] = await client(page, ...from);
-    await page.mouse.move(sx, sy);
-    await page.mouse.down();
+  // The mouse from `from` to `to` (image pixels) in `steps` moves, pressed at `from` first when
+  // `press`; drag() releases at the end and waits for the page.
+  const sweep = async (from, to, steps, press = false) => {
+    if (press) {
+      const [sx, sy] = await client(page, ...from);
+      await page.mouse.move(sx, sy);
+      await page.mouse.down();
+    }
     for (let i = 1; i <= steps; ++i) {
       const [x, y] = await client(page, from[0] + ((to[0] - from[0]) * i) / steps, from[1] + ((to[1] - from[1]) * i) / steps);
       await page.mouse.move(x, y);
       await page.waitForTimeout(15);
     }
+  };
+  const drag = async (from, to, steps = 10) => {
+    await sweep(from, to, steps, true);
     await page.mouse.up();
     await idle(page);
     return doc();
@@ -191,14 +198,8 @@ try {
   // A drag whose pointer capture the browser takes away (no pointerup follows) ends there and
   // commits: its task must not hold the queue waiting for a release.
   const lost = await doc();
+  await sweep([76, 48], [80, 48], 4, true);
   const [lx, ly] = await client(page, 76, 48);
-  await page.mouse.move(lx, ly);
-  await page.mouse.down();
-  for (let i = 1; i <= 4; i++) {
-    const [x, y] = await client(page, 76 + i, 48);
-    await page.mouse.move(x, y);
-    await page.waitForTimeout(15);
-  }
   await page.evaluate(() => document.getElementById('canvas').releasePointerCapture(window.subvec.state.drag.pointer));
   await page.mouse.move(lx + 40, ly + 40);  // the capture's loss is delivered with the next pointer event
   await idle(page);
@@ -253,23 +254,12 @@ try {
   await idle(page);
   const { page: tabB } = await openEditor(browser, server.url);
   const v0 = (await doc()).version;
-  const [ax, ay] = await client(page, 76, 48);
-  await page.mouse.move(ax, ay);
-  await page.mouse.down();
-  for (let i = 1; i <= 4; i++) {
-    const [x, y] = await client(page, 76 + i, 48);
-    await page.mouse.move(x, y);
-    await page.waitForTimeout(15);
-  }
+  await sweep([76, 48], [80, 48], 4, true);
   await tabB.keyboard.press('c');
   const [bx, by] = await client(tabB, 6, 6);
   await tabB.mouse.click(bx, by);  // tab B recolors the corner while tab A drags
   await idle(tabB);
-  for (let i = 5; i <= 8; i++) {
-    const [x, y] = await client(page, 76 + i, 48);
-    await page.mouse.move(x, y);
-    await page.waitForTimeout(15);
-  }
+  await sweep([80, 48], [84, 48], 4);
   await page.mouse.up();
   await idle(page);
   d = await doc();
