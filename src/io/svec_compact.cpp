@@ -1005,11 +1005,14 @@ void encode_features(const ControlMesh& m, const std::vector<Point>& fp, SymbolS
   }
 }
 
-// The decoder takes grid values and residuals up to 2^48 in magnitude; colors up to 2^44 grid
-// steps leave room for the residuals (at most 2^46) and the error diffusion. Larger colors (a
-// hand-written 3e38, valid in the model) cannot be coded: llround would overflow.
+// Colors are floats: a grid value survives the read (k * 2^-c as a float) only while |k| <= 2^24.
+// Colors up to 2^23 grid steps leave room for the error diffusion, so every value read back lies
+// exactly on the grid and a second write gives the same bytes. (At 2^44 steps, a color of 2^27 at
+// quarter steps came back rounded, and its neighbors moved; the fuzzer found it.) Larger colors
+// (a filter's 1e6, a hand-written 3e38, valid in the model) are refused; the lossless form keeps
+// them.
 void check_color_range(const ControlMesh& mesh, int color_bits) {
-  const double max_color = std::ldexp(1.0, 44 - color_bits);
+  const double max_color = std::ldexp(1.0, 23 - color_bits);
   for (const Color& color : mesh.colors) {
     for (const float v : {color.r, color.g, color.b}) {
       if (!(std::abs(double(v)) <= max_color)) {
@@ -1299,6 +1302,7 @@ void decode_colors(SymbolSource& src, const LevelCounts& counts, int width, int 
   const int64_t mid = to_grid(128.0, color_bits);
   Rgb last{mid, mid, mid};
   constexpr int64_t kColorLimit = int64_t{1} << 48;
+  constexpr int64_t kColorValueLimit = int64_t{1} << 24;
   for (int32_t ci = 0; ci < nc; ++ci) {
     const Rgb q = predict_color(cadj.of(ci), known, colors, last);
     Rgb d = src.color(color_context(cadj.of(ci), known, color_activity));
@@ -1308,8 +1312,10 @@ void decode_colors(SymbolSource& src, const LevelCounts& counts, int width, int 
     }
     d = {d[1] + d[0], d[0], d[2] + d[0]};
     for (int ch = 0; ch < 3; ++ch) {
-      if (std::abs(q[ch]) > kColorLimit) fail(name + "colors: value out of range");
       colors[ci][ch] = q[ch] + d[ch];
+      // A float holds grid values up to 2^24 exactly; the writer stays below 2^23 plus its error
+      // diffusion (check_color_range).
+      if (std::abs(colors[ci][ch]) > kColorValueLimit) fail(name + "colors: value out of range");
     }
     known[ci] = 1;
     last = colors[ci];

@@ -25,7 +25,8 @@ struct SvecWriteOptions {
   // content in about 11 % more bytes; for readers that predate version 3).
   int compact_version = 3;
   // Compact: positions on multiples of 2^-position_bits pixels (0 to 12; finer where needed to
-  // keep every triangle positive), colors on multiples of 2^-color_bits levels (0 to 12).
+  // keep every triangle positive), colors on multiples of 2^-color_bits levels (-4 to 12) and at
+  // most 2^(23 - color_bits) in magnitude, so that each is exact as a float (larger ones throw).
   // docs/format.md gives the measured effect of each choice.
   int position_bits = 2;
   int color_bits = -1;

@@ -649,8 +649,9 @@ function decodeColors(src: Source, tc: Int32Array, nc: number, cb: number, what:
       activity[3 * ci + ch] = Math.min(Math.abs(d[ch]), 65535);
     }
     for (let ch = 0; ch < 3; ch++) {
-      if (Math.abs(q[ch]) > 2 ** 48) fail(`${what}colors: value out of range`);
       last[ch] = rgb[3 * ci + ch] = q[ch] + (ch === 1 ? d[0] : d[ch || 1] + d[0]);
+      // As the C++ reader: a float holds grid values up to 2^24 exactly.
+      if (Math.abs(last[ch]) > 2 ** 24) fail(`${what}colors: value out of range`);
       colors[3 * ci + ch] = last[ch] * 2 ** -cb;
     }
   }
