@@ -431,13 +431,11 @@ SelectResult Editor::select(const SelectRequest& request) const {
   const MeshTopology topology = MeshTopology::build(mesh, image_.width, image_.height);
   SelectResult result;
   try {
-    subvec::ColorSelection colors;
     if (request.select == EditSelect::kVertex) {
       result.vertex = subvec::nearest_vertex(mesh, request.at);
       const Vec2 p = mesh.positions[result.vertex];
       result.distance = std::hypot(p.x - request.at.x, p.y - request.at.y);
-      colors = subvec::select_vertex_colors(mesh, topology, request.at, request.radius);
-    } else {
+    } else if (request.select == EditSelect::kFeature) {
       const subvec::FeaturePick pick = subvec::nearest_feature(mesh, topology, request.at);
       if (pick.feature < 0) {
         throw RequestError(kUnprocessable, "nothing to select: level " +
@@ -446,8 +444,9 @@ SelectResult Editor::select(const SelectRequest& request) const {
       result.feature = pick.feature;
       result.distance = pick.distance;
       result.chain = mesh.features[pick.feature].vertices;
-      colors = subvec::select_feature_colors(mesh, topology, request.at, request.radius);
     }
+    const subvec::ColorSelection colors = subvec::select_colors(
+        mesh, topology, request.select, request.at, request.radius, request.tolerance);
     result.colors = static_cast<int>(colors.colors.size());
     std::vector<char> in(mesh.num_colors(), 0);
     for (int32_t c : colors.colors) in[c] = 1;

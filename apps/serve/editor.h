@@ -149,6 +149,7 @@ struct SelectRequest {
   subvec::EditSelect select = subvec::EditSelect::kVertex;
   Vec2 at;
   double radius = 0;
+  double tolerance = subvec::kDefaultRegionTolerance;  // a region's
 };
 
 struct SelectResult {

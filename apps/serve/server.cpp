@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -145,11 +147,27 @@ subvec::Vec2 point(const json& j, const char* key) {
   return {v[0].get<double>(), v[1].get<double>()};
 }
 
-subvec::EditSelect select_mode(const json& j) {
+// Drags grab a vertex or a feature; color edits and Select may also take a region.
+subvec::EditSelect select_mode(const json& j, bool region_too) {
   const std::string s = j.contains("select") ? text(j, "select") : "feature";
-  if (s == "vertex") return subvec::EditSelect::kVertex;
-  if (s == "feature") return subvec::EditSelect::kFeature;
-  throw RequestError(kBadRequest, "\"select\" must be \"vertex\" or \"feature\", got \"" + s + "\"");
+  const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s);
+  if (e && (region_too || *e != subvec::EditSelect::kRegion)) return *e;
+  throw RequestError(kBadRequest, "\"select\" must be " +
+                                      (region_too ? std::string(subvec::kEditSelectNames)
+                                                  : std::string(R"("vertex" or "feature")")) +
+                                      ", got \"" + s + "\"");
+}
+
+// A color selection's radius (a region's is uncapped by default) and tolerance (regions only).
+void color_reach(const json& j, subvec::EditSelect select, double& radius, double& tolerance) {
+  const bool region = select == subvec::EditSelect::kRegion;
+  radius = number(j, "radius", region ? std::numeric_limits<double>::infinity() : 0.0);
+  if (radius < 0) throw RequestError(kBadRequest, "\"radius\" must be >= 0");
+  tolerance = number(j, "tolerance", subvec::kDefaultRegionTolerance);
+  if (tolerance < 0) throw RequestError(kBadRequest, "\"tolerance\" must be >= 0");
+  if (!region && j.contains("tolerance")) {
+    throw RequestError(kBadRequest, "\"tolerance\" applies to \"select\": \"region\" only");
+  }
 }
 
 int query_int(const httplib::Request& req, const char* key, int fallback) {
@@ -588,10 +606,9 @@ void EditorServer::Impl::drag_routes() {
     const json j = body_json(req);
     SelectRequest s;
     s.level = small_int(j, "level", 0);
-    s.select = select_mode(j);
+    s.select = select_mode(j, true);
     s.at = point(j, "at");
-    s.radius = number(j, "radius", 0.0);
-    if (s.radius < 0) throw RequestError(kBadRequest, "\"radius\" must be >= 0");
+    color_reach(j, s.select, s.radius, s.tolerance);
     const SelectResult r = ready_editor()->select(s);
     send_json(res, {{"vertex", r.vertex},
                     {"feature", r.feature},
@@ -610,7 +627,7 @@ void EditorServer::Impl::drag_routes() {
       throw RequestError(kBadRequest, "\"tool\" must be \"drag\" or \"move\"");
     }
     d.move_feature = tool == "move";
-    d.select = select_mode(j);
+    d.select = select_mode(j, false);
     d.at = point(j, "at");
     // A number, or "auto": the editor picks an extent local to what is grabbed.
     const auto extent = [&](const char* key, double fallback, bool& is_auto) {
@@ -656,9 +673,9 @@ void EditorServer::Impl::edit_routes() {
     subvec::EditOp op;
     op.kind = subvec::EditOp::Kind::kColor;
     op.level = small_int(j, "level", 0);
-    op.select = select_mode(j);
+    op.select = select_mode(j, true);
     op.at = point(j, "at");
-    op.radius = number(j, "radius", 0.0);
+    color_reach(j, op.select, op.radius, op.tolerance);
     const std::string mode = j.contains("mode") ? text(j, "mode") : "blend";
     if (mode != "blend" && mode != "transform") {
       throw RequestError(kBadRequest, "\"mode\" must be \"blend\" or \"transform\"");

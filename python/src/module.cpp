@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -325,9 +326,20 @@ std::string apply_op(VectorImage& image, const subvec::EditOp& op) {
 }
 
 subvec::EditSelect parse_select(const std::string& s) {
-  if (s == "vertex") return subvec::EditSelect::kVertex;
-  if (s == "feature") return subvec::EditSelect::kFeature;
-  invalid("select must be 'vertex' or 'feature', got '" + s + "'");
+  if (const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s)) return *e;
+  invalid("select must be 'vertex', 'feature' or 'region', got '" + s + "'");
+}
+
+// A color selection's reach: radius None is 0 for a vertex or feature and no cap for a region;
+// the tolerance is the region's.
+void color_reach(subvec::EditSelect select, const std::optional<double>& radius,
+                 const std::optional<double>& tolerance, double& r, double& t) {
+  const bool region = select == subvec::EditSelect::kRegion;
+  r = radius ? *radius : region ? std::numeric_limits<double>::infinity() : 0.0;
+  if (!(r >= 0)) invalid("radius must be >= 0");
+  if (tolerance && !region) invalid("tolerance applies to select='region' only");
+  t = tolerance ? *tolerance : subvec::kDefaultRegionTolerance;
+  if (!(std::isfinite(t) && t >= 0)) invalid("tolerance must be >= 0");
 }
 
 std::vector<int32_t> index_list(const py::object& a, int limit, const char* what) {
@@ -475,8 +487,8 @@ void def_edits(PyVectorImage& vi) {
       .def(
           "recolor",
           [](VectorImage& v, std::array<double, 2> at, std::array<double, 3> color,
-             const std::string& mode, const std::string& select, double radius, double amount,
-             int level) {
+             const std::string& mode, const std::string& select, std::optional<double> radius,
+             std::optional<double> tolerance, double amount, int level) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kColor;
             op.at = point(at, "at");
@@ -489,15 +501,14 @@ void def_edits(PyVectorImage& vi) {
               invalid("mode must be 'blend' or 'transform', got '" + mode + "'");
             }
             op.select = parse_select(select);
-            if (!(std::isfinite(radius) && radius >= 0)) invalid("radius must be >= 0");
+            color_reach(op.select, radius, tolerance, op.radius, op.tolerance);
             if (!(amount >= 0 && amount <= 1)) invalid("amount must be in [0, 1]");
-            op.radius = radius;
             op.amount = amount;
             op.level = level;
             return apply_op(v, op);
           },
           "at"_a, "color"_a, py::kw_only(), "mode"_a = "blend", "select"_a = "vertex",
-          "radius"_a = 0.0, "amount"_a = 0.5, "level"_a = 0);
+          "radius"_a = py::none(), "tolerance"_a = py::none(), "amount"_a = 0.5, "level"_a = 0);
 }
 
 // The building blocks of color and shape edits (edit/selection.h, edit/color.h, edit/shape.h).
@@ -505,23 +516,23 @@ void def_edit_parts(PyVectorImage& vi) {
   vi.def(
           "select_colors",
           [](const VectorImage& v, std::array<double, 2> at, const std::string& select,
-             double radius, int level) {
+             std::optional<double> radius, std::optional<double> tolerance, int level) {
             const subvec::ControlMesh& mesh = v.levels[size_t(check_level(v, level))];
             const subvec::Vec2 p = point(at, "at");
             const subvec::EditSelect s = parse_select(select);
-            if (!(std::isfinite(radius) && radius >= 0)) invalid("radius must be >= 0");
+            double r = 0, t = 0;
+            color_reach(s, radius, tolerance, r, t);
             subvec::ColorSelection sel;
             {
               py::gil_scoped_release release;
               const subvec::MeshTopology topo = subvec::MeshTopology::build(mesh, v.width, v.height);
-              sel = s == subvec::EditSelect::kVertex
-                        ? subvec::select_vertex_colors(mesh, topo, p, radius)
-                        : subvec::select_feature_colors(mesh, topo, p, radius);
+              sel = subvec::select_colors(mesh, topo, s, p, r, t);
             }
             return py::dict("colors"_a = index_vector(sel.colors), "seed_color"_a = sel.seed_color,
                             "seed_vertex"_a = sel.seed_vertex);
           },
-          "at"_a, py::kw_only(), "select"_a = "vertex", "radius"_a = 0.0, "level"_a = 0)
+          "at"_a, py::kw_only(), "select"_a = "vertex", "radius"_a = py::none(),
+          "tolerance"_a = py::none(), "level"_a = 0)
       .def(
           "blend_colors",
           [](VectorImage& v, const py::object& colors, std::array<double, 3> target, double amount,

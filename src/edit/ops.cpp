@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -154,12 +156,16 @@ EditOp parse_op(const Json& j, Place& at) {
     }
     op.level = static_cast<int>(level->get<int64_t>());
   }
-  auto select = [&]() {
+  // Drags grab a vertex or a feature; color edits may also fill a region.
+  auto select = [&](bool region_too) {
     if (const Json* s = fields.optional("select")) {
       const std::string v = string_value(*s, at, "select");
-      if (v == "vertex") return EditSelect::kVertex;
-      if (v == "feature") return EditSelect::kFeature;
-      at.fail("select", "expected \"vertex\" or \"feature\", got \"" + printable(v) + "\"");
+      const std::optional<EditSelect> e = edit_select_from_name(v);
+      if (e && (region_too || *e != EditSelect::kRegion)) return *e;
+      at.fail("select", "expected " +
+                            (region_too ? std::string(kEditSelectNames)
+                                        : std::string(R"("vertex" or "feature")")) +
+                            ", got \"" + printable(v) + "\"");
     }
     return EditSelect::kVertex;
   };
@@ -173,7 +179,7 @@ EditOp parse_op(const Json& j, Place& at) {
   switch (op.kind) {
     case EditOp::Kind::kDrag:
       region();
-      op.select = select();
+      op.select = select(false);
       op.from = vec2(fields.required("from"), at, "from");
       op.to = vec2(fields.required("to"), at, "to");
       if (op.select == EditSelect::kFeature) {
@@ -204,12 +210,19 @@ EditOp parse_op(const Json& j, Place& at) {
         at.fail("mode", "expected \"blend\" or \"transform\", got \"" + printable(mode) + "\"");
       }
       at.op = "color " + mode;
-      op.select = select();
+      op.select = select(true);
       op.at = vec2(fields.required("at"), at, "at");
       op.color = color(fields.required("color"), at, "color");
+      // A region is uncapped unless a radius is given.
+      if (op.select == EditSelect::kRegion) op.radius = std::numeric_limits<double>::infinity();
       if (const Json* r = fields.optional("radius")) {
         op.radius = number(*r, at, "radius");
         if (op.radius < 0) at.fail("radius", "expected a number >= 0, got " + num(op.radius));
+      }
+      if (const Json* t = fields.optional("tolerance")) {
+        if (op.select != EditSelect::kRegion) at.fail("tolerance", "applies to \"select\": \"region\" only");
+        op.tolerance = number(*t, at, "tolerance");
+        if (op.tolerance < 0) at.fail("tolerance", "expected a number >= 0, got " + num(op.tolerance));
       }
       if (op.mode == ColorMode::kBlend) {
         if (const Json* a = fields.optional("amount")) {
@@ -334,6 +347,9 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
       switch (op.kind) {
         case EditOp::Kind::kDrag:
         case EditOp::Kind::kMoveFeature: {
+          if (op.kind == EditOp::Kind::kDrag && op.select == EditSelect::kRegion) {
+            refuse(where, "a drag grabs a \"vertex\" or a \"feature\", not a region");
+          }
           Handles handles;
           if (op.kind == EditOp::Kind::kDrag) {
             inside("from", op.from);
@@ -380,9 +396,8 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
         }
         case EditOp::Kind::kColor: {
           inside("at", op.at);
-          const ColorSelection s = op.select == EditSelect::kVertex
-                                       ? select_vertex_colors(mesh, topology, op.at, op.radius)
-                                       : select_feature_colors(mesh, topology, op.at, op.radius);
+          const ColorSelection s =
+              select_colors(mesh, topology, op.select, op.at, op.radius, op.tolerance);
           if (s.colors.empty()) refuse(where, "nothing to select at " + point(op.at));
           const Color seed = mesh.colors[s.seed_color];
           if (op.mode == ColorMode::kBlend) {

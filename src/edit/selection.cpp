@@ -2,6 +2,7 @@
 #include "subvec/edit/selection.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -47,11 +48,27 @@ int face_towards(const ControlMesh& mesh, const MeshTopology& topology, int v, V
   return best;
 }
 
-// Grows `seeds` over triangles through color values whose vertex is within `radius` of the seed
-// geometry (`distance` of a position).
-template <class Distance>
-std::vector<int32_t> grow(const ControlMesh& mesh, std::vector<int32_t> seeds, double radius,
-                          Distance&& distance) {
+// CIELAB (D65) of an sRGB color on the 0-255 scale: distances in it follow what the eye sees (a
+// region's tolerance). Values outside 0-255 extend the curves.
+std::array<double, 3> lab(const Color& c) {
+  auto linear = [](double v) {
+    v /= 255;
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  };
+  const double r = linear(c.r), g = linear(c.g), b = linear(c.b);
+  const double x = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047;
+  const double y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+  const double z = (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883;
+  auto f = [](double t) { return t > 216.0 / 24389 ? std::cbrt(t) : (24389.0 / 27 * t + 16) / 116; };
+  const double fx = f(x), fy = f(y), fz = f(z);
+  return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
+}
+
+// Grows `seeds` over triangles through the color values that `accept` takes (a color value's
+// index and its vertex's position).
+template <class Accept>
+std::vector<int32_t> grow(const ControlMesh& mesh, const std::vector<int32_t>& seeds,
+                          Accept&& accept) {
   const int nc = mesh.num_colors(), nf = mesh.num_triangles();
   std::vector<int32_t> vertex_of(nc, -1), offsets(size_t(nc) + 1, 0), faces(size_t(nf) * 3);
   for (int f = 0; f < nf; ++f)
@@ -69,12 +86,12 @@ std::vector<int32_t> grow(const ControlMesh& mesh, std::vector<int32_t> seeds, d
   std::vector<int32_t> queue;
   for (int32_t c : seeds)
     if (!seen[c]) seen[c] = 1, queue.push_back(c);
-  for (size_t i = 0; i < queue.size() && radius > 0; ++i) {
+  for (size_t i = 0; i < queue.size(); ++i) {
     const int32_t c = queue[i];
     for (int32_t j = offsets[c]; j < offsets[c + 1]; ++j) {
       for (int32_t d : mesh.triangle_colors[faces[j]]) {
         if (seen[d]) continue;
-        if (distance(mesh.positions[vertex_of[d]]) > radius) continue;
+        if (!accept(d, mesh.positions[vertex_of[d]])) continue;
         seen[d] = 1;
         queue.push_back(d);
       }
@@ -160,8 +177,8 @@ ColorSelection select_vertex_colors(const ControlMesh& mesh, const MeshTopology&
   if (s.seed_vertex < 0) return s;
   s.seed_color = corner_color(mesh, face_towards(mesh, topology, s.seed_vertex, at), s.seed_vertex);
   const Vec2 o = mesh.positions[s.seed_vertex];
-  s.colors = grow(mesh, {s.seed_color}, radius,
-                  [&](Vec2 q) { return std::hypot(q.x - o.x, q.y - o.y); });
+  s.colors = grow(mesh, {s.seed_color},
+                  [&](int32_t, Vec2 q) { return radius > 0 && std::hypot(q.x - o.x, q.y - o.y) <= radius; });
   return s;
 }
 
@@ -193,15 +210,73 @@ ColorSelection select_feature_colors(const ControlMesh& mesh, const MeshTopology
       }
     }
   }
-  s.colors = grow(mesh, seeds, radius, [&](Vec2 q) {
+  s.colors = grow(mesh, seeds, [&](int32_t, Vec2 q) {
+    if (!(radius > 0)) return false;
     double d = std::numeric_limits<double>::infinity();
     for (size_t k = 0; k + 1 < feature.vertices.size(); ++k) {
       d = std::min(d, segment_distance(q, mesh.positions[feature.vertices[k]],
                                        mesh.positions[feature.vertices[k + 1]]));
     }
-    return d;
+    return d <= radius;
   });
   return s;
+}
+
+std::optional<EditSelect> edit_select_from_name(std::string_view name) {
+  if (name == "vertex") return EditSelect::kVertex;
+  if (name == "feature") return EditSelect::kFeature;
+  if (name == "region") return EditSelect::kRegion;
+  return std::nullopt;
+}
+
+ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at, double radius,
+                                    double tolerance) {
+  if (!(radius >= 0) || !(tolerance >= 0) || std::isinf(tolerance)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "a region needs a radius >= 0 and a finite tolerance >= 0");
+  }
+  ColorSelection s;
+  // The clicked triangle: the one containing `at`, or else the nearest (a point on the border).
+  int face = -1;
+  double face_distance = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < mesh.num_triangles() && face_distance > 0; ++f) {
+    const Vec2 a = mesh.positions[mesh.triangles[f][0]], b = mesh.positions[mesh.triangles[f][1]],
+               c = mesh.positions[mesh.triangles[f][2]];
+    const bool inside = cross(b.x - a.x, b.y - a.y, at.x - a.x, at.y - a.y) >= 0 &&
+                        cross(c.x - b.x, c.y - b.y, at.x - b.x, at.y - b.y) >= 0 &&
+                        cross(a.x - c.x, a.y - c.y, at.x - c.x, at.y - c.y) >= 0;
+    const double d = inside ? 0
+                            : std::min({segment_distance(at, a, b), segment_distance(at, b, c),
+                                        segment_distance(at, c, a)});
+    if (d < face_distance) face_distance = d, face = f;
+  }
+  if (face < 0) return s;
+  double seed_d2 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const Vec2 q = mesh.positions[mesh.triangles[face][k]];
+    const double d2 = (q.x - at.x) * (q.x - at.x) + (q.y - at.y) * (q.y - at.y);
+    if (d2 < seed_d2) {
+      seed_d2 = d2, s.seed_vertex = mesh.triangles[face][k], s.seed_color = mesh.triangle_colors[face][k];
+    }
+  }
+  const std::array<double, 3> seed = lab(mesh.colors[s.seed_color]);
+  s.colors = grow(mesh, {s.seed_color}, [&](int32_t c, Vec2 q) {
+    const std::array<double, 3> v = lab(mesh.colors[c]);
+    const double dl = v[0] - seed[0], da = v[1] - seed[1], db = v[2] - seed[2];
+    return dl * dl + da * da + db * db <= tolerance * tolerance &&
+           std::hypot(q.x - at.x, q.y - at.y) <= radius;
+  });
+  return s;
+}
+
+ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topology,
+                             EditSelect select, Vec2 at, double radius, double tolerance) {
+  switch (select) {
+    case EditSelect::kVertex: return select_vertex_colors(mesh, topology, at, radius);
+    case EditSelect::kFeature: return select_feature_colors(mesh, topology, at, radius);
+    case EditSelect::kRegion: break;
+  }
+  return select_region_colors(mesh, at, radius, tolerance);
 }
 
 }  // namespace subvec

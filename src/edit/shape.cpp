@@ -162,7 +162,13 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
               ")); refused: try a smaller displacement, a larger sigma or several smaller steps");
     }
     std::vector<Vec2> blend(rest_.size());
+    // A result that is not finite (a numerically singular scale step) counts as flipped, and
+    // lambda 0 is the similarity step exactly: 0 * NaN would carry the NaN through.
     auto mix = [&](double lambda) {
+      if (lambda == 0) {
+        blend = similarity_;
+        return;
+      }
       for (size_t v = 0; v < rest_.size(); ++v) {
         blend[v] = {similarity_[v].x + lambda * (result[v].x - similarity_[v].x),
                     similarity_[v].y + lambda * (result[v].y - similarity_[v].y)};
@@ -180,6 +186,12 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
     mix(lo);
     result.swap(blend);
     scale_fraction_ = lo;
+  }
+  for (const Vec2& p : result) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      invalid("the edit could not be solved (a numerically singular system); try a smaller "
+              "displacement or a larger region");
+    }
   }
   out = std::move(result);
 }

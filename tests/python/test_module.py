@@ -187,6 +187,27 @@ def test_mouse_edits_change_what_they_should():
     assert copy.to_bytes(lossless=True) == image.to_bytes(lossless=True)
 
 
+def test_region_selection_is_a_fill_that_the_tolerance_bounds():
+    image = subvec.load(BUTTERFLY)
+    # No cap by default; a wider tolerance fills at least as much; the radius caps it.
+    tight = image.select_colors((223, 262), select="region", tolerance=10)["colors"]
+    wide = image.select_colors((223, 262), select="region", tolerance=40)["colors"]
+    capped = image.select_colors((223, 262), select="region", tolerance=40, radius=5)["colors"]
+    assert 0 < tight.size <= wide.size and set(tight) <= set(wide)
+    assert set(capped) <= set(wide) and capped.size < wide.size
+    with pytest.raises(subvec.InvalidArgumentError, match="tolerance applies to select='region'"):
+        image.select_colors((223, 262), select="vertex", tolerance=10)
+    with pytest.raises(subvec.InvalidArgumentError, match="'vertex', 'feature' or 'region'"):
+        image.select_colors((223, 262), select="blob")
+    with pytest.raises(subvec.InvalidArgumentError, match="not a region"):
+        image.drag((111, 126), (104, 104), select="region")
+    before = image.mesh()["colors"]
+    image.recolor((223, 262), (255, 0, 0), select="region", tolerance=40, amount=1)
+    after = image.mesh()["colors"]
+    changed = np.flatnonzero(np.any(after != before, axis=1))
+    assert set(changed) <= set(wide) and changed.size > 0
+
+
 def test_color_selection_blend_and_transform():
     image = subvec.load(BUTTERFLY)
     sel = image.select_colors((160, 175), radius=40)

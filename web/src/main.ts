@@ -15,10 +15,10 @@ type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color';
 
 const TOOL_HELP: Record<Tool, string> = {
   pan: 'Pan: drag to move the view. The wheel zooms at the cursor with every tool; the image is re-refined for the new zoom when you stop.',
-  select: 'Select: click to see what the other tools would pick there — the nearest feature (pink, its control chain) or control vertex, and the color region the radius grows from it (white points). Changes nothing.',
+  select: 'Select: click to see what the other tools would pick there — the nearest feature (pink, its control chain) or control vertex, and the color region a click would change (white points). Changes nothing.',
   drag: 'Drag (as-rigid-as-possible): press on a feature (or a vertex, with "vertex" picked) and drag. The part near where you grabbed follows the mouse (σ sets how far along the feature), and the whole mesh deforms as rigidly as possible around it; the image border stays in place.',
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
-  color: 'Color: click a region to recolor it with the picked color. The region is the clicked side of the nearest feature (or vertex) grown by the radius, stopped by tears. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
+  color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
 const $ = <T extends HTMLElement = HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -117,8 +117,18 @@ function status(message: string, error = false) {
   statusBox.classList.toggle('error', error);
 }
 
-function pick(): 'vertex' | 'feature' {
-  return (document.querySelector('input[name=pick]:checked') as HTMLInputElement).value as 'vertex' | 'feature';
+function pick(): 'vertex' | 'feature' | 'region' {
+  return (document.querySelector('input[name=pick]:checked') as HTMLInputElement).value as 'vertex' | 'feature' | 'region';
+}
+// Drags grab a vertex or a feature: "region" grabs the nearest feature.
+const dragPick = () => (pick() === 'vertex' ? 'vertex' : 'feature');
+const RADIUS_NONE = 201;  // the radius slider's far right: no cap
+// What a color edit (or Select) takes: the pick, its radius (the image's diagonal for "no cap") and
+// a region's tolerance.
+function colorPick() {
+  const select = pick(), r = num('radius');
+  const radius = r >= RADIUS_NONE && state.doc ? Math.ceil(Math.hypot(state.doc.width, state.doc.height)) : r;
+  return select === 'region' ? { select, radius, tolerance: num('tolerance') } : { select, radius };
 }
 function mode(): 'blend' | 'transform' {
   return (document.querySelector('input[name=mode]:checked') as HTMLInputElement).value as 'blend' | 'transform';
@@ -358,11 +368,12 @@ let selectSeq = 0;
 async function doSelect(at: [number, number]) {
   const seq = ++selectSeq;
   try {
-    const r = await postJson('/api/select', { level: state.level, select: pick(), at, radius: num('radius') });
+    const r = await postJson('/api/select', { level: state.level, at, ...colorPick() });
     if (seq !== selectSeq) return;
     renderer.setHighlight(r.chain, r.region);
-    status(`${r.feature >= 0 ? `the nearest feature, ${r.distance.toFixed(1)} px away (pink)` : `the nearest control point, ${r.distance.toFixed(1)} px away`}; ` +
-      `a color edit here changes the ${r.colors} control colors shown white`);
+    const what = r.feature >= 0 ? `the nearest feature, ${r.distance.toFixed(1)} px away (pink)`
+      : r.vertex >= 0 ? `the nearest control point, ${r.distance.toFixed(1)} px away` : 'the region around the click';
+    status(`${what}; a color edit here changes the ${r.colors} control colors shown white`);
   } catch (e) {
     if (seq === selectSeq) status(e instanceof Error ? e.message : String(e), true);
   }
@@ -409,7 +420,7 @@ function previewRegion(at: [number, number]) {
       while (previewWanted) {
         const p = previewWanted;
         previewWanted = null;
-        const r = await postJson('/api/select', { level: state.level, select: pick(), at: p, radius: num('radius') });
+        const r = await postJson('/api/select', { level: state.level, at: p, ...colorPick() });
         if (state.tool !== 'color' || state.drag) break;
         renderer.setHighlight([], r.region);
         status(`a click here changes the ${r.colors} control colors shown white`);
@@ -431,10 +442,11 @@ function hexColor(): number[] {
 async function doColor(at: [number, number]) {
   await edit(async () => {
     const f = await postFrame('/api/color', {
-      session: state.session, version: state.version, level: state.level, at, select: pick(),
-      radius: num('radius'), mode: mode(), color: hexColor(), amount: num('amount'),
+      session: state.session, version: state.version, level: state.level, at, ...colorPick(),
+      mode: mode(), color: hexColor(), amount: num('amount'),
     });
     applyDelta(f);
+    renderer.setHighlight([], []);  // the result unobstructed; the next move previews again
     status(f.header.log);
   });
 }
@@ -633,7 +645,7 @@ async function runDrag(drag: Drag) {
   try {
     const r = await postJson('/api/drag/start', {
       session: state.session, version: state.version, level: state.level, tool: state.tool,
-      select: state.tool === 'move' ? 'feature' : pick(), at: drag.start, ...dragExtent(),
+      select: state.tool === 'move' ? 'feature' : dragPick(), at: drag.start, ...dragExtent(),
     });
     renderer.setHighlight(r.chain, r.vertex >= 0 ? [r.vertex] : []);
     drag.ok = true;
@@ -859,7 +871,8 @@ function bindOutput(id: string, format: (v: number) => string) {
 function wireControls() {
   document.querySelectorAll<HTMLButtonElement>('#tools button').forEach((b) =>
     b.addEventListener('click', () => setTool(b.dataset.tool as Tool)));
-  bindOutput('radius', (v) => `${v} px`);
+  bindOutput('radius', (v) => (v >= RADIUS_NONE ? 'no cap' : `${v} px`));
+  bindOutput('tolerance', (v) => `${v}`);
   bindOutput('sigma', (v) => (v === 0 ? 'auto' : `${v} px`));
   bindOutput('region', (v) => (v === 0 ? 'auto' : v >= REGION_WHOLE ? 'whole' : `${v} px`));
   bindOutput('amount', (v) => v.toFixed(2));

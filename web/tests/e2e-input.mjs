@@ -1,4 +1,4 @@
-// Quick input in the editor page (issue 29, problems 1-4, 6 and 8-11), in headless Chromium with
+// Quick input in the editor page (issue 29, problems 1-6 and 8-11), in headless Chromium with
 // software WebGL: the page queues its requests, so quick clicks with every tool make exactly the
 // edits they ask for (a click is no drag), quick undos raise no conflict, a drag the mesh refuses
 // at its end commits where it last fitted, a press outside the image grabs nothing, the status
@@ -315,6 +315,52 @@ try {
   await idle(page);
   const line = await page.evaluate(() => document.getElementById('status').textContent);
   check('svg download: the status line says what came', /^downloaded \S+\.svg \(\d+(\.\d)? MB\)$/.test(line), `status "${line}"`);
+
+  // Problem 5: a color fill stops at the wing's outline. The page's defaults pick the region
+  // around the click (no radius cap, tolerance 60): a click on the right wing's black paints it
+  // red, and the leaf around the wing keeps its green. (A 200 px disk painted straight through the
+  // outline before.) On the butterfly only: the points are the wing's.
+  if (photo.endsWith('butterfly.png')) {
+    const { width, height } = await page.evaluate(() => window.subvec.state.doc);
+    const grid = [];
+    for (let y = 2; y < height; y += 4) for (let x = 2; x < width; x += 4) grid.push([x, y]);
+    const before = await page.evaluate((g) => window.subvec.pixelsAt(g), grid);
+    await page.keyboard.press('c');
+    await page.locator('#color-text').fill('255, 0, 0');
+    await page.locator('#color-text').press('Enter');
+    await page.evaluate(() => {
+      const el = document.getElementById('amount');
+      el.value = '1';
+      el.dispatchEvent(new Event('input'));
+      document.activeElement.blur();
+    });
+    const [wx, wy] = await client(page, 400, 180);
+    await page.mouse.move(wx, wy);
+    await page.waitForTimeout(300);  // the hover preview
+    await page.mouse.click(wx, wy);
+    await idle(page);
+    const after = await page.evaluate((g) => window.subvec.pixelsAt(g), grid);
+    const dark = (p) => p[0] + p[1] + p[2] < 150;
+    const green = (p) => p[1] > 90 && p[1] > p[0] + 30 && p[1] > p[2] + 30;
+    const red = (p) => p[0] > 150 && p[1] < 90 && p[2] < 90;
+    // The right wing: dark samples right of the body (x > 270) within 90 px of the click.
+    const wing = grid.map(([x, y], i) => x > 270 && Math.hypot(x - 400, y - 180) < 90 && dark(before[i]));
+    const painted = wing.filter((w, i) => w && red(after[i])).length / Math.max(1, wing.filter(Boolean).length);
+    // Leaf samples at least a sample step (4 px) inside the green: all eight neighbours green too.
+    // The outline's own pixels mix wing and leaf, and may take some red.
+    const columns = Math.ceil((width - 2) / 4);
+    const leaf = grid.map((_, i) => [-1, 0, 1].every((dy) => [-1, 0, 1].every((dx) => {
+      const j = i + dy * columns + dx;
+      return j >= 0 && j < grid.length && green(before[j]);
+    })));
+    const leafChanged = leaf.filter((l, i) => l && diff(before[i], after[i]) > 12).length;
+    const leafCount = leaf.filter(Boolean).length;
+    check(`color fill: the wing turns red (${(100 * painted).toFixed(0)} % of its dark samples near the click)`, painted > 0.8);
+    check(`color fill: the leaf keeps its green (${leafChanged} of ${leafCount} green samples changed)`,
+      leafCount > 1000 && leafChanged <= leafCount / 200);
+    await page.keyboard.press('Control+z');
+    await idle(page);
+  }
 
   // Problem 4: a 25 px drag of a small closed shape (the butterfly's white spots) moves it and
   // leaves the rest of the picture where it was (it shifted the whole butterfly before: 220k of

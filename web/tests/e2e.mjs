@@ -77,10 +77,11 @@ try {
   const cornerAfter = await pixel(page, 3, 3);
   check('drag: the image corner stays', diff(cornerAfter, corner) < 3, `${corner} -> ${cornerAfter}`);
 
-  // Color: BLEND the inside of the disk to pure green, amount 1, radius 40.
+  // Color: BLEND the inside of the disk to pure green, amount 1, the feature's side grown by 40 px.
   const centreBefore = await pixel(page, 48, 48);
   const outsideBefore = await pixel(page, 8, 48);
   await page.keyboard.press('c');
+  await page.locator('input[name=pick][value=feature]').check();
   await page.locator('#color').fill('#00ff00');
   await page.evaluate(() => {
     for (const [id, v] of [['amount', '1'], ['radius', '40']]) {

@@ -8,18 +8,18 @@
 #include <string_view>
 #include <vector>
 
+#include "subvec/edit/selection.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec {
 
-enum class EditSelect { kVertex, kFeature };
 enum class ColorMode { kBlend, kTransform };
 
 struct EditOp {
   enum class Kind {
     kDrag,         // from -> to, select vertex (one vertex) or feature (Gaussian falloff, sigma)
     kMoveFeature,  // at; translate, rotate (degrees)
-    kColor,        // at; mode, select, radius, color, amount (blend)
+    kColor,        // at; mode, select, radius, tolerance (region), color, amount (blend)
   };
   Kind kind = Kind::kDrag;
   int level = 0;
@@ -31,7 +31,8 @@ struct EditOp {
   Vec2 translate;         // move-feature, pixels
   double rotate = 0;      // move-feature, degrees, clockwise on screen
   ColorMode mode = ColorMode::kBlend;
-  double radius = 0;      // color: propagation radius, pixels
+  double radius = 0;      // color: propagation radius, pixels (a region's cap; infinity: none)
+  double tolerance = kDefaultRegionTolerance;  // color of a region: CIELAB distance from the seed
   Color color;            // color: the new color, 0-255
   double amount = 0.5;    // color blend: 0 keeps the old color, 1 paints the new one
 

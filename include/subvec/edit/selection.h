@@ -11,6 +11,14 @@
 // vertices: the region is a Euclidean disk (or band) clipped to the side of the tears it started
 // on, and it passes a tear only around its end, where the color is continuous.
 //
+// Regions. A region selection is a flood fill over the control mesh: from the clicked point's
+// color value it grows through triangles to every color value whose color is within `tolerance`
+// of the seed's, never across a tear, and optionally capped by a radius around the click. Tears
+// rarely close a shape in a photograph; the tolerance stops the fill where the color changes, as a
+// paint bucket does. It is a CIELAB distance (ΔE 1976, D65), so that shading in the dark, which
+// RGB spreads thin, is one region (the default 25 fills the butterfly photograph's black wings
+// from one click and stops at their outline, where RGB distance 60 left holes).
+//
 // Sides. A vertex on a tear has one color value per side. The seed is the value on the clicked
 // side: for a vertex, the wedge of triangles around it that contains the direction to the click;
 // for a feature, the side of its limit curve on which the click lies. So the two sides of a tear
@@ -18,13 +26,25 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/vector_image.h"
 
 namespace subvec {
+
+// What a click selects: the nearest control vertex, the nearest feature, or the region around the
+// click (color edits and the editor's Select tool; drags take a vertex or a feature).
+enum class EditSelect { kVertex, kFeature, kRegion };
+
+// "vertex", "feature" or "region"; nullopt for any other name. kEditSelectNames lists them for
+// error messages.
+std::optional<EditSelect> edit_select_from_name(std::string_view name);
+inline constexpr std::string_view kEditSelectNames = R"("vertex", "feature" or "region")";
 
 // One smooth piece of a feature's limit curve (mesh/curves.h): the feature chain split at its
 // corner vertices (junctions, a tear meeting a crease or the border), which the curve interpolates.
@@ -72,5 +92,18 @@ ColorSelection select_vertex_colors(const ControlMesh& mesh, const MeshTopology&
 // feature.
 ColorSelection select_feature_colors(const ControlMesh& mesh, const MeshTopology& topology,
                                      Vec2 at, double radius);
+
+// Region selection (a flood fill, see Regions above): the seed is the color value of the clicked
+// triangle's corner nearest to `at` (a point on no triangle takes the nearest triangle). The fill
+// takes color values within `tolerance` (ΔE, >= 0) of the seed's color whose vertex lies within
+// `radius` of `at` (infinity: no cap).
+inline constexpr double kDefaultRegionTolerance = 25;
+ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at,
+                                    double radius = std::numeric_limits<double>::infinity(),
+                                    double tolerance = kDefaultRegionTolerance);
+
+// The selection a color edit makes: one of the three above. `tolerance` is the region's only.
+ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topology,
+                             EditSelect select, Vec2 at, double radius, double tolerance);
 
 }  // namespace subvec

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 #include <vector>
 
@@ -72,6 +73,61 @@ TEST(ColorSelection, FeatureSelectionTakesTheClickedSide) {
   for (int c : a.colors) EXPECT_TRUE(inside.count(c) && !outside.count(c));
   for (int c : b.colors) EXPECT_TRUE(outside.count(c) && !inside.count(c));
   EXPECT_EQ(a.seed_vertex, disk.focus);
+}
+
+// A region (a fill) from a click inside the torn disk is the inside, from outside the outside,
+// whatever the tolerance: the closed tear stops it.
+TEST(ColorSelection, RegionStopsAtATear) {
+  const TestMesh disk = testing::torn_disk();
+  const ControlMesh& m = disk.mesh;
+  const std::set<int> inside = side_colors(m, true), outside = side_colors(m, false);
+  const Vec2 centre = m.positions[0];
+  for (const double tolerance : {1e3, 1e9}) {
+    const ColorSelection in = select_region_colors(m, {centre.x + 0.5, centre.y + 0.3},
+                                                   std::numeric_limits<double>::infinity(), tolerance);
+    EXPECT_EQ(std::set<int>(in.colors.begin(), in.colors.end()), inside);
+    const ColorSelection out = select_region_colors(m, {1, 1}, std::numeric_limits<double>::infinity(), tolerance);
+    EXPECT_EQ(std::set<int>(out.colors.begin(), out.colors.end()), outside);
+  }
+}
+
+// Without tears, the tolerance is what stops a region: a grid whose left columns are black and the
+// rest grey 50 (CIELAB distance 20.8 from black, RGB distance 87). Tolerance 20 keeps to the black
+// (the values the fill can reach through black ones), 22 takes the grey too. The radius caps it
+// around the click.
+TEST(ColorSelection, RegionFollowsTheToleranceInCielabAndTheRadius) {
+  TestMesh grid = testing::grid_mesh(8, 6, 4, true);
+  ControlMesh& m = grid.mesh;
+  std::vector<int32_t> column(m.num_colors());
+  for (int f = 0; f < m.num_triangles(); ++f)
+    for (int k = 0; k < 3; ++k) column[m.triangle_colors[f][k]] = int(std::lround(m.positions[m.triangles[f][k]].x / 4));
+  std::set<int> black;
+  for (int c = 0; c < m.num_colors(); ++c) {
+    m.colors[c] = column[c] <= 3 ? Color{0, 0, 0} : Color{50, 50, 50};
+    if (column[c] <= 3) black.insert(c);
+  }
+  const Vec2 at{5, 11};
+  const double none = std::numeric_limits<double>::infinity();
+  const ColorSelection tight = select_region_colors(m, at, none, 20);
+  EXPECT_EQ(std::set<int>(tight.colors.begin(), tight.colors.end()), black);
+  EXPECT_EQ(select_region_colors(m, at, none, 22).colors.size(), size_t(m.num_colors()));
+  // Capped at 6 px: only values within 6 px of the click, and all of the black ones there.
+  const ColorSelection capped = select_region_colors(m, at, 6, 1e3);
+  ASSERT_FALSE(capped.colors.empty());
+  for (int c : capped.colors) {
+    int v = -1;
+    for (int f = 0; f < m.num_triangles() && v < 0; ++f)
+      for (int k = 0; k < 3; ++k)
+        if (m.triangle_colors[f][k] == c) v = m.triangles[f][k];
+    EXPECT_LE(std::hypot(m.positions[v].x - at.x, m.positions[v].y - at.y), 6.0);
+  }
+  EXPECT_LT(capped.colors.size(), black.size());
+  // Through the dispatcher, as the edit ops and the editor call it.
+  const MeshTopology topology = grid.topology();
+  EXPECT_EQ(select_colors(m, topology, EditSelect::kRegion, at, none, 20).colors, tight.colors);
+  EXPECT_THROW(select_region_colors(m, at, none, -1), Error);
+  EXPECT_EQ(edit_select_from_name("region"), EditSelect::kRegion);
+  EXPECT_EQ(edit_select_from_name("Region"), std::nullopt);
 }
 
 TEST(ColorSelection, NothingToSelectWithoutFeatures) {

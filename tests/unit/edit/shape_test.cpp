@@ -173,6 +173,46 @@ TEST(Shape, StrokesFollowShapeEdits) {
   EXPECT_EQ(img.strokes[0].points, moved);
 }
 
+// The ops file's region fill: "select": "region" is uncapped unless a radius is given, takes a
+// "tolerance", and does what select_region_colors selects. A tolerance elsewhere, a drag of a
+// region and a negative tolerance are refused, naming the key.
+TEST(EditOps, RegionFillsParseAndApply) {
+  const std::vector<EditOp> ops = parse_edit_ops(
+      R"([{"op":"color","mode":"blend","at":[20,20],"select":"region","tolerance":12,"color":[255,0,0],"amount":1},
+          {"op":"color","mode":"blend","at":[20,20],"select":"region","radius":5,"color":[0,0,255]}])");
+  ASSERT_EQ(ops.size(), 2u);
+  EXPECT_EQ(ops[0].select, EditSelect::kRegion);
+  EXPECT_EQ(ops[0].radius, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(ops[0].tolerance, 12);
+  EXPECT_EQ(ops[1].radius, 5);
+  EXPECT_EQ(ops[1].tolerance, kDefaultRegionTolerance);
+  VectorImage img = image_with_features();
+  const ColorSelection expected = select_region_colors(img.levels[0], {20, 20}, ops[0].radius, 12);
+  EXPECT_GT(expected.colors.size(), 1u);
+  EXPECT_LT(expected.colors.size(), size_t(img.levels[0].num_colors()));
+  apply_edit_ops(img, std::span(ops.data(), 1));
+  for (int c = 0; c < img.levels[0].num_colors(); ++c) {
+    const bool in = std::binary_search(expected.colors.begin(), expected.colors.end(), c);
+    EXPECT_EQ(img.levels[0].colors[c] == (Color{255, 0, 0}), in) << c;
+  }
+  auto refused = [](const char* json, const char* part) {
+    try {
+      (void)parse_edit_ops(json);
+      ADD_FAILURE() << json;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  refused(R"([{"op":"color","mode":"blend","at":[1,1],"select":"vertex","tolerance":3,"color":[0,0,0]}])",
+          "\"tolerance\": applies to \"select\": \"region\" only");
+  refused(R"([{"op":"color","mode":"blend","at":[1,1],"select":"region","tolerance":-1,"color":[0,0,0]}])",
+          "expected a number >= 0, got -1");
+  refused(R"([{"op":"drag","from":[1,1],"to":[2,2],"select":"region"}])",
+          "expected \"vertex\" or \"feature\", got \"region\"");
+  refused(R"([{"op":"color","mode":"blend","at":[1,1],"select":"blob","color":[0,0,0]}])",
+          "expected \"vertex\", \"feature\" or \"region\", got \"blob\"");
+}
+
 TEST(Shape, FeatureDragMeetsItsConstraintsAndIsMoreRigidThanTheFalloffAlone) {
   const VectorImage image = image_with_features();
   const ControlMesh& mesh = image.levels[0];

@@ -434,6 +434,38 @@ TEST_F(ServeHttp, ErrorsAreJsonWithStatus) {
   expect_error(client_->Get("/api/status", foreign), 403);
 }
 
+// The region fill over HTTP: /api/select with "select": "region" reports the values a color
+// edit with the same fields changes (the disk's closed tear bounds it), and a tolerance is the
+// region's only.
+TEST_F(ServeHttp, RegionSelectAndColorAgree) {
+  const json pick = {{"select", "region"}, {"at", {48, 48}}, {"tolerance", 100}};
+  auto sel = client_->Post("/api/select", pick.dump(), "application/json");
+  ASSERT_TRUE(sel);
+  ASSERT_EQ(sel->status, 200) << sel->body;
+  const json s = body(sel);
+  const VectorImage original = disk();
+  const int inside = s["colors"].get<int>();
+  EXPECT_GT(inside, 1);
+  EXPECT_LT(inside, original.levels[0].num_colors());  // the tear stops it
+  EXPECT_EQ(s["vertex"], -1);
+  EXPECT_EQ(s["feature"], -1);
+  auto session = client_->Post("/api/session", "{}", "application/json");
+  ASSERT_TRUE(session);
+  json edit = pick;
+  edit.update({{"session", body(session)["session"]}, {"version", 1}, {"color", {0, 255, 0}}, {"amount", 1}});
+  auto r = client_->Post("/api/color", edit.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->body.find(std::to_string(inside) + " control colors"), std::string::npos) << r->body.substr(0, 300);
+  auto bad = client_->Post("/api/select", json{{"select", "vertex"}, {"at", {48, 48}}, {"tolerance", 5}}.dump(), "application/json");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("applies to \\\"select\\\": \\\"region\\\" only"), std::string::npos) << bad->body;
+  auto drag = client_->Post("/api/drag/start", json{{"session", "s1"}, {"version", 2}, {"select", "region"}, {"at", {48, 48}}}.dump(), "application/json");
+  ASSERT_TRUE(drag);
+  EXPECT_EQ(drag->status, 400) << drag->body;
+}
+
 TEST_F(ServeHttp, SaveWritesOnlyTheNamedFile) {
   const fs::path out = dir_ / "out.svec";
   EXPECT_FALSE(fs::exists(out));
