@@ -72,10 +72,15 @@ std::string edit_label(const EditOp& op) {
   const auto at = [](Vec2 p) {
     return " at (" + std::to_string(std::lround(p.x)) + ", " + std::to_string(std::lround(p.y)) + ")";
   };
+  const auto points = [](size_t n) {
+    return " of " + std::to_string(n) + (n == 1 ? " control point" : " control points");
+  };
   switch (op.kind) {
     case EditOp::Kind::kDrag: return "drag" + at(op.from);
     case EditOp::Kind::kMoveFeature: return "feature move" + at(op.at);
-    case EditOp::Kind::kColor: return op.name() + at(op.at);
+    case EditOp::Kind::kColor:
+      return op.name() + (op.select == EditSelect::kVertices ? points(op.vertices.size()) : at(op.at));
+    case EditOp::Kind::kMoveVertices: return "move" + points(op.vertices.size());
   }
   return op.name();
 }
@@ -478,7 +483,14 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
   drag->last_to = drag->start.at;
   drag->version = version;
   SelectResult result;
-  if (!start.move_feature && start.select == EditSelect::kVertex) {
+  const bool points = !start.vertices.empty();
+  if (points) {
+    try {
+      (void)subvec::move_vertices(mesh, start.vertices, {0, 0});  // checks the list
+    } catch (const Error& e) {
+      refuse_edit(e);
+    }
+  } else if (!start.move_feature && start.select == EditSelect::kVertex) {
     drag->vertex = subvec::nearest_vertex(mesh, drag->start.at);
     if (is_image_corner(mesh.positions[drag->vertex], image_.width, image_.height)) {
       throw RequestError(kUnprocessable, "nothing to drag: the nearest control vertex is an image "
@@ -499,7 +511,8 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
   }
   // What the user left to the editor: an extent local to what was grabbed.
   if (start.auto_sigma || start.auto_region) {
-    const subvec::DragExtent e = subvec::suggested_drag_extent(mesh, drag->feature, drag->vertex);
+    const subvec::DragExtent e = points ? subvec::suggested_drag_extent(mesh, start.vertices)
+                                        : subvec::suggested_drag_extent(mesh, drag->feature, drag->vertex);
     if (start.auto_sigma) drag->start.sigma = e.sigma;
     if (start.auto_region) drag->start.region = e.region;
   }
@@ -545,7 +558,9 @@ Delta Editor::drag_move_locked(Session& session, Vec2 to, double rotate) {
   const ControlMesh& mesh = image_.levels[drag.start.level];
   const Vec2 d{to.x - drag.start.at.x, to.y - drag.start.at.y};
   subvec::Handles handles;
-  if (drag.start.move_feature) {
+  if (!drag.start.vertices.empty()) {
+    handles = subvec::move_vertices(mesh, drag.start.vertices, d);
+  } else if (drag.start.move_feature) {
     handles = subvec::move_feature(mesh, mesh.features[drag.feature], d, rotate);
   } else if (drag.vertex >= 0) {
     handles = subvec::drag_vertex(mesh, drag.vertex, d);
@@ -586,7 +601,11 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
     EditOp op;
     op.level = drag->start.level;
     op.region = drag->start.region;
-    if (drag->start.move_feature) {
+    if (!drag->start.vertices.empty()) {
+      op.kind = EditOp::Kind::kMoveVertices;
+      op.vertices = drag->start.vertices;
+      op.translate = {target.x - drag->start.at.x, target.y - drag->start.at.y};
+    } else if (drag->start.move_feature) {
       op.kind = EditOp::Kind::kMoveFeature;
       op.at = drag->start.at;
       op.translate = {target.x - drag->start.at.x, target.y - drag->start.at.y};
@@ -612,6 +631,9 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
     };
     const std::string by =
         "(" + px(target.x - drag->start.at.x) + ", " + px(target.y - drag->start.at.y) + ") px";
+    if (const size_t n = drag->start.vertices.size()) {
+      return "moved " + std::to_string(n) + (n == 1 ? " control point" : " control points") + " by " + by;
+    }
     if (!drag->start.move_feature) return "dragged by " + by;
     return "moved by " + by + (angle != 0 ? ", rotated by " + px(angle) + "°" : std::string());
   };
@@ -662,12 +684,24 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(op.level);
-  if (op.kind != EditOp::Kind::kColor) throw RequestError(kBadRequest, "not a color edit");
+  if (op.kind != EditOp::Kind::kColor && op.kind != EditOp::Kind::kMoveVertices) {
+    throw RequestError(kBadRequest, "not a color edit or a move of control points");
+  }
   VectorImage edited = image_;
   try {
     subvec::apply_edit_ops(edited, std::span(&op, 1));
   } catch (const Error& e) {
     refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+  }
+  if (op.kind == EditOp::Kind::kMoveVertices) {  // an arrow-key nudge
+    const auto px = [](double v) { return std::to_string(std::lround(v)); };
+    log = "moved " + std::to_string(op.vertices.size()) +
+          (op.vertices.size() == 1 ? " control point" : " control points") + " by (" +
+          px(op.translate.x) + ", " + px(op.translate.y) + ") px";
+    const bool strokes_moved = std::any_of(edited.strokes.begin(), edited.strokes.end(),
+                                           [&](const subvec::Stroke& s) { return s.level == op.level; });
+    commit_locked(std::move(edited), edit_label(op), session);
+    return delta_locked(session, nullptr, strokes_moved);
   }
   // The page's line, in plain words: what changed and how much (the library's line names the
   // seed vertex and its color value).
@@ -685,6 +719,16 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
         (op.mode == subvec::ColorMode::kBlend ? "moved toward " : "mapped onto ") + rgb(op.color);
   commit_locked(std::move(edited), edit_label(op), session);
   return delta_locked(session, nullptr, false);
+}
+
+double Editor::suggested_region(int level, const std::vector<int32_t>& vertices) const {
+  std::lock_guard lock(mutex_);
+  check_level_locked(level);
+  try {
+    return subvec::suggested_drag_extent(image_.levels[level], vertices).region;
+  } catch (const Error& e) {
+    refuse_edit(e);
+  }
 }
 
 Delta Editor::stylize(const std::string& session_id, int64_t version, int level,

@@ -142,6 +142,9 @@ struct DragStart {
   double region = 0;
   // Left to the editor ("auto"): subvec::suggested_drag_extent for what is grabbed.
   bool auto_sigma = false, auto_region = false;
+  // Not empty: a move of these control vertices (the points tool's selection), by the mouse's
+  // displacement from `at`.
+  std::vector<int32_t> vertices;
 };
 
 struct SelectRequest {
@@ -205,10 +208,13 @@ class Editor {
                  std::string& log);
   void drag_cancel(const std::string& session);
 
-  // A color edit (op.kind == kColor) through apply_edit_ops; the delta for the session's view, and
-  // `log`, the page's line: "color blend at (50, 46): 34 control colors moved toward (0, 255, 0)".
+  // A color edit (op.kind == kColor) or a nudge of control points (kMoveVertices) through
+  // apply_edit_ops; the delta for the session's view, and `log`, the page's line: "color blend at
+  // (50, 46): 34 control colors moved toward (0, 255, 0)", "moved 3 control points by (1, 0) px".
   Delta apply(const std::string& session, int64_t version, const subvec::EditOp& op,
               std::string& log);
+  // The deformation's extent local to a selection of control vertices (suggested_drag_extent).
+  double suggested_region(int level, const std::vector<int32_t>& vertices) const;
   Delta stylize(const std::string& session, int64_t version, int level, std::optional<double> threshold,
                 uint64_t seed, double probability, std::string& log);
   // Filters the pyramid (subvec::filter). The sliders are absolute: a filter that directly follows

@@ -158,6 +158,20 @@ subvec::EditSelect select_mode(const json& j, bool region_too) {
                                       ", got \"" + s + "\"");
 }
 
+// "vertices": control vertex indices, not empty (the library checks them against the level).
+std::vector<int32_t> vertex_list(const json& j) {
+  const json& v = field(j, "vertices");
+  if (!v.is_array() || v.empty() || !std::all_of(v.begin(), v.end(), [](const json& x) {
+        return x.is_number_integer() && x.get<int64_t>() >= 0 &&
+               x.get<int64_t>() <= std::numeric_limits<int32_t>::max();
+      })) {
+    throw RequestError(kBadRequest, "\"vertices\" must be a non-empty array of vertex indices");
+  }
+  std::vector<int32_t> out;
+  for (const json& x : v) out.push_back(static_cast<int32_t>(x.get<int64_t>()));
+  return out;
+}
+
 // A color selection's radius (a region's is uncapped by default) and tolerance (regions only).
 void color_reach(const json& j, subvec::EditSelect select, double& radius, double& tolerance) {
   const bool region = select == subvec::EditSelect::kRegion;
@@ -607,6 +621,9 @@ void EditorServer::Impl::drag_routes() {
     SelectRequest s;
     s.level = small_int(j, "level", 0);
     s.select = select_mode(j, true);
+    if (s.select == subvec::EditSelect::kVertices) {
+      throw RequestError(kBadRequest, "\"select\": \"vertices\" is for color edits");
+    }
     s.at = point(j, "at");
     color_reach(j, s.select, s.radius, s.tolerance);
     const SelectResult r = ready_editor()->select(s);
@@ -623,10 +640,11 @@ void EditorServer::Impl::drag_routes() {
     DragStart d;
     d.level = small_int(j, "level", 0);
     const std::string tool = j.contains("tool") ? text(j, "tool") : "drag";
-    if (tool != "drag" && tool != "move") {
-      throw RequestError(kBadRequest, "\"tool\" must be \"drag\" or \"move\"");
+    if (tool != "drag" && tool != "move" && tool != "points") {
+      throw RequestError(kBadRequest, "\"tool\" must be \"drag\", \"move\" or \"points\"");
     }
     d.move_feature = tool == "move";
+    if (tool == "points") d.vertices = vertex_list(j);  // the selection moves
     d.select = select_mode(j, false);
     d.at = point(j, "at");
     // A number, or "auto": the editor picks an extent local to what is grabbed.
@@ -674,8 +692,12 @@ void EditorServer::Impl::edit_routes() {
     op.kind = subvec::EditOp::Kind::kColor;
     op.level = small_int(j, "level", 0);
     op.select = select_mode(j, true);
-    op.at = point(j, "at");
-    color_reach(j, op.select, op.radius, op.tolerance);
+    if (op.select == subvec::EditSelect::kVertices) {
+      op.vertices = vertex_list(j);
+    } else {
+      op.at = point(j, "at");
+      color_reach(j, op.select, op.radius, op.tolerance);
+    }
     const std::string mode = j.contains("mode") ? text(j, "mode") : "blend";
     if (mode != "blend" && mode != "transform") {
       throw RequestError(kBadRequest, "\"mode\" must be \"blend\" or \"transform\"");
@@ -690,6 +712,26 @@ void EditorServer::Impl::edit_routes() {
     op.color = {c[0].get<float>(), c[1].get<float>(), c[2].get<float>()};
     op.amount = number(j, "amount", 0.5);
     std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+
+  // A nudge of the points tool's selection (the arrow keys): a move of control vertices.
+  server.Post("/api/points/move", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kMoveVertices;
+    op.level = small_int(j, "level", 0);
+    op.vertices = vertex_list(j);
+    op.translate = point(j, "translate");
+    std::shared_ptr<Editor> doc = ready_editor();
+    // A number, or "auto": local to the selection (subvec::suggested_drag_extent).
+    op.region = j.contains("region") && j["region"] == "auto"
+                    ? doc->suggested_region(op.level, op.vertices)
+                    : number(j, "region", 0.0);
+    if (op.region < 0) throw RequestError(kBadRequest, "\"region\" must be >= 0");
     std::string log;
     const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
     res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),

@@ -327,7 +327,7 @@ std::string apply_op(VectorImage& image, const subvec::EditOp& op) {
 
 subvec::EditSelect parse_select(const std::string& s) {
   if (const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s)) return *e;
-  invalid("select must be 'vertex', 'feature' or 'region', got '" + s + "'");
+  invalid("select must be 'vertex', 'feature', 'region' or 'vertices', got '" + s + "'");
 }
 
 // A color selection's reach: radius None is 0 for a vertex or feature and no cap for a region;
@@ -485,10 +485,24 @@ void def_edits(PyVectorImage& vi) {
           "at"_a, py::kw_only(), "translate"_a = std::array<double, 2>{0, 0}, "rotate"_a = 0.0,
           "region"_a = 0.0, "level"_a = 0)
       .def(
+          "move_vertices",
+          [](VectorImage& v, const py::object& vertices, std::array<double, 2> translate,
+             double region, int level) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kMoveVertices;
+            op.level = check_level(v, level);
+            op.vertices = index_list(vertices, v.levels[size_t(op.level)].num_vertices(), "vertices");
+            op.translate = point(translate, "translate");
+            if (!(std::isfinite(region) && region >= 0)) invalid("region must be >= 0");
+            op.region = region;
+            return apply_op(v, op);
+          },
+          "vertices"_a, "translate"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0)
+      .def(
           "recolor",
           [](VectorImage& v, std::array<double, 2> at, std::array<double, 3> color,
              const std::string& mode, const std::string& select, std::optional<double> radius,
-             std::optional<double> tolerance, double amount, int level) {
+             std::optional<double> tolerance, const py::object& vertices, double amount, int level) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kColor;
             op.at = point(at, "at");
@@ -502,13 +516,21 @@ void def_edits(PyVectorImage& vi) {
             }
             op.select = parse_select(select);
             color_reach(op.select, radius, tolerance, op.radius, op.tolerance);
+            if ((op.select == subvec::EditSelect::kVertices) != !vertices.is_none()) {
+              invalid("vertices go with select='vertices', and it needs them");
+            }
+            if (!vertices.is_none()) {
+              op.vertices = index_list(vertices, v.levels[size_t(check_level(v, level))].num_vertices(),
+                                       "vertices");
+            }
             if (!(amount >= 0 && amount <= 1)) invalid("amount must be in [0, 1]");
             op.amount = amount;
             op.level = level;
             return apply_op(v, op);
           },
           "at"_a, "color"_a, py::kw_only(), "mode"_a = "blend", "select"_a = "vertex",
-          "radius"_a = py::none(), "tolerance"_a = py::none(), "amount"_a = 0.5, "level"_a = 0);
+          "radius"_a = py::none(), "tolerance"_a = py::none(), "vertices"_a = py::none(),
+          "amount"_a = 0.5, "level"_a = 0);
 }
 
 // The building blocks of color and shape edits (edit/selection.h, edit/color.h, edit/shape.h).

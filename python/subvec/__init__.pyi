@@ -110,9 +110,12 @@ class VectorImage:
     def move_feature(self, at: _Point, *, translate: _Point = (0, 0), rotate: float = 0.0,
                      region: float = 0.0, level: int = 0) -> str: ...
     def recolor(self, at: _Point, color: _Color, *, mode: Literal["blend", "transform"] = "blend",
-                select: Literal["vertex", "feature", "region"] = "vertex",
+                select: Literal["vertex", "feature", "region", "vertices"] = "vertex",
                 radius: float | None = None, tolerance: float | None = None,
+                vertices: npt.ArrayLike | None = None,
                 amount: float = 0.5, level: int = 0) -> str: ...
+    def move_vertices(self, vertices: npt.ArrayLike, translate: _Point, *, region: float = 0.0,
+                      level: int = 0) -> str: ...
     def select_colors(self, at: _Point, *, select: Literal["vertex", "feature", "region"] = "vertex",
                       radius: float | None = None, tolerance: float | None = None,
                       level: int = 0) -> Selection: ...

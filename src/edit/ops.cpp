@@ -143,8 +143,10 @@ EditOp parse_op(const Json& j, Place& at) {
     op.kind = EditOp::Kind::kMoveFeature;
   } else if (kind == "color") {
     op.kind = EditOp::Kind::kColor;
+  } else if (kind == "move-vertices") {
+    op.kind = EditOp::Kind::kMoveVertices;
   } else {
-    at.fail("unknown op \"" + printable(kind) + "\" (expected drag, move-feature or color)");
+    at.fail("unknown op \"" + printable(kind) + "\" (expected drag, move-feature, color or move-vertices)");
   }
   at.op = kind;
 
@@ -156,12 +158,12 @@ EditOp parse_op(const Json& j, Place& at) {
     }
     op.level = static_cast<int>(level->get<int64_t>());
   }
-  // Drags grab a vertex or a feature; color edits may also fill a region.
+  // Drags grab a vertex or a feature; color edits may also fill a region or take listed vertices.
   auto select = [&](bool region_too) {
     if (const Json* s = fields.optional("select")) {
       const std::string v = string_value(*s, at, "select");
       const std::optional<EditSelect> e = edit_select_from_name(v);
-      if (e && (region_too || *e != EditSelect::kRegion)) return *e;
+      if (e && (region_too || *e == EditSelect::kVertex || *e == EditSelect::kFeature)) return *e;
       at.fail("select", "expected " +
                             (region_too ? std::string(kEditSelectNames)
                                         : std::string(R"("vertex" or "feature")")) +
@@ -176,7 +178,29 @@ EditOp parse_op(const Json& j, Place& at) {
       if (!(op.region > 0)) at.fail("region", "expected a positive number, got " + num(op.region));
     }
   };
+  // A list of control vertex indices: non-empty, each once.
+  auto vertex_list = [&]() {
+    const Json& list = fields.required("vertices");
+    if (!list.is_array() || list.empty()) {
+      at.fail("vertices", std::string("expected a non-empty array of vertex indices, got ") +
+                              (list.is_array() ? "an empty array" : type_name(list)));
+    }
+    std::set<int64_t> seen;
+    for (const Json& v : list) {
+      if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > std::numeric_limits<int32_t>::max()) {
+        at.fail("vertices", "expected vertex indices (integers >= 0), got " +
+                                (v.is_number() ? v.dump() : type_name(v)));
+      }
+      if (!seen.insert(v.get<int64_t>()).second) at.fail("vertices", "vertex " + v.dump() + " is listed twice");
+      op.vertices.push_back(static_cast<int32_t>(v.get<int64_t>()));
+    }
+  };
   switch (op.kind) {
+    case EditOp::Kind::kMoveVertices:
+      region();
+      vertex_list();
+      op.translate = vec2(fields.required("translate"), at, "translate");
+      break;
     case EditOp::Kind::kDrag:
       region();
       op.select = select(false);
@@ -211,7 +235,13 @@ EditOp parse_op(const Json& j, Place& at) {
       }
       at.op = "color " + mode;
       op.select = select(true);
-      op.at = vec2(fields.required("at"), at, "at");
+      // Listed vertices need no point.
+      if (op.select == EditSelect::kVertices) {
+        vertex_list();
+        if (const Json* a = fields.optional("at")) op.at = vec2(*a, at, "at");
+      } else {
+        op.at = vec2(fields.required("at"), at, "at");
+      }
       op.color = color(fields.required("color"), at, "color");
       // A region is uncapped unless a radius is given.
       if (op.select == EditSelect::kRegion) op.radius = std::numeric_limits<double>::infinity();
@@ -285,6 +315,8 @@ std::string EditOp::name() const {
       return "move-feature";
     case Kind::kColor:
       return mode == ColorMode::kBlend ? "color blend" : "color transform";
+    case Kind::kMoveVertices:
+      return "move-vertices";
   }
   return "?";
 }
@@ -346,12 +378,19 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
     try {
       switch (op.kind) {
         case EditOp::Kind::kDrag:
-        case EditOp::Kind::kMoveFeature: {
-          if (op.kind == EditOp::Kind::kDrag && op.select == EditSelect::kRegion) {
-            refuse(where, "a drag grabs a \"vertex\" or a \"feature\", not a region");
+        case EditOp::Kind::kMoveFeature:
+        case EditOp::Kind::kMoveVertices: {
+          if (op.kind == EditOp::Kind::kDrag && op.select != EditSelect::kVertex &&
+              op.select != EditSelect::kFeature) {
+            refuse(where, "a drag grabs a \"vertex\" or a \"feature\"");
           }
           Handles handles;
-          if (op.kind == EditOp::Kind::kDrag) {
+          if (op.kind == EditOp::Kind::kMoveVertices) {
+            handles = move_vertices(mesh, op.vertices, op.translate);
+            done = std::to_string(op.vertices.size()) +
+                   (op.vertices.size() == 1 ? " control point" : " control points") +
+                   " moved by " + point(op.translate);
+          } else if (op.kind == EditOp::Kind::kDrag) {
             inside("from", op.from);
             inside("to", op.to);
             const Vec2 d{op.to.x - op.from.x, op.to.y - op.from.y};
@@ -395,9 +434,9 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           break;
         }
         case EditOp::Kind::kColor: {
-          inside("at", op.at);
-          const ColorSelection s =
-              select_colors(mesh, topology, op.select, op.at, op.radius, op.tolerance);
+          if (op.select != EditSelect::kVertices) inside("at", op.at);
+          const ColorSelection s = select_colors(mesh, topology, op.select, op.at, op.radius,
+                                                 op.tolerance, op.vertices);
           if (s.colors.empty()) refuse(where, "nothing to select at " + point(op.at));
           const Color seed = mesh.colors[s.seed_color];
           if (op.mode == ColorMode::kBlend) {

@@ -226,6 +226,7 @@ std::optional<EditSelect> edit_select_from_name(std::string_view name) {
   if (name == "vertex") return EditSelect::kVertex;
   if (name == "feature") return EditSelect::kFeature;
   if (name == "region") return EditSelect::kRegion;
+  if (name == "vertices") return EditSelect::kVertices;
   return std::nullopt;
 }
 
@@ -269,11 +270,38 @@ ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at, double rad
   return s;
 }
 
+ColorSelection select_vertices_colors(const ControlMesh& mesh, std::span<const int32_t> vertices) {
+  if (vertices.empty()) throw Error(ErrorCode::kInvalidArgument, "no vertices selected");
+  std::vector<uint8_t> in(mesh.positions.size(), 0);
+  for (const int32_t v : vertices) {
+    if (v < 0 || v >= mesh.num_vertices()) {
+      throw Error(ErrorCode::kInvalidArgument, "vertex " + std::to_string(v) +
+                                                   " is out of range (the level has " +
+                                                   std::to_string(mesh.num_vertices()) + ")");
+    }
+    in[v] = 1;
+  }
+  ColorSelection s;
+  s.seed_vertex = vertices.front();
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      if (!in[mesh.triangles[f][k]]) continue;
+      s.colors.push_back(mesh.triangle_colors[f][k]);
+      if (s.seed_color < 0 && mesh.triangles[f][k] == s.seed_vertex) s.seed_color = mesh.triangle_colors[f][k];
+    }
+  }
+  std::sort(s.colors.begin(), s.colors.end());
+  s.colors.erase(std::unique(s.colors.begin(), s.colors.end()), s.colors.end());
+  return s;
+}
+
 ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topology,
-                             EditSelect select, Vec2 at, double radius, double tolerance) {
+                             EditSelect select, Vec2 at, double radius, double tolerance,
+                             std::span<const int32_t> vertices) {
   switch (select) {
     case EditSelect::kVertex: return select_vertex_colors(mesh, topology, at, radius);
     case EditSelect::kFeature: return select_feature_colors(mesh, topology, at, radius);
+    case EditSelect::kVertices: return select_vertices_colors(mesh, vertices);
     case EditSelect::kRegion: break;
   }
   return select_region_colors(mesh, at, radius, tolerance);

@@ -31,6 +31,23 @@ Handles drag_vertex(const ControlMesh& mesh, int vertex, Vec2 displacement) {
   return {{vertex}, {{p.x + displacement.x, p.y + displacement.y}}};
 }
 
+Handles move_vertices(const ControlMesh& mesh, std::span<const int32_t> vertices, Vec2 translate) {
+  if (vertices.empty()) invalid("no vertices to move");
+  std::vector<uint8_t> seen(mesh.positions.size(), 0);
+  Handles h;
+  for (const int32_t v : vertices) {
+    if (v < 0 || v >= mesh.num_vertices()) {
+      invalid("vertex " + std::to_string(v) + " is out of range (the level has " +
+              std::to_string(mesh.num_vertices()) + ")");
+    }
+    if (seen[v]++) invalid("vertex " + std::to_string(v) + " is given twice");
+    const Vec2 p = mesh.positions[v];
+    h.vertices.push_back(v);
+    h.targets.push_back({p.x + translate.x, p.y + translate.y});
+  }
+  return h;
+}
+
 namespace {
 
 // The feature's vertices once each (a closed chain repeats its first vertex).
@@ -255,6 +272,26 @@ DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int verte
     }
   }
   e.region = std::max(4 * longest, 30.0);
+  return e;
+}
+
+DragExtent suggested_drag_extent(const ControlMesh& mesh, std::span<const int32_t> vertices) {
+  if (vertices.empty()) invalid("no vertices");
+  std::vector<double> longest(mesh.positions.size(), 0);
+  for (const int32_t v : vertices) {
+    if (v < 0 || v >= mesh.num_vertices()) invalid("vertex " + std::to_string(v) + " is out of range");
+  }
+  for (const Tri& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 p = mesh.positions[t[k]], q = mesh.positions[t[(k + 1) % 3]];
+      const double l = std::hypot(q.x - p.x, q.y - p.y);
+      longest[t[k]] = std::max(longest[t[k]], l);
+      longest[t[(k + 1) % 3]] = std::max(longest[t[(k + 1) % 3]], l);
+    }
+  }
+  DragExtent e;
+  e.region = 30;
+  for (const int32_t v : vertices) e.region = std::max(e.region, 4 * longest[v]);
   return e;
 }
 

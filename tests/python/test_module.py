@@ -197,15 +197,33 @@ def test_region_selection_is_a_fill_that_the_tolerance_bounds():
     assert set(capped) <= set(wide) and capped.size < wide.size
     with pytest.raises(subvec.InvalidArgumentError, match="tolerance applies to select='region'"):
         image.select_colors((223, 262), select="vertex", tolerance=10)
-    with pytest.raises(subvec.InvalidArgumentError, match="'vertex', 'feature' or 'region'"):
+    with pytest.raises(subvec.InvalidArgumentError, match="'vertex', 'feature', 'region' or 'vertices'"):
         image.select_colors((223, 262), select="blob")
-    with pytest.raises(subvec.InvalidArgumentError, match="not a region"):
+    with pytest.raises(subvec.InvalidArgumentError, match='grabs a "vertex" or a "feature"'):
         image.drag((111, 126), (104, 104), select="region")
     before = image.mesh()["colors"]
     image.recolor((223, 262), (255, 0, 0), select="region", tolerance=40, amount=1)
     after = image.mesh()["colors"]
     changed = np.flatnonzero(np.any(after != before, axis=1))
     assert set(changed) <= set(wide) and changed.size > 0
+
+
+def test_direct_handles_move_and_recolor_control_points():
+    image = subvec.load(BUTTERFLY)
+    positions = image.mesh()["positions"]
+    inner = np.flatnonzero((positions[:, 0] > 100) & (positions[:, 0] < 300) &
+                           (positions[:, 1] > 100) & (positions[:, 1] < 250))[:4]
+    line = image.move_vertices(inner, (2, -1), region=60)
+    assert "4 control points moved by [2, -1]" in line
+    assert np.allclose(image.mesh()["positions"][inner], positions[inner] + (2, -1))
+    before = image.mesh()["colors"]
+    image.recolor((0, 0), (0, 255, 0), select="vertices", vertices=inner, amount=1)
+    changed = np.flatnonzero(np.any(image.mesh()["colors"] != before, axis=1))
+    assert changed.size >= 4 and np.allclose(image.mesh()["colors"][changed], (0, 255, 0))
+    with pytest.raises(subvec.InvalidArgumentError, match="vertices go with select='vertices'"):
+        image.recolor((5, 5), (0, 0, 0), select="vertices")
+    with pytest.raises(subvec.InvalidArgumentError, match="out of range"):
+        image.move_vertices([10**6], (1, 1))
 
 
 def test_color_selection_blend_and_transform():

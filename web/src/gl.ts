@@ -71,6 +71,7 @@ export class Renderer {
   private controlEdges: WebGLBuffer;
   private highlightLines: WebGLBuffer;
   private highlightPoints: WebGLBuffer;
+  private selectedPoints: WebGLBuffer;
   private strokeVao: WebGLVertexArrayObject;
   private strokePos: WebGLBuffer;
   private strokeColor: WebGLBuffer;
@@ -79,6 +80,8 @@ export class Renderer {
   private controlEdgeCount = 0;
   private highlightLineCount = 0;
   private highlightPointCount = 0;
+  private controlPointCount = 0;  // drawn (all control points) while the points tool is on
+  private selectedPointCount = 0;
   private strokeVertexCount = 0;
   // CPU copies, updated in place by deltas.
   positions = new Float32Array(0);
@@ -130,6 +133,7 @@ export class Renderer {
     this.controlEdges = gl.createBuffer()!;
     this.highlightLines = gl.createBuffer()!;
     this.highlightPoints = gl.createBuffer()!;
+    this.selectedPoints = gl.createBuffer()!;
     this.controlVao = vao(this.controlPos, null, this.controlEdges);
     this.strokePos = gl.createBuffer()!;
     this.strokeColor = gl.createBuffer()!;
@@ -181,8 +185,10 @@ export class Renderer {
     gl.bufferSubData(gl.ARRAY_BUFFER, 0, this.colors);
   }
 
+  private controlVertexCount = 0;
   setControl(positions: Float32Array, edges?: Uint32Array) {
     const gl = this.gl;
+    this.controlVertexCount = positions.length / 2;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.controlPos);
     gl.bufferData(gl.ARRAY_BUFFER, positions, gl.DYNAMIC_DRAW);
     if (edges) {
@@ -204,6 +210,15 @@ export class Renderer {
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightPoints);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(region), gl.DYNAMIC_DRAW);
     this.highlightPointCount = region.length;
+  }
+
+  // The points tool's handles: every control point when `all`, and the selected ones.
+  setPoints(all: boolean, selected: number[]) {
+    const gl = this.gl;
+    this.controlPointCount = all ? this.controlVertexCount : 0;
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.selectedPoints);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(selected), gl.DYNAMIC_DRAW);
+    this.selectedPointCount = selected.length;
   }
 
   // Strokes as triangle strips turned into triangles: each polyline point offset by its
@@ -281,6 +296,17 @@ export class Renderer {
       gl.uniform4f(this.uTint, 1, 1, 1, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightPoints);
       gl.drawElements(gl.POINTS, this.highlightPointCount, gl.UNSIGNED_INT, 0);
+    }
+    if (this.controlPointCount > 0) {
+      gl.uniform1f(this.uPoint, 4);
+      gl.uniform4f(this.uTint, 0.1, 0.9, 1, 1);
+      gl.drawArrays(gl.POINTS, 0, this.controlPointCount);
+    }
+    if (this.selectedPointCount > 0) {
+      gl.uniform1f(this.uPoint, 8);
+      gl.uniform4f(this.uTint, 1, 0.55, 0.05, 1);
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.selectedPoints);
+      gl.drawElements(gl.POINTS, this.selectedPointCount, gl.UNSIGNED_INT, 0);
     }
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
     gl.bindVertexArray(null);

@@ -11,13 +11,14 @@
 import { ApiError, Frame, getJson, postFrame, postJson } from './api';
 import { Renderer, Transform, softwareWebGL } from './gl';
 
-type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color';
+type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points';
 
 const TOOL_HELP: Record<Tool, string> = {
   pan: 'Pan: drag to move the view. The wheel zooms at the cursor with every tool; the image is re-refined for the new zoom when you stop.',
   select: 'Select: click to see what the other tools would pick there — the nearest feature (pink, its control chain) or control vertex, and the color region a click would change (white points). Changes nothing.',
   drag: 'Drag (as-rigid-as-possible): press on a feature (or a vertex, with "vertex" picked) and drag. The part near where you grabbed follows the mouse (σ sets how far along the feature), and the whole mesh deforms as rigidly as possible around it; the image border stays in place.',
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
+  points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
   color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
@@ -52,6 +53,9 @@ const state = {
   viewTimer: 0,
   measure: false,
   latencies: [] as number[],
+  control: new Float32Array(0),  // control positions of the level (image pixels), for the points tool
+  selection: [] as number[],     // the points tool's selected control vertices
+  box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean },
 };
 
 // A drag or move, from press to release. Its task (runDrag) holds the queue from the press
@@ -249,7 +253,9 @@ const loadView = () => enqueue(fetchView);
 
 async function loadControl() {
   const c = await getJson(`/api/control?level=${state.level}`);
-  renderer.setControl(new Float32Array(c.positions), new Uint32Array(c.edges));
+  state.control = new Float32Array(c.positions);
+  renderer.setControl(state.control, new Uint32Array(c.edges));
+  showPoints();
 }
 
 async function loadStrokes() {
@@ -265,7 +271,10 @@ function applyDelta(frame: Frame) {
   } else if (h.view) {
     void loadView();
   }
-  if (frame.f32.control.length > 0) renderer.setControl(frame.f32.control);
+  if (frame.f32.control.length > 0) {
+    state.control = new Float32Array(frame.f32.control);
+    renderer.setControl(state.control);
+  }
   if (h.strokes_changed) void loadStrokes().then(redraw);
 }
 
@@ -361,6 +370,112 @@ function setTool(tool: Tool) {
     b.classList.toggle('active', b.dataset.tool === tool));
   $('tool-help').textContent = TOOL_HELP[tool];
   canvas.classList.toggle('pan', tool === 'pan');
+  if (!renderer) return;  // at start, before the renderer
+  renderer.setHighlight([], []);
+  showPoints();
+  redraw();
+}
+
+// ---- the points tool: control points as direct handles --------------------------------------
+
+const POINT_HIT = 6;  // CSS pixels: a press this close to a point takes it
+function showPoints() {
+  renderer.setPoints(state.tool === 'points', state.selection);
+  $<HTMLButtonElement>('recolor-points').disabled = state.selection.length === 0;
+}
+function selectionLine() {
+  const n = state.selection.length;
+  return n ? `${n} control point${n === 1 ? '' : 's'} selected: drag one or use the arrow keys to move them` : 'no control point selected';
+}
+function setSelection(vertices: number[]) {
+  state.selection = [...new Set(vertices)].sort((a, b) => a - b);
+  showPoints();
+  redraw();
+}
+// The control point nearest to canvas point p within POINT_HIT CSS px, or -1.
+function pointAt(p: [number, number]): number {
+  const t = state.transform, dpr = window.devicePixelRatio || 1;
+  let best = -1, bestD = POINT_HIT * dpr;
+  for (let i = 0; i < state.control.length / 2; i++) {
+    const d = Math.hypot(state.control[2 * i] * t.zoom + t.panX - p[0], state.control[2 * i + 1] * t.zoom + t.panY - p[1]);
+    if (d <= bestD) bestD = d, best = i;
+  }
+  return best;
+}
+function pointsDown(e: PointerEvent) {
+  const p = canvasPoint(e);
+  const hit = pointAt(p);
+  if (hit >= 0 && state.selection.includes(hit) && !e.shiftKey) {
+    void dragStart(e);  // a press on the selection moves it
+    return;
+  }
+  if (hit >= 0) {
+    const s = state.selection;
+    setSelection(e.shiftKey ? (s.includes(hit) ? s.filter((v) => v !== hit) : [...s, hit]) : [hit]);
+    status(selectionLine());
+    if (!e.shiftKey) void dragStart(e);  // and a drag right away moves it
+    return;
+  }
+  state.box = { pointer: e.pointerId, from: p, to: p, add: e.shiftKey };
+  canvas.setPointerCapture(e.pointerId);
+  drawBox();
+}
+function drawBox() {
+  const box = $('box'), b = state.box;
+  box.hidden = !b;
+  if (!b) return;
+  const dpr = window.devicePixelRatio || 1;
+  const [x0, x1] = [b.from[0], b.to[0]].sort((a, c) => a - c), [y0, y1] = [b.from[1], b.to[1]].sort((a, c) => a - c);
+  Object.assign(box.style, { left: `${x0 / dpr}px`, top: `${y0 / dpr}px`, width: `${(x1 - x0) / dpr}px`, height: `${(y1 - y0) / dpr}px` });
+}
+function boxEnd(e: PointerEvent | null, cancel = false) {
+  const b = state.box;
+  if (!b || (e && e.pointerId !== b.pointer)) return;
+  if (e) b.to = canvasPoint(e);
+  state.box = null;
+  drawBox();
+  if (cancel) return;
+  const t = state.transform;
+  const [x0, x1] = [b.from[0], b.to[0]].sort((a, c) => a - c), [y0, y1] = [b.from[1], b.to[1]].sort((a, c) => a - c);
+  const inside: number[] = [];
+  for (let i = 0; i < state.control.length / 2; i++) {
+    const x = state.control[2 * i] * t.zoom + t.panX, y = state.control[2 * i + 1] * t.zoom + t.panY;
+    if (x >= x0 && x <= x1 && y >= y0 && y <= y1) inside.push(i);
+  }
+  setSelection(b.add ? [...state.selection, ...inside] : inside);
+  status(selectionLine());
+}
+// An arrow-key nudge of the selection: one edit each, queued.
+function nudge(dx: number, dy: number) {
+  if (!state.selection.length) {
+    status('select control points first: click one, or drag a box around several');
+    return;
+  }
+  const vertices = state.selection.slice(), level = state.level;
+  const region = dragExtent().region;
+  void edit(async () => {
+    const f = await postFrame('/api/points/move', {
+      session: state.session, version: state.version, level, vertices, translate: [dx, dy], region,
+    });
+    applyDelta(f);
+    status(f.header.log);
+  });
+}
+// Color per control point: the selection's color values take the picked color.
+function recolorPoints() {
+  if (!state.selection.length) {
+    status('select control points first (the points tool, P)');
+    return;
+  }
+  const vertices = state.selection.slice(), level = state.level;
+  void edit(async () => {
+    const f = await postFrame('/api/color', {
+      session: state.session, version: state.version, level, select: 'vertices', vertices,
+      mode: mode(), color: hexColor(), amount: num('amount'),
+    });
+    applyDelta(f);
+    status(f.header.log);
+  });
 }
 
 // Select changes nothing, so it skips the queue; of quick clicks, the last one's answer shows.
@@ -613,6 +728,7 @@ async function doSave() {
 async function setLevel(level: number) {
   if (!state.doc || level < 0 || level >= state.doc.levels.length || level === state.level) return;
   state.level = level;
+  state.selection = [];  // a level's own vertices
   $<HTMLInputElement>('level').value = String(level);
   describeLevel();
   renderer.setHighlight([], []);
@@ -643,13 +759,16 @@ function dragStart(e: PointerEvent) {
 async function runDrag(drag: Drag) {
   if (drag.released && !drag.moved) return;  // a click, released before its turn came
   try {
+    const points = state.tool === 'points';
     const r = await postJson('/api/drag/start', {
       session: state.session, version: state.version, level: state.level, tool: state.tool,
       select: state.tool === 'move' ? 'feature' : dragPick(), at: drag.start, ...dragExtent(),
+      ...(points ? { vertices: state.selection } : {}),
     });
     renderer.setHighlight(r.chain, r.vertex >= 0 ? [r.vertex] : []);
     drag.ok = true;
-    status(`dragging ${r.feature >= 0 ? 'a feature' : 'a control point'}; ` +
+    const n = state.selection.length;
+    status(`dragging ${points ? `${n} control point${n === 1 ? '' : 's'}` : r.feature >= 0 ? 'a feature' : 'a control point'}; ` +
       (r.region > 0 ? `the image follows within ${Math.round(r.region)} px` : 'the whole image follows'));
   } catch (e) {
     if (state.drag === drag) state.drag = null;
@@ -663,7 +782,7 @@ async function runDrag(drag: Drag) {
     try {
       await postJson('/api/drag/cancel', { session: state.session });
       if (drag.previewed) await Promise.all([fetchView(), loadControl()]);
-      status(commit ? 'a click: press and drag to move' : 'drag cancelled');
+      status(!commit ? 'drag cancelled' : state.tool === 'points' ? selectionLine() : 'a click: press and drag to move');
     } catch (e) {
       await reportError(e);
     }
@@ -767,6 +886,7 @@ canvas.addEventListener('pointerdown', (e) => {
   }
   if (state.tool === 'select') void doSelect(at);
   else if (state.tool === 'color') void doColor(at);
+  else if (state.tool === 'points') pointsDown(e);
   else void dragStart(e);
 });
 canvas.addEventListener('pointermove', (e) => {
@@ -784,6 +904,11 @@ canvas.addEventListener('pointermove', (e) => {
     scheduleView();
     return;
   }
+  if (state.box && e.pointerId === state.box.pointer) {
+    state.box.to = canvasPoint(e);
+    drawBox();
+    return;
+  }
   dragMove(e);
 });
 const release = (e: PointerEvent) => {
@@ -791,14 +916,19 @@ const release = (e: PointerEvent) => {
     state.pan = null;
     return;
   }
+  if (state.box) {
+    boxEnd(e);
+    return;
+  }
   dragEnd(e);
 };
 canvas.addEventListener('pointerup', release);
-canvas.addEventListener('pointercancel', (e) => { state.pan = null; dragEnd(e, true); });
+canvas.addEventListener('pointercancel', (e) => { state.pan = null; boxEnd(e, true); dragEnd(e, true); });
 // A capture lost without a pointerup (the browser took it away): the drag ends there, so that its
 // task, which holds the queue, cannot wait for a release that never comes.
 canvas.addEventListener('lostpointercapture', (e) => {
   if (state.drag && e.pointerId === state.drag.pointer) dragEnd(e);
+  if (state.box && e.pointerId === state.box.pointer) boxEnd(e);
 });
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
 canvas.addEventListener('wheel', (e) => {
@@ -827,7 +957,16 @@ window.addEventListener('keydown', (e) => {
   if (ctrl || e.altKey) return;
   if (e.key === 'Tab' && document.activeElement === document.body) { e.preventDefault(); togglePanel(); return; }
   if (e.key === ' ') { state.space = true; canvas.classList.add('pan'); e.preventDefault(); return; }
-  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color' };
+  const arrows: Record<string, [number, number]> = { arrowleft: [-1, 0], arrowright: [1, 0], arrowup: [0, -1], arrowdown: [0, 1] };
+  if (arrows[key] && state.tool === 'points') {
+    e.preventDefault();
+    const step = e.shiftKey ? 10 : 1;
+    nudge(arrows[key][0] * step, arrows[key][1] * step);
+    return;
+  }
+  if (key === 'r') { recolorPoints(); return; }
+  if (key === 'escape' && state.tool === 'points' && !state.drag && state.selection.length) { setSelection([]); status('selection cleared'); return; }
+  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points' };
   if (tools[key]) { setTool(tools[key]); return; }
   if (key === 'f') { toggleRadio('pick'); return; }
   if (key === 'b') { toggleRadio('mode'); return; }
@@ -892,6 +1031,7 @@ function wireControls() {
     }
   });
   $('eyedropper').addEventListener('click', () => status('point at the image and press I to take its color'));
+  $('recolor-points').addEventListener('click', () => recolorPoints());
   $('panel-toggle').addEventListener('click', () => togglePanel());
   canvas.addEventListener('pointerdown', () => togglePanel(false));
   $('undo').addEventListener('click', () => void doHistory('undo'));

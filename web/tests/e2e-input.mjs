@@ -247,6 +247,64 @@ try {
   check('resize: after a zoom the view is kept', !zoomed.fitted && kept.zoom === zoomed.zoom, JSON.stringify([zoomed, kept]));
   await page.setViewportSize({ width: 1000, height: 700 });
 
+  // Direct handles: the points tool shows the control points; a box selects the ones inside it,
+  // Shift+click takes one out; the arrow keys nudge the selection (one edit each), a drag of a
+  // selected point moves them all, R recolors them; undo takes each back.
+  await page.keyboard.press('0');
+  await idle(page);
+  const control = () => page.evaluate(async () => (await (await fetch(`/api/control?level=${window.subvec.state.level}`)).json()).positions);
+  const rest = await control();
+  const inBox = (pos, x0, y0, x1, y1) => Array.from({ length: pos.length / 2 }, (_, i) => i)
+    .filter((i) => pos[2 * i] >= x0 && pos[2 * i] <= x1 && pos[2 * i + 1] >= y0 && pos[2 * i + 1] <= y1);
+  const boxed = inBox(rest, 60, 30, 90, 66);  // the right-hand side of the disk's outline
+  await page.keyboard.press('p');
+  const handle = await pixel(page, rest[2 * boxed[0]], rest[2 * boxed[0] + 1]);
+  check('points: the control points are drawn', diff(handle, [26, 230, 255]) < 40 || diff(handle, [255, 140, 13]) < 40, `${handle}`);
+  const v1 = (await doc()).version;
+  await sweep([58, 28], [92, 68], 6, true);
+  await page.mouse.up();
+  await idle(page);
+  let selection = await page.evaluate(() => window.subvec.state.selection);
+  check(`points: a box selects the ${boxed.length} points inside it`, boxed.length >= 3 &&
+    JSON.stringify(selection) === JSON.stringify(boxed), `${selection} vs ${boxed}`);
+  const [ox, oy] = await client(page, rest[2 * boxed[0]], rest[2 * boxed[0] + 1]);
+  await page.keyboard.down('Shift');
+  await page.mouse.click(ox, oy);
+  await page.keyboard.up('Shift');
+  selection = await page.evaluate(() => window.subvec.state.selection);
+  check('points: Shift+click takes a point out', selection.length === boxed.length - 1 && !selection.includes(boxed[0]), `${selection}`);
+  for (let i = 0; i < 3; i++) await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('Shift+ArrowUp');
+  await idle(page);
+  d = await doc();
+  let now = await control();
+  const shifted = (i, dx, dy) => Math.abs(now[2 * i] - rest[2 * i] - dx) < 1e-3 && Math.abs(now[2 * i + 1] - rest[2 * i + 1] - dy) < 1e-3;
+  check('points: arrow keys nudge the selection, one edit each', d.version === v1 + 4 &&
+    selection.every((i) => shifted(i, 3, -10)) && shifted(boxed[0], now[2 * boxed[0]] - rest[2 * boxed[0]], now[2 * boxed[0] + 1] - rest[2 * boxed[0] + 1]) &&
+    /^moved \d+ control points by \(0, -10\) px$/.test(d.status), `version ${v1} -> ${d.version}, status "${d.status}"`);
+  const grab = [now[2 * selection[0]], now[2 * selection[0] + 1]];
+  await drag(grab, [grab[0] - 6, grab[1] + 4]);
+  d = await doc();
+  now = await control();
+  check('points: a drag of a selected point moves the selection', d.version === v1 + 5 &&
+    selection.every((i) => Math.hypot(now[2 * i] - rest[2 * i] + 3, now[2 * i + 1] - rest[2 * i + 1] + 6) < 0.6) &&
+    /^moved \d+ control points by \(-6, 4\) px$/.test(d.status), `status "${d.status}"`);
+  await page.locator('#color-text').fill('#ff0000');
+  await page.locator('#color-text').press('Enter');
+  await page.evaluate(() => { const el = document.getElementById('amount'); el.value = '1'; el.dispatchEvent(new Event('input')); document.activeElement.blur(); });
+  await page.keyboard.press('r');
+  await idle(page);
+  d = await doc();
+  check('points: R recolors the selected points', d.version === v1 + 6 &&
+    new RegExp(`^color blend of ${selection.length} control points: \\d+ control colors moved toward \\(255, 0, 0\\)$`).test(d.status), `status "${d.status}"`);
+  await page.keyboard.press('Escape');
+  check('points: Esc clears the selection', (await page.evaluate(() => window.subvec.state.selection.length)) === 0);
+  for (let i = 0; i < 6; i++) await page.keyboard.press('Control+z');
+  await idle(page);
+  const back = await control();
+  check('points: undo takes the moves back', (await doc()).version === v1 + 12 && back.every((v, i) => Math.abs(v - rest[i]) < 1e-4));
+  await page.keyboard.press('d');
+
   // Problem 11: two tabs. Another tab's edit during a drag does not throw the drag away, and undo
   // takes back a tab's own edits only.
   await page.keyboard.press('0');

@@ -1,11 +1,13 @@
-// The screenshot in docs/serve.md: the butterfly of docs/editing.md edited in the page with the
+// The screenshots in docs/serve.md: the butterfly of docs/editing.md edited in the page with the
 // mouse (the first drag and the first TRANSFORM of docs/figures/butterfly-ops.json), the feature
-// overlay on, the dragged feature selected.
+// overlay on, the dragged feature selected; then, when asked for, a region fill of the black
+// wings with the preview of the next click, and a box selection of control points.
 //
-//   node web/tests/screenshot.mjs BUILD/bin/subvec docs/figures/serve-editor.jpg
+//   node web/tests/screenshot.mjs BUILD/bin/subvec docs/figures/serve-editor.jpg \
+//       [docs/figures/serve-fill.jpg docs/figures/serve-points.jpg]
 import { findChromium, launch, serve, stop, openEditor, idle, client } from './harness.mjs';
 
-const [binary, out] = process.argv.slice(2);
+const [binary, out, fillOut, pointsOut] = process.argv.slice(2);
 const server = await serve(binary, ['docs/figures/butterfly.svec']);
 const browser = await launch(findChromium());
 try {
@@ -32,7 +34,7 @@ try {
   // TRANSFORM the white patch of the left wing to yellow.
   await page.keyboard.press('c');
   await page.keyboard.press('b');  // blend -> transform
-  await page.keyboard.press('f');  // feature -> vertex
+  await page.locator('input[name=pick][value=vertex]').check();
   await page.locator('#color').fill('#ffbe14');
   await page.evaluate(() => {
     const el = document.getElementById('radius');
@@ -47,6 +49,48 @@ try {
   await page.evaluate(() => { document.getElementById('panel').scrollTop = 0; });
   await page.waitForTimeout(300);
   await page.screenshot({ path: out });
+  if (fillOut) {
+    // A fill: the region pick, one click on a black wing; the mouse then rests on the other
+    // wing's white spot, whose region (white points) a click would change.
+    await page.evaluate(() => document.getElementById('show-features').click());
+    await page.keyboard.press('c');
+    await page.keyboard.press('b');  // transform -> blend
+    await page.locator('input[name=pick][value=region]').check();
+    await page.evaluate(() => {
+      for (const [id, v] of [['radius', '201'], ['amount', '0.85']]) {
+        const el = document.getElementById(id);
+        el.value = v;
+        el.dispatchEvent(new Event('input'));
+      }
+    });
+    await page.locator('#color').fill('#c81e3c');
+    const [wx, wy] = await client(page, 400, 180);
+    await page.mouse.click(wx, wy);
+    await idle(page);
+    const [sx, sy] = await client(page, 330, 185);
+    await page.mouse.move(sx, sy, { steps: 4 });
+    await page.waitForTimeout(600);
+    await page.screenshot({ path: fillOut });
+  }
+  if (pointsOut) {
+    // A box selection of control points, the box still held.
+    await page.keyboard.press('p');
+    const [bx, by] = await client(page, 250, 90), [ex, ey] = await client(page, 330, 150);
+    await page.mouse.move(bx, by);
+    await page.mouse.down();
+    await page.mouse.move(ex, ey, { steps: 6 });
+    await page.mouse.up();
+    await idle(page);
+    const [cx2, cy2] = await client(page, 230, 200), [dx2, dy2] = await client(page, 300, 245);
+    await page.keyboard.down('Shift');
+    await page.mouse.move(cx2, cy2);
+    await page.mouse.down();
+    await page.mouse.move(dx2, dy2, { steps: 6 });
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: pointsOut });
+    await page.mouse.up();
+    await page.keyboard.up('Shift');
+  }
 } finally {
   await browser.close();
   await stop(server);

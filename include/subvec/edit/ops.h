@@ -20,6 +20,7 @@ struct EditOp {
     kDrag,         // from -> to, select vertex (one vertex) or feature (Gaussian falloff, sigma)
     kMoveFeature,  // at; translate, rotate (degrees)
     kColor,        // at; mode, select, radius, tolerance (region), color, amount (blend)
+    kMoveVertices, // vertices, translate (the editor's direct handles)
   };
   Kind kind = Kind::kDrag;
   int level = 0;
@@ -35,8 +36,10 @@ struct EditOp {
   double tolerance = kDefaultRegionTolerance;  // color of a region: CIELAB distance from the seed
   Color color;            // color: the new color, 0-255
   double amount = 0.5;    // color blend: 0 keeps the old color, 1 paints the new one
+  std::vector<int32_t> vertices;  // move-vertices; color with select "vertices"
 
-  // "drag vertex", "drag feature", "move-feature", "color blend", "color transform".
+  // "drag vertex", "drag feature", "move-feature", "color blend", "color transform",
+  // "move-vertices".
   std::string name() const;
 };
 

@@ -39,12 +39,14 @@ namespace subvec {
 
 // What a click selects: the nearest control vertex, the nearest feature, or the region around the
 // click (color edits and the editor's Select tool; drags take a vertex or a feature).
-enum class EditSelect { kVertex, kFeature, kRegion };
+// kVertices: a list of control vertices the user selected (the editor's direct handles).
+enum class EditSelect { kVertex, kFeature, kRegion, kVertices };
 
-// "vertex", "feature" or "region"; nullopt for any other name. kEditSelectNames lists them for
-// error messages.
+// "vertex", "feature", "region" or "vertices"; nullopt for any other name. kEditSelectNames lists
+// them for error messages.
 std::optional<EditSelect> edit_select_from_name(std::string_view name);
-inline constexpr std::string_view kEditSelectNames = R"("vertex", "feature" or "region")";
+inline constexpr std::string_view kEditSelectNames =
+    R"("vertex", "feature", "region" or "vertices")";
 
 // One smooth piece of a feature's limit curve (mesh/curves.h): the feature chain split at its
 // corner vertices (junctions, a tear meeting a crease or the border), which the curve interpolates.
@@ -102,8 +104,15 @@ ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at,
                                     double radius = std::numeric_limits<double>::infinity(),
                                     double tolerance = kDefaultRegionTolerance);
 
-// The selection a color edit makes: one of the three above. `tolerance` is the region's only.
+// Every color value of the given control vertices (all sides of a vertex on a tear): color editing
+// per control point. The seed is the first vertex and its first value. Throws
+// Error(kInvalidArgument) for an empty list or an index out of range.
+ColorSelection select_vertices_colors(const ControlMesh& mesh, std::span<const int32_t> vertices);
+
+// The selection a color edit makes: one of the four above. `tolerance` is the region's only,
+// `vertices` the list's.
 ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topology,
-                             EditSelect select, Vec2 at, double radius, double tolerance);
+                             EditSelect select, Vec2 at, double radius, double tolerance,
+                             std::span<const int32_t> vertices = {});
 
 }  // namespace subvec

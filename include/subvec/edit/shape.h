@@ -55,6 +55,11 @@ Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 cente
 Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 translate,
                      double degrees);
 
+// A selection of control vertices translated by `translate` (the editor's direct handles: a box
+// selection dragged or nudged with the arrow keys). Throws Error(kInvalidArgument) for an empty
+// selection, an index out of range or one given twice.
+Handles move_vertices(const ControlMesh& mesh, std::span<const int32_t> vertices, Vec2 translate);
+
 // The extent of a drag the user leaves to the editor (issue 29): an influence local to what was
 // grabbed, so that a small shape moves without the rest of the picture. For a feature, sigma is a
 // quarter of its control polygon's length, within [8, 60] pixels, or, for a closed feature whose
@@ -67,6 +72,8 @@ struct DragExtent {
   double region = 0;
 };
 DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex);
+// For a selection of vertices: the largest of their regions (sigma is unused).
+DragExtent suggested_drag_extent(const ControlMesh& mesh, std::span<const int32_t> vertices);
 
 // Carries points through a shape edit: each point keeps its barycentric coordinates in the control
 // triangle of `triangles` that holds it at `rest` and takes them to the same triangle at `moved`

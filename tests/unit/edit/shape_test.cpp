@@ -210,7 +210,55 @@ TEST(EditOps, RegionFillsParseAndApply) {
   refused(R"([{"op":"drag","from":[1,1],"to":[2,2],"select":"region"}])",
           "expected \"vertex\" or \"feature\", got \"region\"");
   refused(R"([{"op":"color","mode":"blend","at":[1,1],"select":"blob","color":[0,0,0]}])",
-          "expected \"vertex\", \"feature\" or \"region\", got \"blob\"");
+          "expected \"vertex\", \"feature\", \"region\" or \"vertices\", got \"blob\"");
+}
+
+// Direct handles: "move-vertices" moves the listed control points by exactly the translation
+// (interior ones; border ones slide along their side), keeps the rest of the frame, and colors
+// per control point take every side's value. Bad lists are refused naming the key.
+TEST(EditOps, MoveVerticesAndColorPerControlPoint) {
+  VectorImage img = image_with_features();
+  const ControlMesh before = img.levels[0];
+  std::vector<int32_t> interior;
+  for (int v = 0; v < before.num_vertices() && interior.size() < 3; ++v) {
+    const Vec2 p = before.positions[v];
+    if (p.x > 10 && p.y > 10 && p.x < img.width - 10 && p.y < img.height - 10) interior.push_back(v);
+  }
+  ASSERT_EQ(interior.size(), 3u);
+  const std::string list = "[" + std::to_string(interior[0]) + "," + std::to_string(interior[1]) + "," +
+                           std::to_string(interior[2]) + "]";
+  const std::vector<EditOp> ops = parse_edit_ops(
+      R"([{"op":"move-vertices","vertices":)" + list + R"(,"translate":[1.5,-2],"region":40},
+          {"op":"color","mode":"blend","select":"vertices","vertices":)" + list + R"(,"color":[0,255,0],"amount":1}])");
+  const std::vector<std::string> log = apply_edit_ops(img, ops);
+  EXPECT_NE(log[0].find("3 control points moved by [1.5, -2]"), std::string::npos) << log[0];
+  const ControlMesh& after = img.levels[0];
+  for (const int32_t v : interior) {
+    EXPECT_DOUBLE_EQ(after.positions[v].x, before.positions[v].x + 1.5);
+    EXPECT_DOUBLE_EQ(after.positions[v].y, before.positions[v].y - 2);
+  }
+  const ColorSelection s = select_vertices_colors(after, interior);
+  for (int c = 0; c < after.num_colors(); ++c) {
+    const bool in = std::binary_search(s.colors.begin(), s.colors.end(), c);
+    EXPECT_EQ(after.colors[c] == (Color{0, 255, 0}), in) << c;
+    if (!in) EXPECT_EQ(after.colors[c], before.colors[c]);
+  }
+  EXPECT_GE(s.colors.size(), 3u);
+  auto refused = [](const std::string& json, const char* part) {
+    try {
+      (void)parse_edit_ops(json);
+      ADD_FAILURE() << json;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  refused(R"([{"op":"move-vertices","vertices":[],"translate":[1,1]}])", "expected a non-empty array");
+  refused(R"([{"op":"move-vertices","vertices":[2,2],"translate":[1,1]}])", "vertex 2 is listed twice");
+  refused(R"([{"op":"move-vertices","vertices":[-1],"translate":[1,1]}])", "expected vertex indices");
+  refused(R"([{"op":"move-vertices","vertices":[1]}])", "missing key \"translate\"");
+  refused(R"([{"op":"color","mode":"blend","select":"vertices","color":[0,0,0]}])", "missing key \"vertices\"");
+  const std::vector<EditOp> far = parse_edit_ops(R"([{"op":"move-vertices","vertices":[100000],"translate":[1,1]}])");
+  EXPECT_THROW(apply_edit_ops(img, far), Error);
 }
 
 TEST(Shape, FeatureDragMeetsItsConstraintsAndIsMoreRigidThanTheFalloffAlone) {

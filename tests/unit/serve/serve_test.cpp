@@ -466,6 +466,56 @@ TEST_F(ServeHttp, RegionSelectAndColorAgree) {
   EXPECT_EQ(drag->status, 400) << drag->body;
 }
 
+// The points tool over HTTP: a nudge (/api/points/move) and a drag of a selection ("tool":
+// "points") move exactly the listed vertices by the asked amount, color per control point takes
+// "select": "vertices", and bad lists are 400 or 422.
+TEST_F(ServeHttp, PointsMoveNudgeAndRecolor) {
+  auto session = client_->Post("/api/session", "{}", "application/json");
+  ASSERT_TRUE(session);
+  const std::string id = body(session)["session"];
+  const VectorImage original = disk();
+  const ControlMesh& m = original.levels[0];
+  std::vector<int32_t> inner;
+  for (int v = 0; v < m.num_vertices() && inner.size() < 2; ++v)
+    if (m.positions[v].x > 30 && m.positions[v].x < 66 && m.positions[v].y > 30 && m.positions[v].y < 66) inner.push_back(v);
+  ASSERT_EQ(inner.size(), 2u);
+  const auto positions = [&] {
+    auto c = client_->Get("/api/control?level=0");
+    return body(c)["positions"].get<std::vector<double>>();
+  };
+  auto post = [&](const char* path, const json& j) { return client_->Post(path, j.dump(), "application/json"); };
+  auto r = post("/api/points/move", {{"session", id}, {"version", 1}, {"vertices", inner}, {"translate", {2, 1}}, {"region", "auto"}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->body.find("moved 2 control points by (2, 1) px"), std::string::npos);
+  std::vector<double> p = positions();
+  for (const int32_t v : inner) {
+    EXPECT_NEAR(p[2 * v], m.positions[v].x + 2, 1e-4);
+    EXPECT_NEAR(p[2 * v + 1], m.positions[v].y + 1, 1e-4);
+  }
+  const Vec2 grab{p[2 * inner[0]], p[2 * inner[0] + 1]};
+  r = post("/api/drag/start", {{"session", id}, {"version", 2}, {"tool", "points"}, {"vertices", inner}, {"at", {grab.x, grab.y}}, {"region", "auto"}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  r = post("/api/drag/end", {{"session", id}, {"version", 2}, {"to", {grab.x - 3, grab.y}}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->body.find("moved 2 control points by (-3, 0) px"), std::string::npos);
+  p = positions();
+  EXPECT_NEAR(p[2 * inner[1]], m.positions[inner[1]].x - 1, 1e-4);
+  r = post("/api/color", {{"session", id}, {"version", 3}, {"select", "vertices"}, {"vertices", inner}, {"color", {0, 0, 255}}, {"amount", 1}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->body.find("color blend of 2 control points"), std::string::npos);
+  r = post("/api/points/move", {{"session", id}, {"version", 4}, {"vertices", json::array()}, {"translate", {1, 1}}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400);
+  r = post("/api/points/move", {{"session", id}, {"version", 4}, {"vertices", {100000}}, {"translate", {1, 1}}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 422) << r->body;
+  EXPECT_NE(r->body.find("out of range"), std::string::npos);
+}
+
 TEST_F(ServeHttp, SaveWritesOnlyTheNamedFile) {
   const fs::path out = dir_ / "out.svec";
   EXPECT_FALSE(fs::exists(out));
