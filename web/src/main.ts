@@ -53,6 +53,8 @@ const state = {
   viewTimer: 0,
   measure: false,
   latencies: [] as number[],
+  phases: [] as number[][],
+  clicks: [] as number[],        // per measured color click: click to frame drawn, ms      // per measured preview: [event to send, request, update + draw] ms
   control: new Float32Array(0),  // control positions of the level (image pixels), for the points tool
   selection: [] as number[],     // the points tool's selected control vertices
   box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean },
@@ -267,7 +269,9 @@ function applyDelta(frame: Frame) {
   if (typeof h.version === 'number') state.version = h.version;
   if (h.view === state.view.id) {
     renderer.updatePositions(h.dense_positions ? null : frame.u32.position_indices, frame.f32.positions);
-    renderer.updateColors(h.dense_colors ? null : frame.u32.color_indices, frame.u8.colors);
+    if (frame.u8.colors.length > 0 || h.dense_colors) {
+      renderer.updateColors(h.dense_colors ? null : frame.u32.color_indices, frame.u8.colors);
+    }
   } else if (h.view) {
     void loadView();
   }
@@ -338,17 +342,20 @@ async function refreshCounts() {
 
 // Runs an edit inside a task: on a version conflict (another tab's edit) reloads from the server,
 // on other errors reports them.
-async function runEdit(run: () => Promise<void>) {
+// `run` returns true when it drew the result itself: no second frame then.
+async function runEdit(run: () => Promise<void | boolean>) {
+  let drawn = false;
   try {
-    await run();
+    drawn = (await run()) === true;
     await refreshCounts();
   } catch (e) {
+    drawn = false;
     await reportError(e);
   } finally {
-    redraw();
+    if (!drawn) redraw();
   }
 }
-const edit = (run: () => Promise<void>) => enqueue(() => runEdit(run));
+const edit = (run: () => Promise<void | boolean>) => enqueue(() => runEdit(run));
 
 async function reportError(e: unknown) {
   if (e instanceof ApiError && e.status === 409 && /document changed in another tab/.test(e.message)) {
@@ -526,6 +533,7 @@ function eyedropper() {
 // in flight; the latest position wins).
 let previewWanted: [number, number] | null = null;
 let previewBusy = false;
+let previewEpoch = 0;  // a click starts a new one: an answer from before it is stale
 function previewRegion(at: [number, number]) {
   previewWanted = at;
   if (previewBusy) return;
@@ -533,10 +541,11 @@ function previewRegion(at: [number, number]) {
   void (async () => {
     try {
       while (previewWanted) {
-        const p = previewWanted;
+        const p = previewWanted, epoch = previewEpoch;
         previewWanted = null;
         const r = await postJson('/api/select', { level: state.level, at: p, ...colorPick() });
         if (state.tool !== 'color' || state.drag) break;
+        if (epoch !== previewEpoch) continue;  // a click came first: nothing to draw for this
         renderer.setHighlight([], r.region);
         status(`a click here changes the ${r.colors} control colors shown white`);
         redraw();
@@ -554,15 +563,27 @@ function hexColor(): number[] {
   return [1, 3, 5].map((i) => parseInt(v.slice(i, i + 2), 16));
 }
 
-async function doColor(at: [number, number]) {
+async function doColor(at: [number, number], eventTime = performance.now()) {
+  previewEpoch++;
+  previewWanted = null;
   await edit(async () => {
+    const sent = performance.now();
     const f = await postFrame('/api/color', {
       session: state.session, version: state.version, level: state.level, at, ...colorPick(),
       mode: mode(), color: hexColor(), amount: num('amount'),
     });
+    const answered = performance.now();
     applyDelta(f);
     renderer.setHighlight([], []);  // the result unobstructed; the next move previews again
+    // Drawn now, not at the next animation frame after the history counts come back.
+    renderer.draw(state.transform, state.overlays);
+    if (state.measure) {
+      renderer.readPixel(0, 0);  // waits until the frame is drawn
+      state.clicks.push(performance.now() - eventTime);
+      state.phases.push([sent - eventTime, answered - sent, performance.now() - answered]);
+    }
     status(f.header.log);
+    return true;  // drawn
   });
 }
 
@@ -810,15 +831,20 @@ function pump(drag: Drag) {
   if (!drag.ok || drag.inFlight || !drag.pending || drag.released) return;
   drag.pending = false;
   const eventTime = drag.eventTime;
+  const sent = performance.now();
   drag.inFlight = (async () => {
     try {
       const f = await postFrame('/api/drag/move', { session: state.session, to: drag.target, rotate: drag.rotate });
+      const answered = performance.now();
       applyDelta(f);
       drag.previewed = true;
       renderer.draw(state.transform, state.overlays);
       if (state.measure) {
         renderer.readPixel(0, 0);  // waits until the frame is drawn
-        state.latencies.push(performance.now() - eventTime);
+        const drawn = performance.now();
+        state.latencies.push(drawn - eventTime);
+        // Where the time went: the event to its handler, the request, the update and the draw.
+        state.phases.push([sent - eventTime, answered - sent, drawn - answered]);
       }
       status('dragging');
     } catch (e) {
@@ -885,7 +911,7 @@ canvas.addEventListener('pointerdown', (e) => {
     return;
   }
   if (state.tool === 'select') void doSelect(at);
-  else if (state.tool === 'color') void doColor(at);
+  else if (state.tool === 'color') void doColor(at, e.timeStamp || performance.now());
   else if (state.tool === 'points') pointsDown(e);
   else void dragStart(e);
 });
@@ -1126,8 +1152,10 @@ window.subvec = {
     return [r.left + (x * t.zoom + t.panX) / dpr, r.top + (y * t.zoom + t.panY) / dpr];
   },
   idle() { return state.busy === 0 && !state.drag && downloads === 0; },
-  measure(on: boolean) { state.measure = on; state.latencies = []; },
+  measure(on: boolean) { state.measure = on; state.latencies = []; state.phases = []; state.clicks = []; },
+  clicks() { return state.clicks.slice(); },
   latencies() { return state.latencies.slice(); },
+  phases() { return state.phases.slice(); },
 };
 
 async function main() {

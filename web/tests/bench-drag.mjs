@@ -7,7 +7,8 @@
 //
 // Grabs the longest feature at its middle vertex and drags it in N one-pixel steps, one at a
 // time (each move waits for its frame, so latencies do not queue). Prints the latencies' median,
-// 90th percentile and maximum, and the size of what was drawn.
+// 90th percentile and maximum, and the size of what was drawn; then the same for --clicks color
+// clicks (default 15; the page's default region fill) at points spread over the image.
 import { findChromium, launch, serve, stop, openEditor, client } from './harness.mjs';
 
 const [binary, input, ...rest] = process.argv.slice(2);
@@ -71,6 +72,30 @@ try {
     `canvas ${view.canvas[0]}x${view.canvas[1]}, refinement depth ${view.depth} (${info.triangles * 4 ** view.depth} triangles drawn; ${view.zoom})`);
   console.log(`drag redraw, ${latencies.length} moves: median ${q(0.5).toFixed(1)} ms, p90 ${q(0.9).toFixed(1)} ms, ` +
     `max ${sorted[sorted.length - 1].toFixed(1)} ms`);
+  const phases = await page.evaluate(() => window.subvec.phases());
+  const median = (k) => phases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(phases.length / 2)];
+  console.log(`  medians: event to request ${median(0).toFixed(1)} ms, request ${median(1).toFixed(1)} ms, ` +
+    `update and draw ${median(2).toFixed(1)} ms`);
+
+  // Color clicks with the page's defaults (a region fill), at points spread over the image, one at
+  // a time: from the click to the recolored frame drawn.
+  const clicks = opt('--clicks', 15);
+  await page.keyboard.press('c');
+  await page.evaluate(() => window.subvec.measure(true));
+  for (let i = 1; i <= clicks; ++i) {
+    const [x, y] = await client(page, info.size[0] * (0.15 + 0.7 * ((i * 0.618) % 1)), info.size[1] * (0.15 + 0.7 * ((i * 0.382) % 1)));
+    await page.mouse.click(x, y);
+    await page.waitForFunction((n) => window.subvec.clicks().length >= n, i, { timeout: 30000 });
+    await page.waitForFunction(() => window.subvec.idle());
+  }
+  const taken = (await page.evaluate(() => window.subvec.clicks())).sort((a, b) => a - b);
+  const cq = (p) => taken[Math.min(taken.length - 1, Math.floor(p * taken.length))];
+  console.log(`color click, ${taken.length} clicks: median ${cq(0.5).toFixed(1)} ms, p90 ${cq(0.9).toFixed(1)} ms, ` +
+    `max ${taken[taken.length - 1].toFixed(1)} ms`);
+  const clickPhases = await page.evaluate(() => window.subvec.phases());
+  const cm = (k) => clickPhases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(clickPhases.length / 2)];
+  console.log(`  medians: click to request ${cm(0).toFixed(1)} ms, request ${cm(1).toFixed(1)} ms, ` +
+    `update and draw ${cm(2).toFixed(1)} ms`);
 } finally {
   await browser.close();
   await stop(server);
