@@ -30,6 +30,7 @@ struct Editor::View {
   int num_control_vertices = 0;
   int64_t version = 0;     // the document version it shows
   bool preview = false;    // it holds a drag preview's positions, not the document's
+  double scale = 1;        // canvas pixels per image pixel (ViewRequest::scale)
 };
 
 struct Editor::Session {
@@ -326,6 +327,7 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
   refined.crease_edges = {};
   refined.border_edges = {};
   refined.tear_edges = {};
+  v->scale = request.scale > 0 && std::isfinite(request.scale) ? request.scale : 1;
   v->mesh.id = next_view_++;
   v->mesh.level = request.level;
   v->mesh.depth = v->limit.faces.depth;
@@ -355,10 +357,16 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
     if (colors) v.limit.subdivision->evaluate_colors(mesh.colors, refined.colors);
   }
   const size_t ng = v.gl_vertex.size();
+  // A preview leaves out the vertices that moved less than 1/32 of a canvas pixel from what the
+  // page shows (v.mesh.positions is that): no one sees it, and a drag's smooth falloff moves most
+  // of the region by less. They go as soon as their drift reaches it, and the drag's end sends
+  // every change exactly.
+  const float slack = preview ? static_cast<float>(1 / (32 * v.scale)) : 0.0f;
   for (size_t g = 0; g < ng; ++g) {
     const size_t rv = static_cast<size_t>(v.gl_vertex[g]);
     const float x = refined.positions[2 * rv], y = refined.positions[2 * rv + 1];
-    if (x != v.mesh.positions[2 * g] || y != v.mesh.positions[2 * g + 1]) {
+    const float dx = std::abs(x - v.mesh.positions[2 * g]), dy = std::abs(y - v.mesh.positions[2 * g + 1]);
+    if (preview ? (dx > slack || dy > slack) : (dx != 0 || dy != 0)) {
       v.mesh.positions[2 * g] = x;
       v.mesh.positions[2 * g + 1] = y;
       delta.position_indices.push_back(static_cast<uint32_t>(g));

@@ -162,28 +162,52 @@ TEST(ServeEditor, ADragOutlivesAnotherTabsEdit) {
   EXPECT_EQ(editor.snapshot().first.levels[0].colors, after_b.levels[0].colors);  // b's edit kept
 }
 
-// The committed drag is exactly what `subvec edit` makes of the same operation, and the last
-// preview the page drew is that result.
+// The committed drag is exactly what `subvec edit` makes of the same operation. The previews
+// leave out moves under 1/32 of a canvas pixel (scale 1 here), so the last one the page drew is
+// that result within 1/32 px, and the commit's delta brings the page's positions to it exactly.
 TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   const VectorImage original = disk();
   Editor editor(original);
   const std::string s = editor.new_session();
   const ViewMesh view = editor.view(s, {0, 2});
+  std::vector<float> page = view.positions;  // what the page draws, delta by delta
+  const auto apply = [&](const Delta& d) {
+    if (d.dense_positions) {
+      page = d.positions;
+      return;
+    }
+    for (size_t i = 0; i < d.position_indices.size(); ++i) {
+      page[2 * d.position_indices[i]] = d.positions[2 * i];
+      page[2 * d.position_indices[i] + 1] = d.positions[2 * i + 1];
+    }
+  };
   DragStart start;
   start.at = {76, 48};
   start.sigma = 30;
   const SelectResult picked = editor.drag_start(s, 1, start);
   EXPECT_EQ(picked.feature, 0);
   Delta preview;
-  for (int i = 1; i <= 8; ++i) preview = editor.drag_move(s, {76.0 + i, 48}, 0);
+  size_t sent = 0;
+  for (int i = 1; i <= 8; ++i) {
+    preview = editor.drag_move(s, {76.0 + i, 48}, 0);
+    apply(preview);
+    sent += preview.dense_positions ? page.size() / 2 : preview.position_indices.size();
+  }
   EXPECT_EQ(preview.view_id, view.id);
-  EXPECT_TRUE(preview.dense_positions);  // the whole mesh follows an ARAP drag
+  EXPECT_GT(sent, page.size() / 2);  // an ARAP drag moves much of the mesh
   EXPECT_TRUE(preview.color_indices.empty());
   std::string log;
+  const std::vector<float> last_preview = page;
   const Delta commit = editor.drag_end(s, 1, {84, 48}, 0, log);
   EXPECT_NE(log.find("dragged"), std::string::npos) << log;
-  // Nothing left to redraw after the release: the last preview was the committed shape.
-  EXPECT_TRUE(commit.position_indices.empty() && !commit.dense_positions);
+  apply(commit);
+  const std::string fresh_session = editor.new_session();
+  const ViewMesh fresh = editor.view(fresh_session, {0, 2});
+  EXPECT_EQ(page, fresh.positions);
+  float drift = 0;
+  for (size_t i = 0; i < page.size(); ++i) drift = std::max(drift, std::abs(last_preview[i] - page[i]));
+  EXPECT_GT(drift, 0);  // some moves were too small to send
+  EXPECT_LE(drift, 1.0f / 32 + 1e-5f);
 
   const VectorImage expected = dragged(original, 84);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
