@@ -62,20 +62,23 @@ try {
     });
   }
   await page.mouse.up();
-  const latencies = await page.evaluate(() => window.subvec.latencies());
   const view = await page.evaluate(() => ({
     depth: window.subvec.state.view.depth, zoom: document.getElementById('zoom-out').textContent, canvas: [document.getElementById('canvas').width, document.getElementById('canvas').height],
   }));
-  const sorted = latencies.slice().sort((a, b) => a - b);
-  const q = (p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
   console.log(`image ${info.size[0]}x${info.size[1]}, ${info.vertices} control vertices, ${info.triangles} triangles; ` +
     `canvas ${view.canvas[0]}x${view.canvas[1]}, refinement depth ${view.depth} (${info.triangles * 4 ** view.depth} triangles drawn; ${view.zoom})`);
-  console.log(`drag redraw, ${latencies.length} moves: median ${q(0.5).toFixed(1)} ms, p90 ${q(0.9).toFixed(1)} ms, ` +
-    `max ${sorted[sorted.length - 1].toFixed(1)} ms`);
-  const phases = await page.evaluate(() => window.subvec.phases());
-  const median = (k) => phases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(phases.length / 2)];
-  console.log(`  medians: event to request ${median(0).toFixed(1)} ms, request ${median(1).toFixed(1)} ms, ` +
-    `update and draw ${median(2).toFixed(1)} ms`);
+  // The median, p90 and maximum of `times`, and the medians of the page's phases of each.
+  const report = async (what, times, first) => {
+    const sorted = times.slice().sort((a, b) => a - b);
+    const q = (p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
+    console.log(`${what}: median ${q(0.5).toFixed(1)} ms, p90 ${q(0.9).toFixed(1)} ms, max ${sorted[sorted.length - 1].toFixed(1)} ms`);
+    const phases = await page.evaluate(() => window.subvec.phases());
+    const median = (k) => phases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(phases.length / 2)];
+    console.log(`  medians: ${first} to request ${median(0).toFixed(1)} ms, request ${median(1).toFixed(1)} ms, ` +
+      `update and draw ${median(2).toFixed(1)} ms`);
+  };
+  const latencies = await page.evaluate(() => window.subvec.latencies());
+  await report(`drag redraw, ${latencies.length} moves`, latencies, 'event');
 
   // Color clicks with the page's defaults (a region fill), at points spread over the image, one at
   // a time: from the click to the recolored frame drawn.
@@ -88,14 +91,8 @@ try {
     await page.waitForFunction((n) => window.subvec.clicks().length >= n, i, { timeout: 30000 });
     await page.waitForFunction(() => window.subvec.idle());
   }
-  const taken = (await page.evaluate(() => window.subvec.clicks())).sort((a, b) => a - b);
-  const cq = (p) => taken[Math.min(taken.length - 1, Math.floor(p * taken.length))];
-  console.log(`color click, ${taken.length} clicks: median ${cq(0.5).toFixed(1)} ms, p90 ${cq(0.9).toFixed(1)} ms, ` +
-    `max ${taken[taken.length - 1].toFixed(1)} ms`);
-  const clickPhases = await page.evaluate(() => window.subvec.phases());
-  const cm = (k) => clickPhases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(clickPhases.length / 2)];
-  console.log(`  medians: click to request ${cm(0).toFixed(1)} ms, request ${cm(1).toFixed(1)} ms, ` +
-    `update and draw ${cm(2).toFixed(1)} ms`);
+  const taken = await page.evaluate(() => window.subvec.clicks());
+  await report(`color click, ${taken.length} clicks`, taken, 'click');
 } finally {
   await browser.close();
   await stop(server);
