@@ -88,7 +88,7 @@ export class Renderer {
   colors = new Uint8Array(0);
 
   constructor(readonly canvas: HTMLCanvasElement, antialias: boolean) {
-    const gl = canvas.getContext('webgl2', { antialias, premultipliedAlpha: false });
+    const gl = canvas.getContext('webgl2', { antialias, premultipliedAlpha: false, depth: false, stencil: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
     const program = gl.createProgram()!;
