@@ -457,15 +457,25 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
       refuse(where, message);
     }
     // Strokes on the level follow a shape edit (issue 29): each point keeps its place in its
-    // control triangle.
+    // control triangle. All of the level's points go through one call (one point-location grid).
     if (op.kind != EditOp::Kind::kColor) {
       int carried = 0;
-      for (Stroke& stroke : image.strokes) {
+      std::vector<Vec2> points;
+      for (const Stroke& stroke : image.strokes) {
         if (stroke.level != op.level) continue;
-        transport_points(image.levels[op.level].positions, mesh.positions, mesh.triangles, stroke.points);
+        points.insert(points.end(), stroke.points.begin(), stroke.points.end());
         ++carried;
       }
-      if (carried > 0) done += "; " + std::to_string(carried) + (carried == 1 ? " stroke" : " strokes") + " carried along";
+      if (carried > 0) {
+        transport_points(image.levels[op.level].positions, mesh.positions, mesh.triangles, points);
+        size_t next = 0;
+        for (Stroke& stroke : image.strokes) {
+          if (stroke.level != op.level) continue;
+          std::copy_n(points.begin() + long(next), stroke.points.size(), stroke.points.begin());
+          next += stroke.points.size();
+        }
+        done += "; " + std::to_string(carried) + (carried == 1 ? " stroke" : " strokes") + " carried along";
+      }
     }
     image.levels[op.level] = std::move(mesh);
     log.push_back(where + ": " + done);

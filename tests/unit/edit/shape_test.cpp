@@ -147,17 +147,21 @@ TEST(Shape, StrokesFollowShapeEdits) {
   for (int32_t v : f.vertices) along.points.push_back(before.positions[v]);
   Stroke elsewhere = along;
   elsewhere.level = 1;
+  Stroke second;  // another stroke on the level, off the feature
+  for (int i = 0; i < 5; ++i) second.points.push_back({10.0 + 7 * i, 12.0 + 3 * i});
   img.levels.push_back(before);
-  img.strokes = {along, elsewhere};
+  img.strokes = {along, elsewhere, second};
   EditOp op;
   op.kind = EditOp::Kind::kMoveFeature;
   op.at = before.positions[f.vertices[f.vertices.size() / 2]];
   op.translate = {3, 2};
   const std::vector<std::string> log = apply_edit_ops(img, std::span(&op, 1));
-  EXPECT_NE(log[0].find("1 stroke carried along"), std::string::npos) << log[0];
-  std::vector<Vec2> expected = along.points;
+  EXPECT_NE(log[0].find("2 strokes carried along"), std::string::npos) << log[0];
+  std::vector<Vec2> expected = along.points, expected_second = second.points;
   transport_points(before.positions, img.levels[0].positions, before.triangles, expected);
+  transport_points(before.positions, img.levels[0].positions, before.triangles, expected_second);
   EXPECT_EQ(img.strokes[0].points, expected);
+  EXPECT_EQ(img.strokes[2].points, expected_second);
   // The feature's own vertices moved by the translation, and so did the stroke over them.
   for (size_t i = 0; i < f.vertices.size(); ++i) {
     EXPECT_NEAR(img.strokes[0].points[i].x, along.points[i].x + 3, 1e-6);
