@@ -245,7 +245,9 @@ TEST(EditOps, MoveVerticesAndColorPerControlPoint) {
   for (int c = 0; c < after.num_colors(); ++c) {
     const bool in = std::binary_search(s.colors.begin(), s.colors.end(), c);
     EXPECT_EQ(after.colors[c] == (Color{0, 255, 0}), in) << c;
-    if (!in) EXPECT_EQ(after.colors[c], before.colors[c]);
+    if (!in) {
+      EXPECT_EQ(after.colors[c], before.colors[c]);
+    }
   }
   EXPECT_GE(s.colors.size(), 3u);
   auto refused = [](const std::string& json, const char* part) {
