@@ -18,7 +18,7 @@ const TOOL_HELP: Record<Tool, string> = {
   select: 'Select: click to see what the other tools would pick there — the nearest feature (pink, its control chain) or control vertex, and the color region a click would change (white points). Changes nothing.',
   drag: 'Drag (as-rigid-as-possible): press on a feature (or a vertex, with "vertex" picked) and drag. The part near where you grabbed follows the mouse (σ sets how far along the feature), and the whole mesh deforms as rigidly as possible around it; the image border stays in place.',
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
-  points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
+  points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Alt: draw a lasso; Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
   color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
@@ -57,7 +57,8 @@ const state = {
   clicks: [] as number[],        // per measured color click: click to frame drawn, ms      // per measured preview: [event to send, request, update + draw] ms
   control: new Float32Array(0),  // control positions of the level (image pixels), for the points tool
   selection: [] as number[],     // the points tool's selected control vertices
-  box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean },
+  // A box (or, with Alt, a lasso: the pointer's path) being drawn with the points tool.
+  box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean; lasso: [number, number][] | null },
 };
 
 // A drag or move, from press to release. Its task (runDrag) holds the queue from the press
@@ -423,15 +424,20 @@ function pointsDown(e: PointerEvent) {
     if (!e.shiftKey) void dragStart(e);  // and a drag right away moves it
     return;
   }
-  state.box = { pointer: e.pointerId, from: p, to: p, add: e.shiftKey };
+  state.box = { pointer: e.pointerId, from: p, to: p, add: e.shiftKey, lasso: e.altKey ? [p] : null };
   canvas.setPointerCapture(e.pointerId);
   drawBox();
 }
 function drawBox() {
-  const box = $('box'), b = state.box;
-  box.hidden = !b;
+  const box = $('box'), b = state.box, lasso = document.getElementById('lasso') as unknown as SVGSVGElement;
+  box.hidden = !b || !!b.lasso;
+  lasso.style.display = b && b.lasso ? 'block' : 'none';
   if (!b) return;
   const dpr = window.devicePixelRatio || 1;
+  if (b.lasso) {
+    lasso.querySelector('polygon')!.setAttribute('points', b.lasso.map(([x, y]) => `${x / dpr},${y / dpr}`).join(' '));
+    return;
+  }
   const [x0, x1] = [b.from[0], b.to[0]].sort((a, c) => a - c), [y0, y1] = [b.from[1], b.to[1]].sort((a, c) => a - c);
   Object.assign(box.style, { left: `${x0 / dpr}px`, top: `${y0 / dpr}px`, width: `${(x1 - x0) / dpr}px`, height: `${(y1 - y0) / dpr}px` });
 }
@@ -444,10 +450,20 @@ function boxEnd(e: PointerEvent | null, cancel = false) {
   if (cancel) return;
   const t = state.transform;
   const [x0, x1] = [b.from[0], b.to[0]].sort((a, c) => a - c), [y0, y1] = [b.from[1], b.to[1]].sort((a, c) => a - c);
+  // Inside the lasso: an even number of its edges cross the ray to the right (the polygon closes
+  // back to its first point).
+  const inLasso = (x: number, y: number, path: [number, number][]) => {
+    let inside = false;
+    for (let i = 0, j = path.length - 1; i < path.length; j = i++) {
+      const [xi, yi] = path[i], [xj, yj] = path[j];
+      if ((yi > y) !== (yj > y) && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
+    }
+    return inside;
+  };
   const inside: number[] = [];
   for (let i = 0; i < state.control.length / 2; i++) {
     const x = state.control[2 * i] * t.zoom + t.panX, y = state.control[2 * i + 1] * t.zoom + t.panY;
-    if (x >= x0 && x <= x1 && y >= y0 && y <= y1) inside.push(i);
+    if (b.lasso ? inLasso(x, y, b.lasso) : x >= x0 && x <= x1 && y >= y0 && y <= y1) inside.push(i);
   }
   setSelection(b.add ? [...state.selection, ...inside] : inside);
   status(selectionLine());
@@ -932,6 +948,7 @@ canvas.addEventListener('pointermove', (e) => {
   }
   if (state.box && e.pointerId === state.box.pointer) {
     state.box.to = canvasPoint(e);
+    state.box.lasso?.push(state.box.to);
     drawBox();
     return;
   }

@@ -267,6 +267,18 @@ try {
   let selection = await page.evaluate(() => window.subvec.state.selection);
   check(`points: a box selects the ${boxed.length} points inside it`, boxed.length >= 3 &&
     JSON.stringify(selection) === JSON.stringify(boxed), `${selection} vs ${boxed}`);
+  // The same square drawn as a lasso (Alt): the same points.
+  await page.keyboard.press('Escape');
+  await page.keyboard.down('Alt');
+  await sweep([58, 28], [92, 28], 4, true);
+  await sweep([92, 28], [92, 68], 4);
+  await sweep([92, 68], [58, 68], 4);
+  await sweep([58, 68], [58, 30], 4);
+  await page.mouse.up();
+  await page.keyboard.up('Alt');
+  await idle(page);
+  selection = await page.evaluate(() => window.subvec.state.selection);
+  check('points: an Alt lasso selects the points inside it', JSON.stringify(selection) === JSON.stringify(boxed), `${selection} vs ${boxed}`);
   const [ox, oy] = await client(page, rest[2 * boxed[0]], rest[2 * boxed[0] + 1]);
   await page.keyboard.down('Shift');
   await page.mouse.click(ox, oy);
