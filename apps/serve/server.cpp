@@ -153,10 +153,10 @@ subvec::Vec2 point(const json& j, const char* key) {
 subvec::EditSelect select_mode(const json& j, bool region_too) {
   const std::string s = j.contains("select") ? text(j, "select") : "feature";
   const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s);
-  if (e && (region_too || *e != subvec::EditSelect::kRegion)) return *e;
+  if (e && (region_too || subvec::drag_grabs(*e))) return *e;
   throw RequestError(kBadRequest, "\"select\" must be " +
-                                      (region_too ? std::string(subvec::kEditSelectNames)
-                                                  : std::string(R"("vertex" or "feature")")) +
+                                      std::string(region_too ? subvec::kEditSelectNames
+                                                             : subvec::kDragSelectNames) +
                                       ", got \"" + s + "\"");
 }
 
@@ -177,7 +177,7 @@ std::vector<int32_t> vertex_list(const json& j) {
 // A color selection's radius (a region's is uncapped by default) and tolerance (regions only).
 void color_reach(const json& j, subvec::EditSelect select, double& radius, double& tolerance) {
   const bool region = select == subvec::EditSelect::kRegion;
-  radius = number(j, "radius", region ? std::numeric_limits<double>::infinity() : 0.0);
+  radius = number(j, "radius", subvec::default_color_radius(select));
   if (radius < 0) throw RequestError(kBadRequest, "\"radius\" must be >= 0");
   tolerance = number(j, "tolerance", subvec::kDefaultRegionTolerance);
   if (tolerance < 0) throw RequestError(kBadRequest, "\"tolerance\" must be >= 0");

@@ -335,7 +335,7 @@ subvec::EditSelect parse_select(const std::string& s) {
 void color_reach(subvec::EditSelect select, const std::optional<double>& radius,
                  const std::optional<double>& tolerance, double& r, double& t) {
   const bool region = select == subvec::EditSelect::kRegion;
-  r = radius ? *radius : region ? std::numeric_limits<double>::infinity() : 0.0;
+  r = radius ? *radius : subvec::default_color_radius(select);
   if (!(r >= 0)) invalid("radius must be >= 0");
   if (tolerance && !region) invalid("tolerance applies to select='region' only");
   t = tolerance ? *tolerance : subvec::kDefaultRegionTolerance;

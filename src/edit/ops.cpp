@@ -163,10 +163,9 @@ EditOp parse_op(const Json& j, Place& at) {
     if (const Json* s = fields.optional("select")) {
       const std::string v = string_value(*s, at, "select");
       const std::optional<EditSelect> e = edit_select_from_name(v);
-      if (e && (region_too || *e == EditSelect::kVertex || *e == EditSelect::kFeature)) return *e;
+      if (e && (region_too || drag_grabs(*e))) return *e;
       at.fail("select", "expected " +
-                            (region_too ? std::string(kEditSelectNames)
-                                        : std::string(R"("vertex" or "feature")")) +
+                            std::string(region_too ? kEditSelectNames : kDragSelectNames) +
                             ", got \"" + printable(v) + "\"");
     }
     return EditSelect::kVertex;
@@ -243,8 +242,7 @@ EditOp parse_op(const Json& j, Place& at) {
         op.at = vec2(fields.required("at"), at, "at");
       }
       op.color = color(fields.required("color"), at, "color");
-      // A region is uncapped unless a radius is given.
-      if (op.select == EditSelect::kRegion) op.radius = std::numeric_limits<double>::infinity();
+      op.radius = default_color_radius(op.select);
       if (const Json* r = fields.optional("radius")) {
         op.radius = number(*r, at, "radius");
         if (op.radius < 0) at.fail("radius", "expected a number >= 0, got " + num(op.radius));
@@ -380,8 +378,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
         case EditOp::Kind::kDrag:
         case EditOp::Kind::kMoveFeature:
         case EditOp::Kind::kMoveVertices: {
-          if (op.kind == EditOp::Kind::kDrag && op.select != EditSelect::kVertex &&
-              op.select != EditSelect::kFeature) {
+          if (op.kind == EditOp::Kind::kDrag && !drag_grabs(op.select)) {
             refuse(where, "a drag grabs a \"vertex\" or a \"feature\"");
           }
           Handles handles;

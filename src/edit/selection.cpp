@@ -261,11 +261,15 @@ ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at, double rad
     }
   }
   const std::array<double, 3> seed = lab(mesh.colors[s.seed_color]);
+  // The fill reaches a value once per triangle around it: its color verdict is taken once.
+  std::vector<int8_t> near(mesh.colors.size(), -1);
   s.colors = grow(mesh, {s.seed_color}, [&](int32_t c, Vec2 q) {
-    const std::array<double, 3> v = lab(mesh.colors[c]);
-    const double dl = v[0] - seed[0], da = v[1] - seed[1], db = v[2] - seed[2];
-    return dl * dl + da * da + db * db <= tolerance * tolerance &&
-           std::hypot(q.x - at.x, q.y - at.y) <= radius;
+    if (near[c] < 0) {
+      const std::array<double, 3> v = lab(mesh.colors[c]);
+      const double dl = v[0] - seed[0], da = v[1] - seed[1], db = v[2] - seed[2];
+      near[c] = dl * dl + da * da + db * db <= tolerance * tolerance;
+    }
+    return near[c] == 1 && std::hypot(q.x - at.x, q.y - at.y) <= radius;
   });
   return s;
 }

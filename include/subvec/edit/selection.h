@@ -47,6 +47,11 @@ enum class EditSelect { kVertex, kFeature, kRegion, kVertices };
 std::optional<EditSelect> edit_select_from_name(std::string_view name);
 inline constexpr std::string_view kEditSelectNames =
     R"("vertex", "feature", "region" or "vertices")";
+// What a drag grabs: a vertex or a feature.
+inline constexpr bool drag_grabs(EditSelect s) {
+  return s == EditSelect::kVertex || s == EditSelect::kFeature;
+}
+inline constexpr std::string_view kDragSelectNames = R"("vertex" or "feature")";
 
 // One smooth piece of a feature's limit curve (mesh/curves.h): the feature chain split at its
 // corner vertices (junctions, a tear meeting a crease or the border), which the curve interpolates.
@@ -100,6 +105,10 @@ ColorSelection select_feature_colors(const ControlMesh& mesh, const MeshTopology
 // takes color values within `tolerance` (ΔE, >= 0) of the seed's color whose vertex lies within
 // `radius` of `at` (infinity: no cap).
 inline constexpr double kDefaultRegionTolerance = 25;
+// A color selection's radius when none is given: no cap for a region, 0 (the seed alone) else.
+inline constexpr double default_color_radius(EditSelect s) {
+  return s == EditSelect::kRegion ? std::numeric_limits<double>::infinity() : 0.0;
+}
 ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at,
                                     double radius = std::numeric_limits<double>::infinity(),
                                     double tolerance = kDefaultRegionTolerance);
