@@ -2,6 +2,17 @@
 // tears as seams between GL vertices), strokes, and the overlays (control mesh, feature curves,
 // the current selection). All geometry is in image pixels; one affine transform maps it to the
 // canvas, so panning and zooming only change two uniforms.
+//
+// Partial redraws. The drawing buffer is preserved between frames, and the renderer remembers what
+// it shows. A change to some vertices (a drag preview, a color edit, a moved selection) marks the
+// image-space rectangle it touches: the triangles around each changed vertex, at their old and new
+// positions, and the overlay lines and points on changed control points. The next frame, when the
+// view and the overlays are those shown, clears and draws that rectangle only (scissored), and only
+// the triangle chunks that meet it: the triangles are sorted along a Morton curve once per view, so
+// a chunk of CHUNK consecutive triangles is a compact patch with a bounding box. Pixels outside the
+// rectangle are those a full draw would give, so the frame is exact (web/tests/e2e-input.mjs
+// compares it with a full redraw). Anything else (a new view, zoom, pan, overlay switches, resize,
+// strokes) draws everything.
 
 const VERTEX = `#version 300 es
 in vec2 a_pos;
@@ -54,6 +65,27 @@ function compile(gl: WebGL2RenderingContext, type: number, source: string): WebG
   return shader;
 }
 
+const CHUNK = 256;        // triangles per culling chunk
+const MARGIN = 6;         // canvas pixels around a dirty rectangle: the widest point is 8 px
+const PARTIAL_SHARE = 0.9; // a dirty rectangle over this share of the canvas: draw everything
+
+// Morton code of a point quantized to 10 bits per axis.
+function morton(x: number, y: number): number {
+  const spread = (v: number) => {
+    v &= 0x3ff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    return (v | (v << 1)) & 0x55555555;
+  };
+  return spread(x) | (spread(y) << 1);
+}
+
+// What a frame showed: a partial redraw needs the same canvas size, transform and overlays.
+interface Shown {
+  w: number; h: number; zoom: number; panX: number; panY: number; mesh: boolean; features: boolean;
+}
+
 export class Renderer {
   readonly gl: WebGL2RenderingContext;
   private program: WebGLProgram;
@@ -86,9 +118,31 @@ export class Renderer {
   // CPU copies, updated in place by deltas.
   positions = new Float32Array(0);
   colors = new Uint8Array(0);
+  // The triangles in Morton order, their chunks' bounding boxes (x0, y0, x1, y1 in image pixels;
+  // `stale` ones are recomputed before use), and each GL vertex's triangles (CSR).
+  private triangles = new Uint32Array(0);
+  private chunkBox = new Float32Array(0);
+  private chunkStale = new Uint8Array(0);
+  private staleChunks: number[] = [];
+  private vertexTriOffset = new Uint32Array(1);
+  private vertexTris = new Uint32Array(0);
+  // Overlay geometry on the control points (CPU copies, for dirty rectangles).
+  private control = new Float32Array(0);
+  private controlEdgeList = new Uint32Array(0);
+  private highlightChain = new Uint32Array(0);   // pairs of control vertices
+  private highlightRegion = new Uint32Array(0);
+  private selectedList = new Uint32Array(0);
+  // What the drawing buffer shows (null: nothing trustworthy, the next frame draws everything) and
+  // the image-space rectangle changed since (x0, y0, x1, y1; empty while x0 > x1).
+  private shown: Shown | null = null;
+  private dirty = [Infinity, Infinity, -Infinity, -Infinity];
+  /** Frames drawn in full and in part (for tests and the benchmark). */
+  frames = { full: 0, partial: 0, skipped: 0, partialShare: 0 };  // partialShare: canvas share summed
 
   constructor(readonly canvas: HTMLCanvasElement, antialias: boolean) {
-    const gl = canvas.getContext('webgl2', { antialias, premultipliedAlpha: false, depth: false, stencil: false });
+    const gl = canvas.getContext('webgl2', {
+      antialias, premultipliedAlpha: false, depth: false, stencil: false, preserveDrawingBuffer: true,
+    });
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
     const program = gl.createProgram()!;
@@ -144,58 +198,201 @@ export class Renderer {
     const gl = this.gl;
     this.positions = new Float32Array(positions);
     this.colors = new Uint8Array(colors);
+    this.sortTriangles(triangles);
     gl.bindBuffer(gl.ARRAY_BUFFER, this.meshPos);
     gl.bufferData(gl.ARRAY_BUFFER, this.positions, gl.DYNAMIC_DRAW);
     gl.bindBuffer(gl.ARRAY_BUFFER, this.meshColor);
     gl.bufferData(gl.ARRAY_BUFFER, this.colors, gl.DYNAMIC_DRAW);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.meshIndex);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, triangles, gl.STATIC_DRAW);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.triangles, gl.STATIC_DRAW);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.tearIndex);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, tears, gl.STATIC_DRAW);
     this.triangleCount = triangles.length;
     this.tearCount = tears.length;
+    this.shown = null;
+  }
+
+  // Orders the triangles along a Morton curve of their centroids, then builds the chunk boxes and
+  // the vertex-to-triangle lists.
+  private sortTriangles(triangles: Uint32Array) {
+    const p = this.positions;
+    const nt = triangles.length / 3, nv = p.length / 2;
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (let i = 0; i < p.length; i += 2) {
+      x0 = Math.min(x0, p[i]); x1 = Math.max(x1, p[i]);
+      y0 = Math.min(y0, p[i + 1]); y1 = Math.max(y1, p[i + 1]);
+    }
+    const sx = 1023 / Math.max(x1 - x0, 1e-6), sy = 1023 / Math.max(y1 - y0, 1e-6);
+    // key * 2^22 + index, sorted as doubles (exact below 2^53): a stable order by key.
+    const keys = new Float64Array(nt);
+    for (let t = 0; t < nt; ++t) {
+      const a = 2 * triangles[3 * t], b = 2 * triangles[3 * t + 1], c = 2 * triangles[3 * t + 2];
+      const cx = (p[a] + p[b] + p[c]) / 3, cy = (p[a + 1] + p[b + 1] + p[c + 1]) / 3;
+      keys[t] = morton(Math.round((cx - x0) * sx), Math.round((cy - y0) * sy)) * 4194304 + t;
+    }
+    keys.sort();
+    const sorted = new Uint32Array(3 * nt);
+    for (let j = 0; j < nt; ++j) {
+      const t = keys[j] % 4194304;
+      sorted[3 * j] = triangles[3 * t];
+      sorted[3 * j + 1] = triangles[3 * t + 1];
+      sorted[3 * j + 2] = triangles[3 * t + 2];
+    }
+    this.triangles = sorted;
+    const offset = new Uint32Array(nv + 1);
+    for (let k = 0; k < sorted.length; ++k) offset[sorted[k] + 1]++;
+    for (let v = 0; v < nv; ++v) offset[v + 1] += offset[v];
+    const fill = offset.slice(0, nv);
+    const list = new Uint32Array(sorted.length);
+    for (let k = 0; k < sorted.length; ++k) list[fill[sorted[k]]++] = (k / 3) | 0;
+    this.vertexTriOffset = offset;
+    this.vertexTris = list;
+    const chunks = Math.ceil(nt / CHUNK);
+    this.chunkBox = new Float32Array(4 * chunks);
+    this.chunkStale = new Uint8Array(chunks).fill(1);
+    this.staleChunks = Array.from({ length: chunks }, (_, c) => c);
+  }
+
+  // Grows the dirty rectangle by the triangles around GL vertex g (their current positions) and
+  // marks their chunks stale.
+  private touchVertex(g: number) {
+    const p = this.positions, tri = this.triangles, d = this.dirty;
+    for (let k = this.vertexTriOffset[g], end = this.vertexTriOffset[g + 1]; k < end; ++k) {
+      const t = this.vertexTris[k];
+      for (let c = 3 * t; c < 3 * t + 3; ++c) {
+        const x = p[2 * tri[c]], y = p[2 * tri[c] + 1];
+        if (x < d[0]) d[0] = x;
+        if (x > d[2]) d[2] = x;
+        if (y < d[1]) d[1] = y;
+        if (y > d[3]) d[3] = y;
+      }
+      const chunk = (t / CHUNK) | 0;
+      if (!this.chunkStale[chunk]) {
+        this.chunkStale[chunk] = 1;
+        this.staleChunks.push(chunk);
+      }
+    }
+  }
+
+  // Grows the dirty rectangle by a control point, at its current position.
+  private touchControl(v: number) {
+    const x = this.control[2 * v], y = this.control[2 * v + 1], d = this.dirty;
+    if (x < d[0]) d[0] = x;
+    if (x > d[2]) d[2] = x;
+    if (y < d[1]) d[1] = y;
+    if (y > d[3]) d[3] = y;
+  }
+
+  // Grows the dirty rectangle by the overlay points and lines on the control points flagged in
+  // `changed` (current positions; call before and after a move).
+  private touchControlOverlays(changed: Uint8Array) {
+    const touchLines = (pairs: Uint32Array, count: number) => {
+      for (let i = 0; i + 1 < count; i += 2) {
+        if (changed[pairs[i]] || changed[pairs[i + 1]]) {
+          this.touchControl(pairs[i]);
+          this.touchControl(pairs[i + 1]);
+        }
+      }
+    };
+    if (this.shown?.mesh) touchLines(this.controlEdgeList, this.controlEdgeCount);
+    touchLines(this.highlightChain, this.highlightChain.length);
+    for (let v = 0; v < changed.length; ++v) if (changed[v]) this.touchControl(v);
+  }
+
+  // Uploads GL vertices lo..hi (inclusive) of `data` (`per` values each) into `buffer`.
+  private uploadRange(buffer: WebGLBuffer, data: Float32Array | Uint8Array, per: number, lo: number, hi: number) {
+    const gl = this.gl;
+    gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
+    if (hi < lo) return;
+    gl.bufferSubData(gl.ARRAY_BUFFER, lo * per * data.BYTES_PER_ELEMENT, data, lo * per, (hi - lo + 1) * per);
   }
 
   // A delta from the server: dense arrays replace, sparse ones patch (indices + values).
   updatePositions(indices: Uint32Array | null, values: Float32Array) {
+    const p = this.positions;
     if (indices === null) {
-      if (values.length !== this.positions.length) return;
-      this.positions.set(values);
-    } else {
-      for (let i = 0; i < indices.length; ++i) {
-        const g = indices[i];
-        this.positions[2 * g] = values[2 * i];
-        this.positions[2 * g + 1] = values[2 * i + 1];
+      if (values.length !== p.length) return;
+      // Dense: the vertices that moved, as if the delta were sparse.
+      const moved: number[] = [];
+      for (let g = 0; g < p.length / 2; ++g) {
+        if (p[2 * g] !== values[2 * g] || p[2 * g + 1] !== values[2 * g + 1]) moved.push(g);
       }
+      this.movePositions(new Uint32Array(moved), (_, g) => {
+        p[2 * g] = values[2 * g];
+        p[2 * g + 1] = values[2 * g + 1];
+      });
+      return;
     }
-    const gl = this.gl;
-    gl.bindBuffer(gl.ARRAY_BUFFER, this.meshPos);
-    gl.bufferSubData(gl.ARRAY_BUFFER, 0, this.positions);
+    this.movePositions(indices, (i, g) => {
+      p[2 * g] = values[2 * i];
+      p[2 * g + 1] = values[2 * i + 1];
+    });
+  }
+
+  // Moves GL vertices `indices` (set(i, g) writes vertex g = indices[i]), marking where they were
+  // and where they are dirty, and uploads the range they span.
+  private movePositions(indices: Uint32Array, set: (i: number, g: number) => void) {
+    let lo = Infinity, hi = -1;
+    for (let i = 0; i < indices.length; ++i) this.touchVertex(indices[i]);  // where they were
+    for (let i = 0; i < indices.length; ++i) {
+      const g = indices[i];
+      set(i, g);
+      lo = Math.min(lo, g);
+      hi = Math.max(hi, g);
+    }
+    for (let i = 0; i < indices.length; ++i) this.touchVertex(indices[i]);  // where they are
+    this.uploadRange(this.meshPos, this.positions, 2, lo, hi);
   }
 
   updateColors(indices: Uint32Array | null, values: Uint8Array) {
     if (indices === null) {
       if (values.length !== this.colors.length) return;
       this.colors.set(values);
-    } else {
-      for (let i = 0; i < indices.length; ++i) this.colors.set(values.subarray(4 * i, 4 * i + 4), 4 * indices[i]);
+      this.shown = null;
+      this.uploadRange(this.meshColor, this.colors, 4, 0, this.colors.length / 4 - 1);
+      return;
     }
-    const gl = this.gl;
-    gl.bindBuffer(gl.ARRAY_BUFFER, this.meshColor);
-    gl.bufferSubData(gl.ARRAY_BUFFER, 0, this.colors);
+    let lo = Infinity, hi = -1;
+    for (let i = 0; i < indices.length; ++i) {
+      const g = indices[i];
+      this.colors.set(values.subarray(4 * i, 4 * i + 4), 4 * g);
+      this.touchVertex(g);
+      lo = Math.min(lo, g);
+      hi = Math.max(hi, g);
+    }
+    this.uploadRange(this.meshColor, this.colors, 4, lo, hi);
   }
 
   private controlVertexCount = 0;
   setControl(positions: Float32Array, edges?: Uint32Array) {
     const gl = this.gl;
-    this.controlVertexCount = positions.length / 2;
+    const n = positions.length / 2;
+    const changed = new Uint8Array(n);
+    if (edges || n !== this.controlVertexCount) {
+      this.shown = null;
+    } else {
+      let any = false;
+      for (let v = 0; v < n; ++v) {
+        if (positions[2 * v] !== this.control[2 * v] || positions[2 * v + 1] !== this.control[2 * v + 1]) {
+          changed[v] = 1;
+          any = true;
+        }
+      }
+      if (!any) return;
+      this.touchControlOverlays(changed);  // where they were
+    }
+    this.control = new Float32Array(positions);
+    if (this.shown) this.touchControlOverlays(changed);  // where they are
+    this.controlVertexCount = n;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.controlPos);
     gl.bufferData(gl.ARRAY_BUFFER, positions, gl.DYNAMIC_DRAW);
     if (edges) {
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
       gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, edges, gl.STATIC_DRAW);
+      this.controlEdgeList = new Uint32Array(edges);
       this.controlEdgeCount = edges.length;
     }
+    if (this.controlPointCount > 0) this.controlPointCount = n;
   }
 
   // The selection: a feature chain (control vertex indices, drawn as a polyline over the control
@@ -204,20 +401,32 @@ export class Renderer {
     const gl = this.gl;
     const lines: number[] = [];
     for (let i = 0; i + 1 < chain.length; ++i) lines.push(chain[i], chain[i + 1]);
+    // What was highlighted and what will be: both are redrawn.
+    for (const v of this.highlightChain) this.touchControl(v);
+    for (const v of this.highlightRegion) this.touchControl(v);
+    this.highlightChain = new Uint32Array(lines);
+    this.highlightRegion = new Uint32Array(region);
+    for (const v of this.highlightChain) this.touchControl(v);
+    for (const v of this.highlightRegion) this.touchControl(v);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightLines);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(lines), gl.DYNAMIC_DRAW);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.highlightChain, gl.DYNAMIC_DRAW);
     this.highlightLineCount = lines.length;
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightPoints);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(region), gl.DYNAMIC_DRAW);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.highlightRegion, gl.DYNAMIC_DRAW);
     this.highlightPointCount = region.length;
   }
 
   // The points tool's handles: every control point when `all`, and the selected ones.
   setPoints(all: boolean, selected: number[]) {
     const gl = this.gl;
-    this.controlPointCount = all ? this.controlVertexCount : 0;
+    const count = all ? this.controlVertexCount : 0;
+    if (count !== this.controlPointCount) this.shown = null;
+    this.controlPointCount = count;
+    for (const v of this.selectedList) this.touchControl(v);
+    this.selectedList = new Uint32Array(selected);
+    for (const v of this.selectedList) this.touchControl(v);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.selectedPoints);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(selected), gl.DYNAMIC_DRAW);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.selectedList, gl.DYNAMIC_DRAW);
     this.selectedPointCount = selected.length;
   }
 
@@ -251,12 +460,45 @@ export class Renderer {
     gl.bindBuffer(gl.ARRAY_BUFFER, this.strokeColor);
     gl.bufferData(gl.ARRAY_BUFFER, new Uint8Array(col), gl.STATIC_DRAW);
     this.strokeVertexCount = pos.length / 2;
+    this.shown = null;
   }
 
-  draw(t: Transform, overlays: Overlays) {
+  // Draws the frame: only the dirty rectangle when the buffer shows this view with these overlays
+  // (see the top of this file), everything otherwise or when `full`.
+  draw(t: Transform, overlays: Overlays, full = false) {
     const gl = this.gl;
     const w = this.canvas.width, h = this.canvas.height;
+    const s = this.shown, d = this.dirty;
+    const same = s !== null && s.w === w && s.h === h && s.zoom === t.zoom && s.panX === t.panX &&
+      s.panY === t.panY && s.mesh === overlays.mesh && s.features === overlays.features;
+    let scissor: number[] | null = null;
+    if (same && !full) {
+      if (d[0] > d[2]) {
+        this.frames.skipped++;
+        return;  // nothing changed
+      }
+      // The rectangle in canvas pixels (y down), with a margin for lines and points.
+      const x0 = Math.max(0, Math.floor(d[0] * t.zoom + t.panX) - MARGIN);
+      const y0 = Math.max(0, Math.floor(d[1] * t.zoom + t.panY) - MARGIN);
+      const x1 = Math.min(w, Math.ceil(d[2] * t.zoom + t.panX) + MARGIN);
+      const y1 = Math.min(h, Math.ceil(d[3] * t.zoom + t.panY) + MARGIN);
+      if (x1 <= x0 || y1 <= y0) {
+        this.frames.skipped++;
+        this.dirty = [Infinity, Infinity, -Infinity, -Infinity];
+        return;  // all of it off the canvas
+      }
+      if ((x1 - x0) * (y1 - y0) <= PARTIAL_SHARE * w * h) scissor = [x0, y0, x1, y1];
+    }
+    this.dirty = [Infinity, Infinity, -Infinity, -Infinity];
     gl.viewport(0, 0, w, h);
+    if (scissor) {
+      gl.enable(gl.SCISSOR_TEST);
+      gl.scissor(scissor[0], h - scissor[3], scissor[2] - scissor[0], scissor[3] - scissor[1]);
+      this.frames.partial++;
+      this.frames.partialShare += ((scissor[2] - scissor[0]) * (scissor[3] - scissor[1])) / (w * h);
+    } else {
+      this.frames.full++;
+    }
     gl.clearColor(0.125, 0.129, 0.141, 1);
     gl.clear(gl.COLOR_BUFFER_BIT);
     gl.useProgram(this.program);
@@ -266,7 +508,25 @@ export class Renderer {
     gl.uniform4f(this.uTint, 0, 0, 0, 0);
     gl.bindVertexArray(this.meshVao);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.meshIndex);
-    gl.drawElements(gl.TRIANGLES, this.triangleCount, gl.UNSIGNED_INT, 0);
+    if (scissor) {
+      // The chunks that meet the rectangle (in image pixels), consecutive ones in one call.
+      this.refreshChunks();
+      const rx0 = (scissor[0] - t.panX) / t.zoom, ry0 = (scissor[1] - t.panY) / t.zoom;
+      const rx1 = (scissor[2] - t.panX) / t.zoom, ry1 = (scissor[3] - t.panY) / t.zoom;
+      const box = this.chunkBox, chunks = box.length / 4, nt = this.triangleCount / 3;
+      let run = -1;
+      for (let c = 0; c <= chunks; ++c) {
+        const meets = c < chunks && box[4 * c] <= rx1 && box[4 * c + 2] >= rx0 && box[4 * c + 1] <= ry1 && box[4 * c + 3] >= ry0;
+        if (meets && run < 0) run = c;
+        if (!meets && run >= 0) {
+          const first = run * CHUNK, last = Math.min(nt, c * CHUNK);
+          gl.drawElements(gl.TRIANGLES, 3 * (last - first), gl.UNSIGNED_INT, 12 * first);
+          run = -1;
+        }
+      }
+    } else {
+      gl.drawElements(gl.TRIANGLES, this.triangleCount, gl.UNSIGNED_INT, 0);
+    }
     if (this.strokeVertexCount > 0) {
       gl.enable(gl.BLEND);
       gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
@@ -310,6 +570,39 @@ export class Renderer {
     }
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
     gl.bindVertexArray(null);
+    if (scissor) gl.disable(gl.SCISSOR_TEST);
+    this.shown = { w, h, zoom: t.zoom, panX: t.panX, panY: t.panY, mesh: overlays.mesh, features: overlays.features };
+  }
+
+  // The next frame draws everything (the canvas was resized or cleared).
+  invalidate() {
+    this.shown = null;
+  }
+
+  // Recomputes the bounding boxes of the stale chunks.
+  private refreshChunks() {
+    const p = this.positions, tri = this.triangles, box = this.chunkBox, nt = this.triangleCount / 3;
+    for (const c of this.staleChunks) {
+      let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+      for (let k = 3 * c * CHUNK, end = 3 * Math.min(nt, (c + 1) * CHUNK); k < end; ++k) {
+        const x = p[2 * tri[k]], y = p[2 * tri[k] + 1];
+        if (x < x0) x0 = x;
+        if (x > x1) x1 = x;
+        if (y < y0) y0 = y;
+        if (y > y1) y1 = y;
+      }
+      box[4 * c] = x0; box[4 * c + 1] = y0; box[4 * c + 2] = x1; box[4 * c + 3] = y1;
+      this.chunkStale[c] = 0;
+    }
+    this.staleChunks = [];
+  }
+
+  // The whole canvas, RGBA rows bottom up (tests compare a partial frame with a full one).
+  readAll(): Uint8Array {
+    const gl = this.gl;
+    const out = new Uint8Array(4 * this.canvas.width * this.canvas.height);
+    gl.readPixels(0, 0, this.canvas.width, this.canvas.height, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return out;
   }
 
   // The canvas pixel at canvas coordinates (x, y), y down, read back right after a draw.

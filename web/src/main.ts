@@ -52,9 +52,9 @@ const state = {
   space: false,
   viewTimer: 0,
   measure: false,
-  latencies: [] as number[],
-  phases: [] as number[][],
-  clicks: [] as number[],        // per measured color click: click to frame drawn, ms      // per measured preview: [event to send, request, update + draw] ms
+  latencies: [] as number[],     // per measured drag preview: pointer event to frame drawn, ms
+  phases: [] as number[][],      // per measured preview or click: [event to send, request, update, draw] ms
+  clicks: [] as number[],        // per measured color click: click to frame drawn, ms
   control: new Float32Array(0),  // control positions of the level (image pixels), for the points tool
   selection: [] as number[],     // the points tool's selected control vertices
   // A box (or, with Alt, a lasso: the pointer's path) being drawn with the points tool.
@@ -161,6 +161,7 @@ function resize() {
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
+    renderer?.invalidate();
     if (state.fitted) fit();
     scheduleView();
   }
@@ -591,12 +592,13 @@ async function doColor(at: [number, number], eventTime = performance.now()) {
     const answered = performance.now();
     applyDelta(f);
     renderer.setHighlight([], []);  // the result unobstructed; the next move previews again
+    const updated = performance.now();
     // Drawn now, not at the next animation frame after the history counts come back.
     renderer.draw(state.transform, state.overlays);
     if (state.measure) {
       renderer.readPixel(0, 0);  // waits until the frame is drawn
       state.clicks.push(performance.now() - eventTime);
-      state.phases.push([sent - eventTime, answered - sent, performance.now() - answered]);
+      state.phases.push([sent - eventTime, answered - sent, updated - answered, performance.now() - updated]);
     }
     status(f.header.log);
     return true;  // drawn
@@ -853,14 +855,15 @@ function pump(drag: Drag) {
       const f = await postFrame('/api/drag/move', { session: state.session, to: drag.target, rotate: drag.rotate });
       const answered = performance.now();
       applyDelta(f);
+      const updated = performance.now();
       drag.previewed = true;
       renderer.draw(state.transform, state.overlays);
       if (state.measure) {
         renderer.readPixel(0, 0);  // waits until the frame is drawn
         const drawn = performance.now();
         state.latencies.push(drawn - eventTime);
-        // Where the time went: the event to its handler, the request, the update and the draw.
-        state.phases.push([sent - eventTime, answered - sent, drawn - answered]);
+        // Where the time went: the event to its handler, the request, the update, the draw.
+        state.phases.push([sent - eventTime, answered - sent, updated - answered, drawn - updated]);
       }
       status('dragging');
     } catch (e) {
@@ -1167,6 +1170,19 @@ window.subvec = {
     const dpr = window.devicePixelRatio || 1;
     const t = state.transform;
     return [r.left + (x * t.zoom + t.panX) / dpr, r.top + (y * t.zoom + t.panY) / dpr];
+  },
+  // The partial redraws' reference: draws what changed since the last frame (a partial frame when it
+  // can), then everything, and counts the pixels that differ (0 when partial frames are exact).
+  partialFrameErrors() {
+    renderer.draw(state.transform, state.overlays);
+    const part = renderer.readAll();
+    renderer.draw(state.transform, state.overlays, true);
+    const whole = renderer.readAll();
+    let differ = 0;
+    for (let i = 0; i < part.length; i += 4) {
+      if (part[i] !== whole[i] || part[i + 1] !== whole[i + 1] || part[i + 2] !== whole[i + 2]) differ++;
+    }
+    return { differ, frames: { ...renderer.frames } };
   },
   idle() { return state.busy === 0 && !state.drag && downloads === 0; },
   measure(on: boolean) { state.measure = on; state.latencies = []; state.phases = []; state.clicks = []; },

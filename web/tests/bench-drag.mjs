@@ -75,7 +75,10 @@ try {
     const phases = await page.evaluate(() => window.subvec.phases());
     const median = (k) => phases.map((p) => p[k]).sort((a, b) => a - b)[Math.floor(phases.length / 2)];
     console.log(`  medians: ${first} to request ${median(0).toFixed(1)} ms, request ${median(1).toFixed(1)} ms, ` +
-      `update and draw ${median(2).toFixed(1)} ms`);
+      `update ${median(2).toFixed(1)} ms, draw ${median(3).toFixed(1)} ms`);
+    const frames = await page.evaluate(() => window.subvec.renderer().frames);
+    console.log(`  frames so far: ${frames.partial} partial (${(100 * frames.partialShare / Math.max(1, frames.partial)).toFixed(0)} % ` +
+      `of the canvas on average), ${frames.full} full`);
   };
   const latencies = await page.evaluate(() => window.subvec.latencies());
   await report(`drag redraw, ${latencies.length} moves`, latencies, 'event');

@@ -54,6 +54,15 @@ try {
     }
     await idle(page);
   };
+  // Partial redraws (gl.ts) against a full redraw: at each call, the frame the page draws for
+  // what changed since the last one must equal a full redraw pixel for pixel.
+  const inexact = [];
+  let compared = 0;
+  const exact = async (label) => {
+    const r = await page.evaluate(() => window.subvec.partialFrameErrors());
+    compared++;
+    if (r.differ > 0) inexact.push(`${label}: ${r.differ} pixels`);
+  };
   // Every status line the page shows, for problem 10 (no internal terms).
   await page.evaluate(() => {
     window.statuses = [];
@@ -82,6 +91,7 @@ try {
   await page.mouse.move(hx, hy);
   await page.waitForFunction(() => /^a click here changes the \d+ control colors shown white$/.test(document.getElementById('status').textContent), null, { timeout: 10000 })
     .then(() => check('color: hovering previews the region', true), async () => check('color: hovering previews the region', false, `status "${(await doc()).status}"`));
+  await exact('the hover preview');
   await page.keyboard.press('i');
   const picked = await page.evaluate(() => document.getElementById('color').value);
   const under = await pixel(page, 48, 48);
@@ -96,6 +106,10 @@ try {
     /is not a color/.test((await doc()).status));
   await page.locator('#canvas').focus().catch(() => undefined);
   await page.evaluate(() => document.activeElement.blur());
+  const [hx2, hy2] = await client(page, 8, 8);
+  await page.mouse.move(hx2, hy2);
+  await page.waitForTimeout(300);
+  await exact('a second hover preview');
 
   // Problem 2: twenty quick color clicks are twenty edits, none refused as another tab's.
   await page.evaluate(() => {
@@ -110,6 +124,7 @@ try {
   check('color: 20 quick clicks are 20 edits', d.version === start.version + 20 && d.undo === 20,
     `version ${start.version} -> ${d.version}, ${d.undo} undo steps, status "${d.status}"`);
   check('color: no conflict and no error', !d.error && !/another tab/.test(d.status), `status "${d.status}"`);
+  await exact('20 color clicks');
 
   // A real drag after all that: 8 px to the right, committed once.
   await page.keyboard.press('d');
@@ -133,7 +148,18 @@ try {
     await idle(page);
     return doc();
   };
-  d = await drag([76, 48], [84, 48]);
+  // With the overlays on, compared with a full redraw halfway.
+  await page.keyboard.press('1');
+  await page.keyboard.press('2');
+  await sweep([76, 48], [80, 46], 5, true);
+  await exact('a drag preview with the overlays');
+  await sweep([80, 46], [84, 48], 5);
+  await page.mouse.up();
+  await idle(page);
+  await exact('the drag\'s commit');
+  await page.keyboard.press('1');
+  await page.keyboard.press('2');
+  d = await doc();
   check('drag: one edit', d.version === start.version + 21 && d.undo === 21 && /dragged/.test(d.status),
     `version ${d.version}, ${d.undo} undo steps, status "${d.status}"`);
 
@@ -291,6 +317,7 @@ try {
   d = await doc();
   let now = await control();
   const shifted = (i, dx, dy) => Math.abs(now[2 * i] - rest[2 * i] - dx) < 1e-3 && Math.abs(now[2 * i + 1] - rest[2 * i + 1] - dy) < 1e-3;
+  await exact('points nudged');
   check('points: arrow keys nudge the selection, one edit each', d.version === v1 + 4 &&
     selection.every((i) => shifted(i, 3, -10)) && shifted(boxed[0], now[2 * boxed[0]] - rest[2 * boxed[0]], now[2 * boxed[0] + 1] - rest[2 * boxed[0] + 1]) &&
     /^moved \d+ control points by \(0, -10\) px$/.test(d.status), `version ${v1} -> ${d.version}, status "${d.status}"`);
@@ -307,6 +334,7 @@ try {
   await page.keyboard.press('r');
   await idle(page);
   d = await doc();
+  await exact('points recolored');
   check('points: R recolors the selected points', d.version === v1 + 6 &&
     new RegExp(`^color blend of ${selection.length} control points: \\d+ control colors moved toward \\(255, 0, 0\\)$`).test(d.status), `status "${d.status}"`);
   await page.keyboard.press('Escape');
@@ -356,6 +384,10 @@ try {
   const lines = [...new Set(await page.evaluate(() => window.statuses))];
   const internal = lines.filter((l) => /version|vertex \d|triangle \d|feature \d|id \d|scale adjustment|held back|handle vertices/.test(l));
   check(`status lines are plain (${lines.length} different ones)`, lines.length > 10 && internal.length === 0, internal.join(' | '));
+
+  const frames = await page.evaluate(() => window.subvec.renderer().frames);
+  check(`partial redraws are exact (${compared} compared; ${frames.partial} partial frames, ${frames.full} full)`,
+    inexact.length === 0 && frames.partial >= 20, inexact.join('; '));
 
   check('no page errors', errors.length === 0, errors.join('; '));
 } catch (e) {
