@@ -43,6 +43,8 @@ struct Editor::Session {
     int vertex = -1, feature = -1;
     std::unique_ptr<subvec::ShapeEditor> shape;
     std::vector<Vec2> preview;
+    // The control positions the page holds (the drag's start, then each preview's moves).
+    std::vector<float> control_shown;
     // The last target the preview accepted (it starts at the press point): a release the mesh
     // cannot take commits this one instead.
     Vec2 last_to;
@@ -57,6 +59,32 @@ uint8_t to_byte(float v) {
   if (!(v > 0)) return 0;
   if (v >= 255) return 255;
   return static_cast<uint8_t>(std::lround(v));
+}
+
+// Delta::moved and Delta::offsets for points `indices` (of `count`) going from `shown` to `to`,
+// in steps of 2^-shift; `shown` takes the positions the page will hold. False, with nothing
+// changed, when a move is over 32767 steps.
+bool encode_moves(const std::vector<uint32_t>& indices, const std::vector<float>& to, int shift,
+                  size_t count, std::vector<float>& shown, std::vector<uint8_t>& mask,
+                  std::vector<int16_t>& offsets) {
+  const double step = std::ldexp(1.0, -shift);
+  offsets.resize(to.size());
+  for (size_t k = 0; k < to.size(); ++k) {
+    const double o = std::round((static_cast<double>(to[k]) - shown[2 * indices[k / 2] + k % 2]) / step);
+    if (!(std::abs(o) <= 32767)) return false;
+    offsets[k] = static_cast<int16_t>(o);
+  }
+  mask.assign((count + 7) / 8, 0);
+  for (size_t i = 0; i < indices.size(); ++i) {
+    const uint32_t g = indices[i];
+    mask[g / 8] = static_cast<uint8_t>(mask[g / 8] | (1u << (g % 8)));
+    // Exact in double (an int16 times a power of two plus a float), then one rounding to float:
+    // the page computes the same.
+    for (int c = 0; c < 2; ++c) {
+      shown[2 * g + c] = static_cast<float>(static_cast<double>(shown[2 * g + c]) + offsets[2 * i + c] * step);
+    }
+  }
+  return true;
 }
 
 // A library error raised by a request's content: 422 (the request was well formed, the edit is
@@ -362,14 +390,16 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
   // of the region by less. They go as soon as their drift reaches it, and the drag's end sends
   // every change exactly.
   const float slack = preview ? static_cast<float>(1 / (32 * v.scale)) : 0.0f;
+  std::vector<uint32_t> moved;
+  std::vector<float> to;  // their new positions
   for (size_t g = 0; g < ng; ++g) {
     const size_t rv = static_cast<size_t>(v.gl_vertex[g]);
     const float x = refined.positions[2 * rv], y = refined.positions[2 * rv + 1];
     const float dx = std::abs(x - v.mesh.positions[2 * g]), dy = std::abs(y - v.mesh.positions[2 * g + 1]);
     if (preview ? (dx > slack || dy > slack) : (dx != 0 || dy != 0)) {
-      v.mesh.positions[2 * g] = x;
-      v.mesh.positions[2 * g + 1] = y;
-      delta.position_indices.push_back(static_cast<uint32_t>(g));
+      moved.push_back(static_cast<uint32_t>(g));
+      to.push_back(x);
+      to.push_back(y);
     }
     if (!colors) continue;
     const size_t rc = static_cast<size_t>(v.gl_color[g]);
@@ -381,16 +411,49 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
     }
     if (changed) delta.color_indices.push_back(static_cast<uint32_t>(g));
   }
+  if (preview) {
+    // Moves in steps of 2^-shift image pixels, at most 1/64 of a canvas pixel (half the slack, so
+    // every move sent is at least one step).
+    const int shift = std::clamp(static_cast<int>(std::ceil(std::log2(64 * v.scale))), -8, 24);
+    std::vector<float>& control_shown = session.drag->control_shown;
+    std::vector<uint32_t> control_moved;
+    std::vector<float> control_to;
+    for (size_t i = 0; i < positions.size(); ++i) {
+      const float x = static_cast<float>(positions[i].x), y = static_cast<float>(positions[i].y);
+      if (std::abs(x - control_shown[2 * i]) > slack || std::abs(y - control_shown[2 * i + 1]) > slack) {
+        control_moved.push_back(static_cast<uint32_t>(i));
+        control_to.push_back(x);
+        control_to.push_back(y);
+      }
+    }
+    if (encode_moves(moved, to, shift, ng, v.mesh.positions, delta.moved, delta.offsets) &&
+        encode_moves(control_moved, control_to, shift, positions.size(), control_shown,
+                     delta.control_moved, delta.control_offsets)) {
+      delta.moves = true;
+      delta.offset_shift = shift;
+      return delta;
+    }
+    // A move too long for int16 steps: absolute positions (below).
+    delta.moved.clear();
+    delta.offsets.clear();
+    delta.control_moved.clear();
+    delta.control_offsets.clear();
+    for (size_t i = 0; i < positions.size(); ++i) {
+      control_shown[2 * i] = static_cast<float>(positions[i].x);
+      control_shown[2 * i + 1] = static_cast<float>(positions[i].y);
+    }
+  }
+  for (size_t i = 0; i < moved.size(); ++i) {
+    v.mesh.positions[2 * moved[i]] = to[2 * i];
+    v.mesh.positions[2 * moved[i] + 1] = to[2 * i + 1];
+  }
   // Sparse while it is smaller: an index (4 bytes) per changed value against 8 / 4 bytes each.
-  if (delta.position_indices.size() * 2 > ng) {
+  if (moved.size() * 2 > ng) {
     delta.dense_positions = true;
-    delta.position_indices.clear();
     delta.positions = v.mesh.positions;
   } else {
-    for (uint32_t g : delta.position_indices) {
-      delta.positions.push_back(v.mesh.positions[2 * g]);
-      delta.positions.push_back(v.mesh.positions[2 * g + 1]);
-    }
+    delta.position_indices = std::move(moved);
+    delta.positions = std::move(to);
   }
   if (delta.color_indices.size() * 2 > ng) {
     delta.dense_colors = true;
@@ -536,6 +599,12 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
     drag->shape = std::make_unique<subvec::ShapeEditor>(mesh, image_.width, image_.height);
   } catch (const Error& e) {
     refuse_edit(e);
+  }
+  // The page holds the document's control positions: previews send moves from there.
+  drag->control_shown.reserve(2 * mesh.positions.size());
+  for (const Vec2& p : mesh.positions) {
+    drag->control_shown.push_back(static_cast<float>(p.x));
+    drag->control_shown.push_back(static_cast<float>(p.y));
   }
   session.drag = std::move(drag);
   // Factor the ARAP systems for this handle set now (a zero move), so that every move of the

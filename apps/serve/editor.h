@@ -100,6 +100,15 @@ struct Delta {
   std::vector<uint8_t> colors;
   std::vector<float> control_positions;  // #V x 2 of the view's level (for the overlay)
   bool strokes_changed = false;
+  // A drag preview sends moves instead (a third of the bytes): `moved` has a bit per GL vertex
+  // (bit g % 8 of byte g / 8), and `offsets` an (x, y) int16 pair per set bit, in steps of
+  // 2^-offset_shift image pixels, to add to the position the page holds. The sum is exact in
+  // double and then rounded to float, so the page and the server agree bit for bit. The same for
+  // the control positions (`control_moved`, `control_offsets`; `control_positions` is then empty).
+  bool moves = false;  // false: positions are absolute, as above
+  int offset_shift = 0;
+  std::vector<uint8_t> moved, control_moved;
+  std::vector<int16_t> offsets, control_offsets;
 };
 
 // A stroke as the page draws it: a polyline with a half-width per point.

@@ -42,13 +42,18 @@ constexpr size_t kMaxBody = 64 * 1024;
 // ---- binary frames -------------------------------------------------------------------------
 // A frame is "SVB1", the byte length of a JSON header (u32, little-endian), the header padded
 // with spaces to a multiple of 4 bytes, then the sections the header lists ("sections": name,
-// type f32 / u32 / u8, count), each padded with zeros to a multiple of 4 bytes. The page reads the
+// type f32 / u32 / i16 / u8, count), each padded with zeros to a multiple of 4 bytes. The page reads the
 // sections as typed arrays without copying.
 class Frame {
  public:
   template <class T>
   void add(const std::string& name, const std::vector<T>& values) {
-    const char* type = std::is_same_v<T, float> ? "f32" : std::is_same_v<T, uint32_t> ? "u32" : "u8";
+    static_assert(std::is_same_v<T, float> || std::is_same_v<T, uint32_t> ||
+                  std::is_same_v<T, int16_t> || std::is_same_v<T, uint8_t>);
+    const char* type = std::is_same_v<T, float>      ? "f32"
+                       : std::is_same_v<T, uint32_t> ? "u32"
+                       : std::is_same_v<T, int16_t>  ? "i16"
+                                                     : "u8";
     sections_.push_back({{"name", name}, {"type", type}, {"count", values.size()}});
     const size_t bytes = values.size() * sizeof(T);
     const size_t at = body_.size();
@@ -79,6 +84,13 @@ std::string delta_frame(const Delta& d, json header) {
   f.add("color_indices", d.color_indices);
   f.add("colors", d.colors);
   f.add("control", d.control_positions);
+  if (d.moves) {
+    f.add("moved", d.moved);
+    f.add("offsets", d.offsets);
+    f.add("control_moved", d.control_moved);
+    f.add("control_offsets", d.control_offsets);
+    header["offset_shift"] = d.offset_shift;
+  }
   header["view"] = d.view_id;
   header["dense_positions"] = d.dense_positions;
   header["dense_colors"] = d.dense_colors;

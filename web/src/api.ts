@@ -8,7 +8,7 @@ export class ApiError extends Error {
 
 export interface Section {
   name: string;
-  type: 'f32' | 'u32' | 'u8';
+  type: 'f32' | 'u32' | 'i16' | 'u8';
   count: number;
 }
 
@@ -17,6 +17,7 @@ export interface Frame {
   header: Record<string, any>;
   f32: Record<string, Float32Array>;
   u32: Record<string, Uint32Array>;
+  i16: Record<string, Int16Array>;
   u8: Record<string, Uint8Array>;
 }
 
@@ -27,12 +28,13 @@ export function parseFrame(buffer: ArrayBuffer): Frame {
   }
   const length = view.getUint32(4, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 8, length)));
-  const frame: Frame = { header, f32: {}, u32: {}, u8: {} };
+  const frame: Frame = { header, f32: {}, u32: {}, i16: {}, u8: {} };
   let at = 8 + length;
   for (const s of header.sections as Section[]) {
-    const size = s.type === 'u8' ? 1 : 4;
+    const size = s.type === 'u8' ? 1 : s.type === 'i16' ? 2 : 4;
     if (s.type === 'f32') frame.f32[s.name] = new Float32Array(buffer, at, s.count);
     else if (s.type === 'u32') frame.u32[s.name] = new Uint32Array(buffer, at, s.count);
+    else if (s.type === 'i16') frame.i16[s.name] = new Int16Array(buffer, at, s.count);
     else frame.u8[s.name] = new Uint8Array(buffer, at, s.count);
     at += (s.count * size + 3) & ~3;
   }

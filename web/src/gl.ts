@@ -4,15 +4,15 @@
 // canvas, so panning and zooming only change two uniforms.
 //
 // Partial redraws. The drawing buffer is preserved between frames, and the renderer remembers what
-// it shows. A change to some vertices (a drag preview, a color edit, a moved selection) marks the
-// image-space rectangle it touches: the triangles around each changed vertex, at their old and new
-// positions, and the overlay lines and points on changed control points. The next frame, when the
-// view and the overlays are those shown, clears and draws that rectangle only (scissored), and only
-// the triangle chunks that meet it: the triangles are sorted along a Morton curve once per view, so
-// a chunk of CHUNK consecutive triangles is a compact patch with a bounding box. Pixels outside the
-// rectangle are those a full draw would give, so the frame is exact (web/tests/e2e-input.mjs
-// compares it with a full redraw). Anything else (a new view, zoom, pan, overlay switches, resize,
-// strokes) draws everything.
+// it shows. A change to some GL vertices (a drag preview, a color edit) marks the rectangle around
+// their triangles, before and after; a change to control points or highlights, the overlay points
+// and lines on them. When the view and the overlays are those shown, the next frame clears and
+// draws only the rectangle around all that (scissored), and of the triangles only the chunks that
+// meet it: the triangles are sorted along a Hilbert curve once per view, so that a chunk of CHUNK
+// consecutive ones is a compact patch with a bounding box. Pixels outside the rectangle are those
+// a full draw would give, so the frame is exact (web/tests/e2e-input.mjs compares it with a full
+// redraw). Anything else (a new view, zoom, pan, overlay switches, resize, strokes) draws
+// everything.
 
 const VERTEX = `#version 300 es
 in vec2 a_pos;
@@ -69,16 +69,24 @@ const CHUNK = 256;        // triangles per culling chunk
 const MARGIN = 6;         // canvas pixels around a dirty rectangle: the widest point is 8 px
 const PARTIAL_SHARE = 0.9; // a dirty rectangle over this share of the canvas: draw everything
 
-// Morton code of a point quantized to 10 bits per axis.
-function morton(x: number, y: number): number {
-  const spread = (v: number) => {
-    v &= 0x3ff;
-    v = (v | (v << 8)) & 0x00ff00ff;
-    v = (v | (v << 4)) & 0x0f0f0f0f;
-    v = (v | (v << 2)) & 0x33333333;
-    return (v | (v << 1)) & 0x55555555;
-  };
-  return spread(x) | (spread(y) << 1);
+// Index along a Hilbert curve of a point on a 1024 x 1024 grid: consecutive indices are
+// neighbours, so a run of triangles sorted by it is a compact patch.
+function hilbert(x: number, y: number): number {
+  let d = 0;
+  for (let s = 512; s > 0; s >>= 1) {
+    const rx = (x & s) > 0 ? 1 : 0, ry = (y & s) > 0 ? 1 : 0;
+    d += s * s * ((3 * rx) ^ ry);
+    if (ry === 0) {
+      if (rx === 1) {
+        x = 1023 - x;
+        y = 1023 - y;
+      }
+      const t = x;
+      x = y;
+      y = t;
+    }
+  }
+  return d;
 }
 
 // What a frame showed: a partial redraw needs the same canvas size, transform and overlays.
@@ -118,14 +126,16 @@ export class Renderer {
   // CPU copies, updated in place by deltas.
   positions = new Float32Array(0);
   colors = new Uint8Array(0);
-  // The triangles in Morton order, their chunks' bounding boxes (x0, y0, x1, y1 in image pixels;
+  // The triangles in Hilbert order, their chunks' bounding boxes (x0, y0, x1, y1 in image pixels;
   // `stale` ones are recomputed before use), and each GL vertex's triangles (CSR).
   private triangles = new Uint32Array(0);
   private chunkBox = new Float32Array(0);
   private chunkStale = new Uint8Array(0);
   private staleChunks: number[] = [];
-  private vertexTriOffset = new Uint32Array(1);
-  private vertexTris = new Uint32Array(0);
+  private vertexChunkOffset = new Uint32Array(1);
+  private vertexChunks = new Uint32Array(0);
+  private neighbourOffset = new Uint32Array(1);
+  private neighbours = new Uint32Array(0);
   // Overlay geometry on the control points (CPU copies, for dirty rectangles).
   private control = new Float32Array(0);
   private controlEdgeList = new Uint32Array(0);
@@ -137,7 +147,7 @@ export class Renderer {
   private shown: Shown | null = null;
   private dirty = [Infinity, Infinity, -Infinity, -Infinity];
   /** Frames drawn in full and in part (for tests and the benchmark). */
-  frames = { full: 0, partial: 0, skipped: 0, partialShare: 0 };  // partialShare: canvas share summed
+  frames = { full: 0, partial: 0, skipped: 0, partialShare: 0, triangleShare: 0 };  // shares: summed over partial frames
 
   constructor(readonly canvas: HTMLCanvasElement, antialias: boolean) {
     const gl = canvas.getContext('webgl2', {
@@ -212,7 +222,7 @@ export class Renderer {
     this.shown = null;
   }
 
-  // Orders the triangles along a Morton curve of their centroids, then builds the chunk boxes and
+  // Orders the triangles along a Hilbert curve of their centroids, then builds the chunk boxes and
   // the vertex-to-triangle lists.
   private sortTriangles(triangles: Uint32Array) {
     const p = this.positions;
@@ -228,7 +238,7 @@ export class Renderer {
     for (let t = 0; t < nt; ++t) {
       const a = 2 * triangles[3 * t], b = 2 * triangles[3 * t + 1], c = 2 * triangles[3 * t + 2];
       const cx = (p[a] + p[b] + p[c]) / 3, cy = (p[a + 1] + p[b + 1] + p[c + 1]) / 3;
-      keys[t] = morton(Math.round((cx - x0) * sx), Math.round((cy - y0) * sy)) * 4194304 + t;
+      keys[t] = hilbert(Math.round((cx - x0) * sx), Math.round((cy - y0) * sy)) * 4194304 + t;
     }
     keys.sort();
     const sorted = new Uint32Array(3 * nt);
@@ -239,39 +249,77 @@ export class Renderer {
       sorted[3 * j + 2] = triangles[3 * t + 2];
     }
     this.triangles = sorted;
+    // Each vertex's chunks, once each: chunk ids come in increasing order along the triangles.
+    const last = new Int32Array(nv).fill(-1);
     const offset = new Uint32Array(nv + 1);
-    for (let k = 0; k < sorted.length; ++k) offset[sorted[k] + 1]++;
+    for (let k = 0; k < sorted.length; ++k) {
+      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
+      if (last[v] !== c) {
+        last[v] = c;
+        offset[v + 1]++;
+      }
+    }
     for (let v = 0; v < nv; ++v) offset[v + 1] += offset[v];
     const fill = offset.slice(0, nv);
-    const list = new Uint32Array(sorted.length);
-    for (let k = 0; k < sorted.length; ++k) list[fill[sorted[k]]++] = (k / 3) | 0;
-    this.vertexTriOffset = offset;
-    this.vertexTris = list;
+    const list = new Uint32Array(offset[nv]);
+    last.fill(-1);
+    for (let k = 0; k < sorted.length; ++k) {
+      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
+      if (last[v] !== c) {
+        last[v] = c;
+        list[fill[v]++] = c;
+      }
+    }
+    this.vertexChunkOffset = offset;
+    this.vertexChunks = list;
+    // Each vertex's neighbours along its triangles' edges (an inner edge appears twice).
+    const around = new Uint32Array(nv + 1);
+    for (let k = 0; k < sorted.length; ++k) around[sorted[k] + 1] += 2;
+    for (let v = 0; v < nv; ++v) around[v + 1] += around[v];
+    const at = around.slice(0, nv);
+    const neighbours = new Uint32Array(around[nv]);
+    for (let t = 0; t < nt; ++t) {
+      for (let c = 0; c < 3; ++c) {
+        const v = sorted[3 * t + c];
+        neighbours[at[v]++] = sorted[3 * t + ((c + 1) % 3)];
+        neighbours[at[v]++] = sorted[3 * t + ((c + 2) % 3)];
+      }
+    }
+    this.neighbourOffset = around;
+    this.neighbours = neighbours;
     const chunks = Math.ceil(nt / CHUNK);
     this.chunkBox = new Float32Array(4 * chunks);
     this.chunkStale = new Uint8Array(chunks).fill(1);
     this.staleChunks = Array.from({ length: chunks }, (_, c) => c);
   }
 
-  // Grows the dirty rectangle by the triangles around GL vertex g (their current positions) and
-  // marks their chunks stale.
+  // Grows the dirty rectangle by GL vertex g's triangles as they are now, and marks their chunks
+  // stale. Called before a change of g, and touchPoint(g) after a move: the triangles' other
+  // corners are g's neighbours, and a neighbour that moves adds its own old and new places.
   private touchVertex(g: number) {
-    const p = this.positions, tri = this.triangles, d = this.dirty;
-    for (let k = this.vertexTriOffset[g], end = this.vertexTriOffset[g + 1]; k < end; ++k) {
-      const t = this.vertexTris[k];
-      for (let c = 3 * t; c < 3 * t + 3; ++c) {
-        const x = p[2 * tri[c]], y = p[2 * tri[c] + 1];
-        if (x < d[0]) d[0] = x;
-        if (x > d[2]) d[2] = x;
-        if (y < d[1]) d[1] = y;
-        if (y > d[3]) d[3] = y;
-      }
-      const chunk = (t / CHUNK) | 0;
-      if (!this.chunkStale[chunk]) {
-        this.chunkStale[chunk] = 1;
-        this.staleChunks.push(chunk);
-      }
+    const p = this.positions, d = this.dirty;
+    for (let k = this.neighbourOffset[g], end = this.neighbourOffset[g + 1]; k < end; ++k) {
+      const n = this.neighbours[k], x = p[2 * n], y = p[2 * n + 1];
+      if (x < d[0]) d[0] = x;
+      if (x > d[2]) d[2] = x;
+      if (y < d[1]) d[1] = y;
+      if (y > d[3]) d[3] = y;
     }
+    this.touchPoint(g);
+    for (let k = this.vertexChunkOffset[g], end = this.vertexChunkOffset[g + 1]; k < end; ++k) {
+      const c = this.vertexChunks[k];
+      if (this.chunkStale[c]) continue;
+      this.chunkStale[c] = 1;
+      this.staleChunks.push(c);
+    }
+  }
+
+  private touchPoint(g: number) {
+    const p = this.positions, d = this.dirty, x = p[2 * g], y = p[2 * g + 1];
+    if (x < d[0]) d[0] = x;
+    if (x > d[2]) d[2] = x;
+    if (y < d[1]) d[1] = y;
+    if (y > d[3]) d[3] = y;
   }
 
   // Grows the dirty rectangle by a control point, at its current position.
@@ -329,18 +377,27 @@ export class Renderer {
     });
   }
 
-  // Moves GL vertices `indices` (set(i, g) writes vertex g = indices[i]), marking where they were
-  // and where they are dirty, and uploads the range they span.
+  // Adds (offsets[2i], offsets[2i + 1]) * step to GL vertex indices[i] (a drag preview's moves).
+  moveBy(indices: Uint32Array, offsets: Int16Array, step: number) {
+    const p = this.positions;
+    this.movePositions(indices, (i, g) => {
+      p[2 * g] += offsets[2 * i] * step;
+      p[2 * g + 1] += offsets[2 * i + 1] * step;
+    });
+  }
+
+  // Moves GL vertices `indices` (set(i, g) writes vertex g = indices[i]), marking where their
+  // triangles were and are dirty, and uploads the range they span.
   private movePositions(indices: Uint32Array, set: (i: number, g: number) => void) {
     let lo = Infinity, hi = -1;
-    for (let i = 0; i < indices.length; ++i) this.touchVertex(indices[i]);  // where they were
     for (let i = 0; i < indices.length; ++i) {
       const g = indices[i];
+      this.touchVertex(g);
       set(i, g);
-      lo = Math.min(lo, g);
-      hi = Math.max(hi, g);
+      this.touchPoint(g);
+      if (g < lo) lo = g;
+      if (g > hi) hi = g;
     }
-    for (let i = 0; i < indices.length; ++i) this.touchVertex(indices[i]);  // where they are
     this.uploadRange(this.meshPos, this.positions, 2, lo, hi);
   }
 
@@ -357,8 +414,8 @@ export class Renderer {
       const g = indices[i];
       this.colors.set(values.subarray(4 * i, 4 * i + 4), 4 * g);
       this.touchVertex(g);
-      lo = Math.min(lo, g);
-      hi = Math.max(hi, g);
+      if (g < lo) lo = g;
+      if (g > hi) hi = g;
     }
     this.uploadRange(this.meshColor, this.colors, 4, lo, hi);
   }
@@ -521,6 +578,7 @@ export class Renderer {
         if (!meets && run >= 0) {
           const first = run * CHUNK, last = Math.min(nt, c * CHUNK);
           gl.drawElements(gl.TRIANGLES, 3 * (last - first), gl.UNSIGNED_INT, 12 * first);
+          this.frames.triangleShare += (last - first) / nt;
           run = -1;
         }
       }

@@ -266,9 +266,36 @@ async function loadStrokes() {
   renderer.setStrokes(await getJson(`/api/strokes?level=${state.level}`));
 }
 
+// The set bits of a mask (bit i % 8 of byte i / 8), in order.
+function maskIndices(mask: Uint8Array): Uint32Array {
+  let n = 0;
+  for (let i = 0; i < mask.length; ++i) for (let b = mask[i]; b; b &= b - 1) n++;
+  const out = new Uint32Array(n);
+  let k = 0;
+  for (let i = 0; i < mask.length; ++i) {
+    for (let b = mask[i]; b; b &= b - 1) out[k++] = 8 * i + 31 - Math.clz32(b & -b);
+  }
+  return out;
+}
+
 function applyDelta(frame: Frame) {
   const h = frame.header;
   if (typeof h.version === 'number') state.version = h.version;
+  if (typeof h.offset_shift === 'number') {
+    // A drag preview's moves: int16 steps of 2^-offset_shift px added to what the page holds (in
+    // double, then rounded to float, as the server does: both hold the same positions).
+    const step = 2 ** -h.offset_shift;
+    if (h.view === state.view.id) renderer.moveBy(maskIndices(frame.u8.moved), frame.i16.offsets, step);
+    const control = new Float32Array(state.control);
+    const moved = maskIndices(frame.u8.control_moved), offsets = frame.i16.control_offsets;
+    for (let i = 0; i < moved.length; ++i) {
+      control[2 * moved[i]] += offsets[2 * i] * step;
+      control[2 * moved[i] + 1] += offsets[2 * i + 1] * step;
+    }
+    state.control = control;
+    renderer.setControl(control);
+    return;
+  }
   if (h.view === state.view.id) {
     renderer.updatePositions(h.dense_positions ? null : frame.u32.position_indices, frame.f32.positions);
     if (frame.u8.colors.length > 0 || h.dense_colors) {

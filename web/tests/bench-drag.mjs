@@ -77,8 +77,9 @@ try {
     console.log(`  medians: ${first} to request ${median(0).toFixed(1)} ms, request ${median(1).toFixed(1)} ms, ` +
       `update ${median(2).toFixed(1)} ms, draw ${median(3).toFixed(1)} ms`);
     const frames = await page.evaluate(() => window.subvec.renderer().frames);
-    console.log(`  frames so far: ${frames.partial} partial (${(100 * frames.partialShare / Math.max(1, frames.partial)).toFixed(0)} % ` +
-      `of the canvas on average), ${frames.full} full`);
+    const share = (sum) => (100 * sum / Math.max(1, frames.partial)).toFixed(0);
+    console.log(`  frames so far: ${frames.partial} partial (on average ${share(frames.partialShare)} % of the canvas, ` +
+      `${share(frames.triangleShare)} % of the triangles), ${frames.full} full`);
   };
   const latencies = await page.evaluate(() => window.subvec.latencies());
   await report(`drag redraw, ${latencies.length} moves`, latencies, 'event');

@@ -163,15 +163,48 @@ TEST(ServeEditor, ADragOutlivesAnotherTabsEdit) {
 }
 
 // The committed drag is exactly what `subvec edit` makes of the same operation. The previews
-// leave out moves under 1/32 of a canvas pixel (scale 1 here), so the last one the page drew is
-// that result within 1/32 px, and the commit's delta brings the page's positions to it exactly.
+// send moves (int16 steps of 2^-offset_shift px) and leave out moves under 1/32 of a canvas pixel
+// (scale 1 here), so the last one the page drew is that result within 1/32 px, and the commit's
+// delta brings the page's positions to it exactly.
 TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   const VectorImage original = disk();
   Editor editor(original);
   const std::string s = editor.new_session();
   const ViewMesh view = editor.view(s, {0, 2});
   std::vector<float> page = view.positions;  // what the page draws, delta by delta
+  std::vector<float> control;                // the page's control positions
+  for (const Vec2& p : original.levels[0].positions) {
+    control.push_back(static_cast<float>(p.x));
+    control.push_back(static_cast<float>(p.y));
+  }
+  size_t move_bytes = 0, absolute_bytes = 0;  // the previews' positions, as sent and as they were
   const auto apply = [&](const Delta& d) {
+    if (d.moves) {
+      // As the page does it (web/src/main.ts): in double, then rounded to float.
+      const double step = std::ldexp(1.0, -d.offset_shift);
+      const auto patch = [&](std::vector<float>& out, const std::vector<uint8_t>& mask,
+                             const std::vector<int16_t>& offsets) {
+        ASSERT_EQ(mask.size(), (out.size() / 2 + 7) / 8);
+        size_t i = 0;
+        for (size_t g = 0; g < out.size() / 2; ++g) {
+          if (!((mask[g / 8] >> (g % 8)) & 1)) continue;
+          ASSERT_LT(2 * i + 1, offsets.size());
+          for (size_t c = 0; c < 2; ++c) {
+            out[2 * g + c] = static_cast<float>(static_cast<double>(out[2 * g + c]) + offsets[2 * i + c] * step);
+          }
+          ++i;
+        }
+        EXPECT_EQ(2 * i, offsets.size());
+        move_bytes += mask.size() + 2 * offsets.size();
+        absolute_bytes += std::min(4 * out.size(), 6 * offsets.size());
+      };
+      patch(page, d.moved, d.offsets);
+      absolute_bytes += 4 * control.size();  // sent whole before
+      patch(control, d.control_moved, d.control_offsets);
+      absolute_bytes -= std::min(4 * control.size(), 6 * d.control_offsets.size());
+      return;
+    }
+    if (!d.control_positions.empty()) control = d.control_positions;
     if (d.dense_positions) {
       page = d.positions;
       return;
@@ -190,16 +223,27 @@ TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   size_t sent = 0;
   for (int i = 1; i <= 8; ++i) {
     preview = editor.drag_move(s, {76.0 + i, 48}, 0);
+    EXPECT_TRUE(preview.moves);
+    EXPECT_EQ(preview.offset_shift, 6);  // steps of 1/64 px at scale 1
     apply(preview);
-    sent += preview.dense_positions ? page.size() / 2 : preview.position_indices.size();
+    sent += preview.offsets.size() / 2;
   }
   EXPECT_EQ(preview.view_id, view.id);
   EXPECT_GT(sent, page.size() / 2);  // an ARAP drag moves much of the mesh
   EXPECT_TRUE(preview.color_indices.empty());
+  EXPECT_LT(2 * move_bytes, absolute_bytes) << move_bytes << " bytes of moves";
+  const VectorImage previewed = dragged(original, 84);
+  float control_drift = 0;
+  for (size_t i = 0; i < control.size(); ++i) {
+    const Vec2& p = previewed.levels[0].positions[i / 2];
+    control_drift = std::max(control_drift, std::abs(control[i] - static_cast<float>(i % 2 ? p.y : p.x)));
+  }
+  EXPECT_LE(control_drift, 1.0f / 32 + 1e-5f);
   std::string log;
   const std::vector<float> last_preview = page;
   const Delta commit = editor.drag_end(s, 1, {84, 48}, 0, log);
   EXPECT_NE(log.find("dragged"), std::string::npos) << log;
+  EXPECT_FALSE(commit.moves);
   apply(commit);
   const std::string fresh_session = editor.new_session();
   const ViewMesh fresh = editor.view(fresh_session, {0, 2});
