@@ -548,6 +548,7 @@ export class Renderer {
     }
     this.dirty = [Infinity, Infinity, -Infinity, -Infinity];
     gl.viewport(0, 0, w, h);
+    gl.disable(gl.DITHER);  // of no use on an 8-bit target, and a partial frame must match a full one
     if (scissor) {
       gl.enable(gl.SCISSOR_TEST);
       gl.scissor(scissor[0], h - scissor[3], scissor[2] - scissor[0], scissor[3] - scissor[1]);
