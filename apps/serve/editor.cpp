@@ -305,30 +305,34 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
   // the vertex's slot; the other sides of a tear get extra GL vertices.
   std::vector<int32_t> first_color(nr, -1), vertex_gl(nr, -1);
   std::unordered_map<int64_t, uint32_t> seam;
+  const auto gl_of = [&](int32_t rv, int32_t rc) -> uint32_t {
+    if (first_color[rv] < 0) {
+      first_color[rv] = rc;
+      vertex_gl[rv] = static_cast<int32_t>(v->gl_vertex.size());
+      v->gl_vertex.push_back(rv);
+      v->gl_color.push_back(rc);
+      return static_cast<uint32_t>(vertex_gl[rv]);
+    }
+    if (first_color[rv] == rc) return static_cast<uint32_t>(vertex_gl[rv]);
+    const int64_t key = (int64_t{rv} << 32) | static_cast<uint32_t>(rc);
+    auto [it, fresh] = seam.try_emplace(key, static_cast<uint32_t>(v->gl_vertex.size()));
+    if (fresh) {
+      v->gl_vertex.push_back(rv);
+      v->gl_color.push_back(rc);
+    }
+    return it->second;
+  };
   std::vector<uint32_t>& tris = v->mesh.triangles;
   tris.reserve(refined.triangles.size() * 3);
   for (size_t i = 0; i < refined.triangles.size(); ++i) {
+    for (int k = 0; k < 3; ++k) tris.push_back(gl_of(refined.triangles[i][k], refined.triangle_colors[i][k]));
+  }
+  // The same surface one level coarser on the same GL vertices (their limit points are that
+  // level's): the page draws drag previews with it on software WebGL.
+  v->mesh.coarse_triangles.reserve(refined.coarse_triangles.size() * 3);
+  for (size_t i = 0; i < refined.coarse_triangles.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
-      const int32_t rv = refined.triangles[i][k], rc = refined.triangle_colors[i][k];
-      uint32_t g = 0;
-      if (first_color[rv] < 0) {
-        first_color[rv] = rc;
-        g = static_cast<uint32_t>(v->gl_vertex.size());
-        vertex_gl[rv] = static_cast<int32_t>(g);
-        v->gl_vertex.push_back(rv);
-        v->gl_color.push_back(rc);
-      } else if (first_color[rv] == rc) {
-        g = static_cast<uint32_t>(vertex_gl[rv]);
-      } else {
-        const int64_t key = (int64_t{rv} << 32) | static_cast<uint32_t>(rc);
-        auto [it, fresh] = seam.try_emplace(key, static_cast<uint32_t>(v->gl_vertex.size()));
-        if (fresh) {
-          v->gl_vertex.push_back(rv);
-          v->gl_color.push_back(rc);
-        }
-        g = it->second;
-      }
-      tris.push_back(g);
+      v->mesh.coarse_triangles.push_back(gl_of(refined.coarse_triangles[i][k], refined.coarse_triangle_colors[i][k]));
     }
   }
   for (const subvec::EdgeVerts& e : refined.tear_edges) {

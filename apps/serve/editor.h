@@ -85,6 +85,7 @@ struct ViewMesh {
   std::vector<float> positions;     // #G x 2, image pixels
   std::vector<uint8_t> colors;      // #G x 4, RGBA8 (alpha 255)
   std::vector<uint32_t> triangles;  // #T x 3 GL vertex indices
+  std::vector<uint32_t> coarse_triangles;  // the view one level coarser, same GL vertices (RefinedMesh)
   std::vector<uint32_t> tear_lines; // pairs of GL vertex indices along the feature curves
   int num_gl_vertices() const { return static_cast<int>(positions.size() / 2); }
 };

@@ -620,6 +620,7 @@ void EditorServer::Impl::document_routes() {
     f.add("positions", m.positions);
     f.add("colors", m.colors);
     f.add("triangles", m.triangles);
+    f.add("coarse_triangles", m.coarse_triangles);
     f.add("tear_lines", m.tear_lines);
     const std::string body = f.finish({{"view", m.id},
                                        {"level", m.level},

@@ -295,7 +295,7 @@ Subdivision::Subdivision(const ControlMesh& mesh, const MeshTopology& topo, int 
     }
   }
   // Ancestor of each face among the base faces, to keep the children of selected faces only.
-  std::vector<int32_t> ancestor(m.sub.faces.size());
+  std::vector<int32_t> ancestor(m.sub.faces.size()), parent_ancestor;
   std::iota(ancestor.begin(), ancestor.end(), 0);
   for (int level = 1; level <= depth; ++level) {
     const Far::TopologyLevel& parent = m.refiner->GetLevel(level - 1);
@@ -308,6 +308,7 @@ Subdivision::Subdivision(const ControlMesh& mesh, const MeshTopology& topo, int 
     tags = std::move(child_tags);
     std::vector<int32_t> child_ancestor(child.GetNumFaces());
     for (int f = 0; f < child.GetNumFaces(); ++f) child_ancestor[f] = ancestor[child.GetFaceParentFace(f)];
+    if (level == depth) parent_ancestor = std::move(ancestor);
     ancestor = std::move(child_ancestor);
   }
 
@@ -350,6 +351,30 @@ Subdivision::Subdivision(const ControlMesh& mesh, const MeshTopology& topo, int 
       (tags[e] == EdgeTag::kTear ? r.tear_edges
        : tags[e] == EdgeTag::kCrease ? r.crease_edges
                                      : r.border_edges).push_back(edge);
+    }
+  }
+  // The surface one level coarser over the same vertices: each face of level depth - 1 as the
+  // child vertices of its corners (their limit points are the coarser level's), each with the
+  // color value it has in the face's children.
+  if (depth > 0) {
+    const Far::TopologyLevel& parent = m.refiner->GetLevel(depth - 1);
+    for (int pf = 0; pf < parent.GetNumFaces(); ++pf) {
+      if (parent_ancestor[pf] >= m.sub.num_selected) continue;
+      auto corners = parent.GetFaceVertices(pf);
+      auto children = parent.GetFaceChildFaces(pf);
+      Tri tri{-1, -1, -1}, tri_colors{-1, -1, -1};
+      for (int k = 0; k < 3; ++k) {
+        const int cv = parent.GetVertexChildVertex(corners[k]);
+        tri[k] = vmap[cv];
+        for (int cf : children) {
+          auto fv = last.GetFaceVertices(cf);
+          for (int j = 0; j < 3 && tri_colors[k] < 0; ++j) {
+            if (fv[j] == cv) tri_colors[k] = cmap[last.GetFaceFVarValues(cf, 0)[j]];
+          }
+        }
+      }
+      r.coarse_triangles.push_back(tri);
+      r.coarse_triangle_colors.push_back(tri_colors);
     }
   }
 }

@@ -94,6 +94,138 @@ interface Shown {
   w: number; h: number; zoom: number; panX: number; panY: number; mesh: boolean; features: boolean;
 }
 
+// A triangle list as drawn: sorted along a Hilbert curve of the centroids (so a chunk of CHUNK
+// consecutive triangles is a compact patch), the chunks' bounding boxes in image pixels (the
+// `stale` ones are recomputed before use), and per GL vertex the chunks it is in and its
+// neighbours along the triangles' edges (CSR; an inner edge appears twice).
+class TriangleSet {
+  readonly buffer: WebGLBuffer;
+  readonly triangles: Uint32Array;
+  readonly chunkBox: Float32Array;
+  private chunkStale: Uint8Array;
+  private staleChunks: number[];
+  private vertexChunkOffset: Uint32Array;
+  private vertexChunks: Uint32Array;
+  private neighbourOffset: Uint32Array;
+  private neighbours: Uint32Array;
+
+  constructor(gl: WebGL2RenderingContext, p: Float32Array, triangles: Uint32Array) {
+    const nt = triangles.length / 3, nv = p.length / 2;
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (let i = 0; i < p.length; i += 2) {
+      x0 = Math.min(x0, p[i]); x1 = Math.max(x1, p[i]);
+      y0 = Math.min(y0, p[i + 1]); y1 = Math.max(y1, p[i + 1]);
+    }
+    const sx = 1023 / Math.max(x1 - x0, 1e-6), sy = 1023 / Math.max(y1 - y0, 1e-6);
+    // key * 2^22 + index, sorted as doubles (exact below 2^53): a stable order by key.
+    const keys = new Float64Array(nt);
+    for (let t = 0; t < nt; ++t) {
+      const a = 2 * triangles[3 * t], b = 2 * triangles[3 * t + 1], c = 2 * triangles[3 * t + 2];
+      const cx = (p[a] + p[b] + p[c]) / 3, cy = (p[a + 1] + p[b + 1] + p[c + 1]) / 3;
+      keys[t] = hilbert(Math.round((cx - x0) * sx), Math.round((cy - y0) * sy)) * 4194304 + t;
+    }
+    keys.sort();
+    const sorted = new Uint32Array(3 * nt);
+    for (let j = 0; j < nt; ++j) {
+      const t = keys[j] % 4194304;
+      sorted[3 * j] = triangles[3 * t];
+      sorted[3 * j + 1] = triangles[3 * t + 1];
+      sorted[3 * j + 2] = triangles[3 * t + 2];
+    }
+    this.triangles = sorted;
+    // Each vertex's chunks, once each: chunk ids come in increasing order along the triangles.
+    const last = new Int32Array(nv).fill(-1);
+    const offset = new Uint32Array(nv + 1);
+    for (let k = 0; k < sorted.length; ++k) {
+      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
+      if (last[v] !== c) {
+        last[v] = c;
+        offset[v + 1]++;
+      }
+    }
+    for (let v = 0; v < nv; ++v) offset[v + 1] += offset[v];
+    const fill = offset.slice(0, nv);
+    const list = new Uint32Array(offset[nv]);
+    last.fill(-1);
+    for (let k = 0; k < sorted.length; ++k) {
+      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
+      if (last[v] !== c) {
+        last[v] = c;
+        list[fill[v]++] = c;
+      }
+    }
+    this.vertexChunkOffset = offset;
+    this.vertexChunks = list;
+    const around = new Uint32Array(nv + 1);
+    for (let k = 0; k < sorted.length; ++k) around[sorted[k] + 1] += 2;
+    for (let v = 0; v < nv; ++v) around[v + 1] += around[v];
+    const at = around.slice(0, nv);
+    const neighbours = new Uint32Array(around[nv]);
+    for (let t = 0; t < nt; ++t) {
+      for (let c = 0; c < 3; ++c) {
+        const v = sorted[3 * t + c];
+        neighbours[at[v]++] = sorted[3 * t + ((c + 1) % 3)];
+        neighbours[at[v]++] = sorted[3 * t + ((c + 2) % 3)];
+      }
+    }
+    this.neighbourOffset = around;
+    this.neighbours = neighbours;
+    const chunks = Math.ceil(nt / CHUNK);
+    this.chunkBox = new Float32Array(4 * chunks);
+    this.chunkStale = new Uint8Array(chunks);
+    this.staleChunks = [];
+    this.restale();
+    this.buffer = gl.createBuffer()!;
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer);
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sorted, gl.STATIC_DRAW);
+  }
+
+  get count() { return this.triangles.length; }
+
+  // Every chunk's box is recomputed before its next use.
+  restale() {
+    this.chunkStale.fill(1);
+    this.staleChunks = Array.from({ length: this.chunkStale.length }, (_, c) => c);
+  }
+
+  // Grows `d` (x0, y0, x1, y1) by GL vertex g's triangles as they are now, and marks their chunks
+  // stale. Called before a change of g (and the caller adds g's own new place after a move: a
+  // neighbour that moves adds its own old and new places).
+  touch(g: number, p: Float32Array, d: number[]) {
+    for (let k = this.neighbourOffset[g], end = this.neighbourOffset[g + 1]; k < end; ++k) {
+      const n = this.neighbours[k], x = p[2 * n], y = p[2 * n + 1];
+      if (x < d[0]) d[0] = x;
+      if (x > d[2]) d[2] = x;
+      if (y < d[1]) d[1] = y;
+      if (y > d[3]) d[3] = y;
+    }
+    for (let k = this.vertexChunkOffset[g], end = this.vertexChunkOffset[g + 1]; k < end; ++k) {
+      const c = this.vertexChunks[k];
+      if (this.chunkStale[c]) continue;
+      this.chunkStale[c] = 1;
+      this.staleChunks.push(c);
+    }
+  }
+
+  // Recomputes the bounding boxes of the stale chunks.
+  refresh(p: Float32Array) {
+    const tri = this.triangles, box = this.chunkBox, nt = tri.length / 3;
+    for (const c of this.staleChunks) {
+      let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+      for (let k = 3 * c * CHUNK, end = 3 * Math.min(nt, (c + 1) * CHUNK); k < end; ++k) {
+        const x = p[2 * tri[k]], y = p[2 * tri[k] + 1];
+        if (x < x0) x0 = x;
+        if (x > x1) x1 = x;
+        if (y < y0) y0 = y;
+        if (y > y1) y1 = y;
+      }
+      box[4 * c] = x0; box[4 * c + 1] = y0; box[4 * c + 2] = x1; box[4 * c + 3] = y1;
+      this.chunkStale[c] = 0;
+    }
+    this.staleChunks = [];
+  }
+}
+
 export class Renderer {
   readonly gl: WebGL2RenderingContext;
   private program: WebGLProgram;
@@ -104,7 +236,6 @@ export class Renderer {
   private meshVao: WebGLVertexArrayObject;
   private meshPos: WebGLBuffer;
   private meshColor: WebGLBuffer;
-  private meshIndex: WebGLBuffer;
   private tearIndex: WebGLBuffer;
   private controlVao: WebGLVertexArrayObject;
   private controlPos: WebGLBuffer;
@@ -115,7 +246,6 @@ export class Renderer {
   private strokeVao: WebGLVertexArrayObject;
   private strokePos: WebGLBuffer;
   private strokeColor: WebGLBuffer;
-  private triangleCount = 0;
   private tearCount = 0;
   private controlEdgeCount = 0;
   private highlightLineCount = 0;
@@ -126,16 +256,11 @@ export class Renderer {
   // CPU copies, updated in place by deltas.
   positions = new Float32Array(0);
   colors = new Uint8Array(0);
-  // The triangles in Hilbert order, their chunks' bounding boxes (x0, y0, x1, y1 in image pixels;
-  // `stale` ones are recomputed before use), and each GL vertex's triangles (CSR).
-  private triangles = new Uint32Array(0);
-  private chunkBox = new Float32Array(0);
-  private chunkStale = new Uint8Array(0);
-  private staleChunks: number[] = [];
-  private vertexChunkOffset = new Uint32Array(1);
-  private vertexChunks = new Uint32Array(0);
-  private neighbourOffset = new Uint32Array(1);
-  private neighbours = new Uint32Array(0);
+  // The view's triangles, the same surface one level coarser (drag previews on software WebGL; null
+  // when the view has no coarser level), and the set drawn.
+  private fine: TriangleSet | null = null;
+  private coarse: TriangleSet | null = null;
+  private active: TriangleSet | null = null;
   // Overlay geometry on the control points (CPU copies, for dirty rectangles).
   private control = new Float32Array(0);
   private controlEdgeList = new Uint32Array(0);
@@ -190,9 +315,8 @@ export class Renderer {
     };
     this.meshPos = gl.createBuffer()!;
     this.meshColor = gl.createBuffer()!;
-    this.meshIndex = gl.createBuffer()!;
     this.tearIndex = gl.createBuffer()!;
-    this.meshVao = vao(this.meshPos, this.meshColor, this.meshIndex);
+    this.meshVao = vao(this.meshPos, this.meshColor, null);
     this.controlPos = gl.createBuffer()!;
     this.controlEdges = gl.createBuffer()!;
     this.highlightLines = gl.createBuffer()!;
@@ -204,114 +328,43 @@ export class Renderer {
     this.strokeVao = vao(this.strokePos, this.strokeColor, null);
   }
 
-  setMesh(positions: Float32Array, colors: Uint8Array, triangles: Uint32Array, tears: Uint32Array) {
+  // A new view: GL vertex positions and colors, its triangles and, when it has a coarser level,
+  // that level's triangles over the same vertices (`coarse`, else empty), and the tear lines.
+  setMesh(positions: Float32Array, colors: Uint8Array, triangles: Uint32Array, coarse: Uint32Array, tears: Uint32Array) {
     const gl = this.gl;
     this.positions = new Float32Array(positions);
     this.colors = new Uint8Array(colors);
-    this.sortTriangles(triangles);
+    for (const set of [this.fine, this.coarse]) if (set) gl.deleteBuffer(set.buffer);
+    this.fine = new TriangleSet(gl, this.positions, triangles);
+    this.coarse = coarse.length > 0 ? new TriangleSet(gl, this.positions, coarse) : null;
+    this.active = this.fine;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.meshPos);
     gl.bufferData(gl.ARRAY_BUFFER, this.positions, gl.DYNAMIC_DRAW);
     gl.bindBuffer(gl.ARRAY_BUFFER, this.meshColor);
     gl.bufferData(gl.ARRAY_BUFFER, this.colors, gl.DYNAMIC_DRAW);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.meshIndex);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.triangles, gl.STATIC_DRAW);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.tearIndex);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, tears, gl.STATIC_DRAW);
-    this.triangleCount = triangles.length;
     this.tearCount = tears.length;
     this.shown = null;
   }
 
-  // Orders the triangles along a Hilbert curve of their centroids, then builds the chunk boxes and
-  // the vertex-to-triangle lists.
-  private sortTriangles(triangles: Uint32Array) {
-    const p = this.positions;
-    const nt = triangles.length / 3, nv = p.length / 2;
-    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-    for (let i = 0; i < p.length; i += 2) {
-      x0 = Math.min(x0, p[i]); x1 = Math.max(x1, p[i]);
-      y0 = Math.min(y0, p[i + 1]); y1 = Math.max(y1, p[i + 1]);
-    }
-    const sx = 1023 / Math.max(x1 - x0, 1e-6), sy = 1023 / Math.max(y1 - y0, 1e-6);
-    // key * 2^22 + index, sorted as doubles (exact below 2^53): a stable order by key.
-    const keys = new Float64Array(nt);
-    for (let t = 0; t < nt; ++t) {
-      const a = 2 * triangles[3 * t], b = 2 * triangles[3 * t + 1], c = 2 * triangles[3 * t + 2];
-      const cx = (p[a] + p[b] + p[c]) / 3, cy = (p[a + 1] + p[b + 1] + p[c + 1]) / 3;
-      keys[t] = hilbert(Math.round((cx - x0) * sx), Math.round((cy - y0) * sy)) * 4194304 + t;
-    }
-    keys.sort();
-    const sorted = new Uint32Array(3 * nt);
-    for (let j = 0; j < nt; ++j) {
-      const t = keys[j] % 4194304;
-      sorted[3 * j] = triangles[3 * t];
-      sorted[3 * j + 1] = triangles[3 * t + 1];
-      sorted[3 * j + 2] = triangles[3 * t + 2];
-    }
-    this.triangles = sorted;
-    // Each vertex's chunks, once each: chunk ids come in increasing order along the triangles.
-    const last = new Int32Array(nv).fill(-1);
-    const offset = new Uint32Array(nv + 1);
-    for (let k = 0; k < sorted.length; ++k) {
-      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
-      if (last[v] !== c) {
-        last[v] = c;
-        offset[v + 1]++;
-      }
-    }
-    for (let v = 0; v < nv; ++v) offset[v + 1] += offset[v];
-    const fill = offset.slice(0, nv);
-    const list = new Uint32Array(offset[nv]);
-    last.fill(-1);
-    for (let k = 0; k < sorted.length; ++k) {
-      const v = sorted[k], c = (k / (3 * CHUNK)) | 0;
-      if (last[v] !== c) {
-        last[v] = c;
-        list[fill[v]++] = c;
-      }
-    }
-    this.vertexChunkOffset = offset;
-    this.vertexChunks = list;
-    // Each vertex's neighbours along its triangles' edges (an inner edge appears twice).
-    const around = new Uint32Array(nv + 1);
-    for (let k = 0; k < sorted.length; ++k) around[sorted[k] + 1] += 2;
-    for (let v = 0; v < nv; ++v) around[v + 1] += around[v];
-    const at = around.slice(0, nv);
-    const neighbours = new Uint32Array(around[nv]);
-    for (let t = 0; t < nt; ++t) {
-      for (let c = 0; c < 3; ++c) {
-        const v = sorted[3 * t + c];
-        neighbours[at[v]++] = sorted[3 * t + ((c + 1) % 3)];
-        neighbours[at[v]++] = sorted[3 * t + ((c + 2) % 3)];
-      }
-    }
-    this.neighbourOffset = around;
-    this.neighbours = neighbours;
-    const chunks = Math.ceil(nt / CHUNK);
-    this.chunkBox = new Float32Array(4 * chunks);
-    this.chunkStale = new Uint8Array(chunks).fill(1);
-    this.staleChunks = Array.from({ length: chunks }, (_, c) => c);
+  // Draws the coarser triangles (when the view has them) instead of the view's, or back. A drag
+  // preview on software WebGL: a quarter of the triangles.
+  coarsePreview(on: boolean) {
+    const want = on && this.coarse ? this.coarse : this.fine;
+    if (want === this.active || !want) return;
+    this.active = want;
+    want.restale();  // the vertices moved while it was not drawn
+    this.shown = null;
   }
 
-  // Grows the dirty rectangle by GL vertex g's triangles as they are now, and marks their chunks
-  // stale. Called before a change of g, and touchPoint(g) after a move: the triangles' other
-  // corners are g's neighbours, and a neighbour that moves adds its own old and new places.
+  /** Triangles a frame draws now (for tests). */
+  get drawnTriangles() { return this.active ? this.active.count / 3 : 0; }
+
+  // Grows the dirty rectangle by GL vertex g's triangles, as drawn now.
   private touchVertex(g: number) {
-    const p = this.positions, d = this.dirty;
-    for (let k = this.neighbourOffset[g], end = this.neighbourOffset[g + 1]; k < end; ++k) {
-      const n = this.neighbours[k], x = p[2 * n], y = p[2 * n + 1];
-      if (x < d[0]) d[0] = x;
-      if (x > d[2]) d[2] = x;
-      if (y < d[1]) d[1] = y;
-      if (y > d[3]) d[3] = y;
-    }
+    this.active?.touch(g, this.positions, this.dirty);
     this.touchPoint(g);
-    for (let k = this.vertexChunkOffset[g], end = this.vertexChunkOffset[g + 1]; k < end; ++k) {
-      const c = this.vertexChunks[k];
-      if (this.chunkStale[c]) continue;
-      this.chunkStale[c] = 1;
-      this.staleChunks.push(c);
-    }
   }
 
   private touchPoint(g: number) {
@@ -565,13 +618,14 @@ export class Renderer {
     gl.uniform1f(this.uPoint, 5);
     gl.uniform4f(this.uTint, 0, 0, 0, 0);
     gl.bindVertexArray(this.meshVao);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.meshIndex);
-    if (scissor) {
+    const set = this.active;
+    if (set) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, set.buffer);
+    if (set && scissor) {
       // The chunks that meet the rectangle (in image pixels), consecutive ones in one call.
-      this.refreshChunks();
+      set.refresh(this.positions);
       const rx0 = (scissor[0] - t.panX) / t.zoom, ry0 = (scissor[1] - t.panY) / t.zoom;
       const rx1 = (scissor[2] - t.panX) / t.zoom, ry1 = (scissor[3] - t.panY) / t.zoom;
-      const box = this.chunkBox, chunks = box.length / 4, nt = this.triangleCount / 3;
+      const box = set.chunkBox, chunks = box.length / 4, nt = set.count / 3;
       let run = -1;
       for (let c = 0; c <= chunks; ++c) {
         const meets = c < chunks && box[4 * c] <= rx1 && box[4 * c + 2] >= rx0 && box[4 * c + 1] <= ry1 && box[4 * c + 3] >= ry0;
@@ -583,8 +637,8 @@ export class Renderer {
           run = -1;
         }
       }
-    } else {
-      gl.drawElements(gl.TRIANGLES, this.triangleCount, gl.UNSIGNED_INT, 0);
+    } else if (set) {
+      gl.drawElements(gl.TRIANGLES, set.count, gl.UNSIGNED_INT, 0);
     }
     if (this.strokeVertexCount > 0) {
       gl.enable(gl.BLEND);
@@ -598,7 +652,6 @@ export class Renderer {
       gl.uniform4f(this.uTint, 1, 0.85, 0.1, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.tearIndex);
       gl.drawElements(gl.LINES, this.tearCount, gl.UNSIGNED_INT, 0);
-      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.meshIndex);
     }
     gl.bindVertexArray(this.controlVao);
     if (overlays.mesh && this.controlEdgeCount > 0) {
@@ -638,23 +691,7 @@ export class Renderer {
     this.shown = null;
   }
 
-  // Recomputes the bounding boxes of the stale chunks.
-  private refreshChunks() {
-    const p = this.positions, tri = this.triangles, box = this.chunkBox, nt = this.triangleCount / 3;
-    for (const c of this.staleChunks) {
-      let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-      for (let k = 3 * c * CHUNK, end = 3 * Math.min(nt, (c + 1) * CHUNK); k < end; ++k) {
-        const x = p[2 * tri[k]], y = p[2 * tri[k] + 1];
-        if (x < x0) x0 = x;
-        if (x > x1) x1 = x;
-        if (y < y0) y0 = y;
-        if (y > y1) y1 = y;
-      }
-      box[4 * c] = x0; box[4 * c + 1] = y0; box[4 * c + 2] = x1; box[4 * c + 3] = y1;
-      this.chunkStale[c] = 0;
-    }
-    this.staleChunks = [];
-  }
+
 
   // The whole canvas, RGBA rows bottom up (tests compare a partial frame with a full one).
   readAll(): Uint8Array {

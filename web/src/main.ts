@@ -109,14 +109,15 @@ function enqueue(task: () => Promise<void>): Promise<void> {
 }
 
 // Refinement target: refined edges at most this many canvas pixels long, and MSAA. A GPU draws
-// the fine setting for nothing; a software WebGL pays per triangle, so it gets the coarse one
-// (about a quarter of the triangles: a drag then redraws within 50 ms). ?quality=fine|coarse
-// overrides the choice.
+// the fine setting for nothing; a software WebGL pays per triangle and per pixel, so it gets the
+// coarse one (about a quarter of the triangles), and a drag previews a view of depth 2 or more one
+// level coarser (the view's own limit points, a quarter of the triangles again; the release draws
+// the view). ?quality=fine|coarse overrides the choice.
 const quality = (() => {
   const asked = new URLSearchParams(location.search).get('quality');
   const software = softwareWebGL();
   const coarse = asked ? asked === 'coarse' : software;
-  return { edge: coarse ? 8 : 3, antialias: !coarse, software };
+  return { edge: coarse ? 8 : 3, antialias: !coarse, coarsePreview: coarse, software };
 })();
 
 function status(message: string, error = false) {
@@ -244,7 +245,8 @@ async function fetchView(): Promise<void> {
   });
   // "unchanged": the view held (`have`) already covers this one; nothing was sent.
   if (!frame.header.unchanged) {
-    renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.tear_lines);
+    renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.coarse_triangles,
+      frame.u32.tear_lines);
   }
   state.view = {
     id: frame.header.view, depth: frame.header.depth, partial: frame.header.partial,
@@ -844,6 +846,7 @@ async function runDrag(drag: Drag) {
   pump(drag);
   const commit = await drag.done;
   while (drag.inFlight) await drag.inFlight;
+  renderer.coarsePreview(false);
   if (!commit || !drag.moved) {
     try {
       await postJson('/api/drag/cancel', { session: state.session });
@@ -882,6 +885,7 @@ function pump(drag: Drag) {
       const f = await postFrame('/api/drag/move', { session: state.session, to: drag.target, rotate: drag.rotate });
       const answered = performance.now();
       applyDelta(f);
+      if (quality.coarsePreview && state.view.depth >= 2) renderer.coarsePreview(true);
       const updated = performance.now();
       drag.previewed = true;
       renderer.draw(state.transform, state.overlays);

@@ -153,10 +153,15 @@ try {
   await page.keyboard.press('2');
   await sweep([76, 48], [80, 46], 5, true);
   await exact('a drag preview with the overlays');
+  const drawn = () => page.evaluate(() => [window.subvec.renderer().drawnTriangles, window.subvec.state.view.depth]);
+  const [previewTriangles, depth] = await drawn();
   await sweep([80, 46], [84, 48], 5);
   await page.mouse.up();
   await idle(page);
   await exact('the drag\'s commit');
+  const [viewTriangles] = await drawn();
+  check('software WebGL: a drag previews the view one level coarser, the release draws it',
+    depth >= 2 && previewTriangles * 4 === viewTriangles, `depth ${depth}: ${previewTriangles} triangles in the preview, ${viewTriangles} after`);
   await page.keyboard.press('1');
   await page.keyboard.press('2');
   d = await doc();

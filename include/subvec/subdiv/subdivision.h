@@ -35,6 +35,11 @@ struct RefinedMesh {
   std::vector<EdgeVerts> tear_edges;     // refined edges on a tear (the feature curves)
   std::vector<EdgeVerts> crease_edges;   // refined edges on an interior crease
   std::vector<EdgeVerts> border_edges;   // refined edges on the image border
+  // The limit mesh one level coarser, over the same vertices and color values (empty at depth 0):
+  // a refined vertex that refines a vertex of level depth - 1 has that vertex's limit, so these
+  // are exactly the depth - 1 triangles. For a cheaper preview (subvec serve's drags).
+  std::vector<Tri> coarse_triangles;
+  std::vector<Tri> coarse_triangle_colors;
 
   int num_vertices() const { return static_cast<int>(positions.size() / 2); }
   int num_colors() const { return static_cast<int>(colors.size() / 3); }

@@ -1,6 +1,8 @@
 // `subvec serve`: the editor's versioned document and its HTTP boundary (apps/serve).
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -256,6 +258,31 @@ TEST(ServeEditor, DragCommitMatchesSubvecEditAndLastPreview) {
   const VectorImage expected = dragged(original, 84);
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
   EXPECT_EQ(commit.control_positions.size(), expected.levels[0].positions.size() * 2);
+}
+
+// The view's coarse triangles (the page's drag previews on software WebGL) are the view one
+// level coarser: the same positions and colors, tears included, on the same GL vertices.
+TEST(ServeEditor, CoarseTrianglesAreTheViewOneLevelCoarser) {
+  Editor editor(disk());
+  const std::string s = editor.new_session();
+  const ViewMesh fine = editor.view(s, {0, 2});
+  const std::string s1 = editor.new_session();
+  const ViewMesh coarse = editor.view(s1, {0, 1});
+  ASSERT_EQ(fine.coarse_triangles.size(), coarse.triangles.size());
+  const auto corners = [](const ViewMesh& m, const std::vector<uint32_t>& tris) {
+    std::vector<std::array<std::array<long, 6>, 3>> out(tris.size() / 3);
+    for (size_t i = 0; i < tris.size(); ++i) {
+      const uint32_t g = tris[i];
+      out[i / 3][i % 3] = {std::lround(m.positions[2 * g] * 1024), std::lround(m.positions[2 * g + 1] * 1024),
+                           m.colors[4 * g], m.colors[4 * g + 1], m.colors[4 * g + 2], m.colors[4 * g + 3]};
+    }
+    for (auto& t : out) std::sort(t.begin(), t.end());
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(corners(fine, fine.coarse_triangles), corners(coarse, coarse.triangles));
+  for (uint32_t g : fine.coarse_triangles) EXPECT_LT(g, static_cast<uint32_t>(fine.num_gl_vertices()));
+  EXPECT_TRUE(editor.view(editor.new_session(), {0, 0}).coarse_triangles.empty());
 }
 
 // A release the mesh cannot take commits the last position the preview took, and says so; a
