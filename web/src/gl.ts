@@ -275,8 +275,10 @@ export class Renderer {
   frames = { full: 0, partial: 0, skipped: 0, partialShare: 0, triangleShare: 0 };  // shares: summed over partial frames
 
   constructor(readonly canvas: HTMLCanvasElement, antialias: boolean) {
+    // Opaque (the compositor neither blends nor converts it), no depth or stencil buffer, and
+    // preserved between frames for partial redraws.
     const gl = canvas.getContext('webgl2', {
-      antialias, premultipliedAlpha: false, depth: false, stencil: false, preserveDrawingBuffer: true,
+      antialias, alpha: false, depth: false, stencil: false, preserveDrawingBuffer: true,
     });
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
