@@ -500,12 +500,18 @@ void def_edits(PyVectorImage& vi) {
           "vertices"_a, "translate"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0)
       .def(
           "recolor",
-          [](VectorImage& v, std::array<double, 2> at, std::array<double, 3> color,
+          [](VectorImage& v, std::optional<std::array<double, 2>> at, std::array<double, 3> color,
              const std::string& mode, const std::string& select, std::optional<double> radius,
              std::optional<double> tolerance, const py::object& vertices, double amount, int level) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kColor;
-            op.at = point(at, "at");
+            op.select = parse_select(select);
+            // As in an ops file: a click point, except for select='vertices' (the points are given).
+            if (at) {
+              op.at = point(*at, "at");
+            } else if (op.select != subvec::EditSelect::kVertices) {
+              invalid("at is needed unless select='vertices'");
+            }
             op.color = color3(color, "color");
             if (mode == "blend") {
               op.mode = subvec::ColorMode::kBlend;
@@ -514,7 +520,6 @@ void def_edits(PyVectorImage& vi) {
             } else {
               invalid("mode must be 'blend' or 'transform', got '" + mode + "'");
             }
-            op.select = parse_select(select);
             color_reach(op.select, radius, tolerance, op.radius, op.tolerance);
             if ((op.select == subvec::EditSelect::kVertices) != !vertices.is_none()) {
               invalid("vertices go with select='vertices', and it needs them");

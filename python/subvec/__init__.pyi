@@ -109,7 +109,7 @@ class VectorImage:
              sigma: float = 20.0, region: float = 0.0, level: int = 0) -> str: ...
     def move_feature(self, at: _Point, *, translate: _Point = (0, 0), rotate: float = 0.0,
                      region: float = 0.0, level: int = 0) -> str: ...
-    def recolor(self, at: _Point, color: _Color, *, mode: Literal["blend", "transform"] = "blend",
+    def recolor(self, at: _Point | None, color: _Color, *, mode: Literal["blend", "transform"] = "blend",
                 select: Literal["vertex", "feature", "region", "vertices"] = "vertex",
                 radius: float | None = None, tolerance: float | None = None,
                 vertices: npt.ArrayLike | None = None,

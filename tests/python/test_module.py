@@ -217,11 +217,13 @@ def test_direct_handles_move_and_recolor_control_points():
     assert "4 control points moved by [2, -1]" in line
     assert np.allclose(image.mesh()["positions"][inner], positions[inner] + (2, -1))
     before = image.mesh()["colors"]
-    image.recolor((0, 0), (0, 255, 0), select="vertices", vertices=inner, amount=1)
+    image.recolor(None, (0, 255, 0), select="vertices", vertices=inner, amount=1)  # no click point
     changed = np.flatnonzero(np.any(image.mesh()["colors"] != before, axis=1))
     assert changed.size >= 4 and np.allclose(image.mesh()["colors"][changed], (0, 255, 0))
     with pytest.raises(subvec.InvalidArgumentError, match="vertices go with select='vertices'"):
         image.recolor((5, 5), (0, 0, 0), select="vertices")
+    with pytest.raises(subvec.InvalidArgumentError, match="at is needed unless select='vertices'"):
+        image.recolor(None, (0, 0, 0), select="region")
     with pytest.raises(subvec.InvalidArgumentError, match="out of range"):
         image.move_vertices([10**6], (1, 1))
 
