@@ -1127,17 +1127,34 @@ function wireControls() {
 
 // This browser tab's id, kept across reloads (sessionStorage is per tab): the server lets a tab
 // undo and redo its own edits only, and a reload keeps them.
-function tabId(): string {
-  let id = sessionStorage.getItem('subvec-tab');
-  if (!id) {
-    id = Array.from(crypto.getRandomValues(new Uint8Array(12)), (b) => b.toString(16).padStart(2, '0')).join('');
+// This tab's id: the server keeps undo and redo per tab id. sessionStorage keeps it across
+// reloads, but a duplicated tab starts with a copy of it. So a tab also holds a Web Lock named
+// after its id for as long as it is open: a tab that finds its id's lock taken is a duplicate and
+// takes a new id. (Without Web Locks, on plain http away from localhost, duplicates share one.)
+let ownTab: Promise<string> | null = null;
+function tabId(): Promise<string> {
+  ownTab ??= (async () => {
+    const fresh = () => Array.from(crypto.getRandomValues(new Uint8Array(12)), (b) => b.toString(16).padStart(2, '0')).join('');
+    let id = sessionStorage.getItem('subvec-tab') ?? fresh();
+    const locks = navigator.locks;
+    while (locks) {
+      const held = await new Promise<boolean>((resolve) => {
+        void locks.request(`subvec-tab-${id}`, { ifAvailable: true }, (lock) => {
+          resolve(lock !== null);
+          return lock ? new Promise<void>(() => undefined) : undefined;  // held until the tab closes
+        });
+      });
+      if (held) break;
+      id = fresh();
+    }
     sessionStorage.setItem('subvec-tab', id);
-  }
-  return id;
+    return id;
+  })();
+  return ownTab;
 }
 
 async function startSession() {
-  state.session = (await postJson('/api/session', { tab: tabId() })).session;
+  state.session = (await postJson('/api/session', { tab: await tabId() })).session;
   await reloadAll();
 }
 
@@ -1215,6 +1232,7 @@ window.subvec = {
     }
     return { differ, frames: { ...renderer.frames } };
   },
+  tab: tabId,
   idle() { return state.busy === 0 && !state.drag && downloads === 0; },
   measure(on: boolean) { state.measure = on; state.latencies = []; state.phases = []; state.clicks = []; },
   clicks() { return state.clicks.slice(); },
@@ -1234,7 +1252,7 @@ async function main() {
   resize();
   try {
     await waitForDocument();
-    state.session = (await postJson('/api/session', { tab: tabId() })).session;
+    state.session = (await postJson('/api/session', { tab: await tabId() })).session;
     await loadDocument();
     fit();
     await Promise.all([loadView(), loadControl(), loadStrokes()]);

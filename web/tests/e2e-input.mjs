@@ -384,6 +384,29 @@ try {
   check('two tabs: the other tab undoes its own edit', /^undid: color blend at \(6, 6\)$/.test(lineB), `status "${lineB}"`);
   await tabB.close();
 
+  // A duplicated tab starts with a copy of this tab's sessionStorage, and so of its id: it takes
+  // an id of its own (or both tabs would share one undo history), and keeps it across a reload.
+  const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
+  const ready = (p) => p.waitForFunction(() => window.subvec && window.subvec.ready, null, { timeout: 60000 });
+  const original = await context.newPage();
+  await original.goto(server.url);
+  await ready(original);
+  const idA = await original.evaluate(() => window.subvec.tab());
+  const dup = await context.newPage();
+  await dup.addInitScript((id) => {
+    if (!sessionStorage.getItem('copied')) sessionStorage.setItem('subvec-tab', id), sessionStorage.setItem('copied', '1');
+  }, idA);
+  await dup.goto(server.url);
+  await ready(dup);
+  const idDup = await dup.evaluate(() => window.subvec.tab());
+  await dup.reload();
+  await ready(dup);
+  const idReloaded = await dup.evaluate(() => window.subvec.tab());
+  check('a duplicated tab takes its own id and keeps it across a reload',
+    idDup !== idA && idReloaded === idDup && (await original.evaluate(() => window.subvec.tab())) === idA,
+    `original ${idA}, duplicate ${idDup}, reloaded ${idReloaded}`);
+  await context.close();
+
   // Problem 10: the status lines of all of the above speak plainly: no versions, vertex or
   // triangle numbers or solver internals.
   const lines = [...new Set(await page.evaluate(() => window.statuses))];
