@@ -61,6 +61,17 @@ uint8_t to_byte(float v) {
   return static_cast<uint8_t>(std::lround(v));
 }
 
+// Positions as the page holds them: x, y floats.
+std::vector<float> as_floats(const std::vector<Vec2>& positions) {
+  std::vector<float> out;
+  out.reserve(2 * positions.size());
+  for (const Vec2& p : positions) {
+    out.push_back(static_cast<float>(p.x));
+    out.push_back(static_cast<float>(p.y));
+  }
+  return out;
+}
+
 // Delta::moved and Delta::offsets for points `indices` (of `count`) going from `shown` to `to`,
 // in steps of 2^-shift; `shown` takes the positions the page will hold. False, with nothing
 // changed, when a move is over 32767 steps.
@@ -231,10 +242,7 @@ Editor::ControlData Editor::control(int level) const {
   check_level_locked(level);
   const ControlMesh& mesh = image_.levels[level];
   ControlData data;
-  for (const Vec2& p : mesh.positions) {
-    data.positions.push_back(static_cast<float>(p.x));
-    data.positions.push_back(static_cast<float>(p.y));
-  }
+  data.positions = as_floats(mesh.positions);
   // Each interior edge appears in two triangles with opposite directions: keep a < b once, and
   // border edges (one triangle) whichever way they come.
   std::vector<std::pair<int32_t, int32_t>> edges;
@@ -420,10 +428,11 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
     // every move sent is at least one step).
     const int shift = std::clamp(static_cast<int>(std::ceil(std::log2(64 * v.scale))), -8, 24);
     std::vector<float>& control_shown = session.drag->control_shown;
+    const std::vector<float> control = as_floats(positions);
     std::vector<uint32_t> control_moved;
     std::vector<float> control_to;
     for (size_t i = 0; i < positions.size(); ++i) {
-      const float x = static_cast<float>(positions[i].x), y = static_cast<float>(positions[i].y);
+      const float x = control[2 * i], y = control[2 * i + 1];
       if (std::abs(x - control_shown[2 * i]) > slack || std::abs(y - control_shown[2 * i + 1]) > slack) {
         control_moved.push_back(static_cast<uint32_t>(i));
         control_to.push_back(x);
@@ -442,10 +451,7 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
     delta.offsets.clear();
     delta.control_moved.clear();
     delta.control_offsets.clear();
-    for (size_t i = 0; i < positions.size(); ++i) {
-      control_shown[2 * i] = static_cast<float>(positions[i].x);
-      control_shown[2 * i + 1] = static_cast<float>(positions[i].y);
-    }
+    control_shown = control;
   }
   for (size_t i = 0; i < moved.size(); ++i) {
     v.mesh.positions[2 * moved[i]] = to[2 * i];
@@ -469,11 +475,7 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
                           v.mesh.colors.begin() + 4 * g + 4);
     }
   }
-  delta.control_positions.reserve(positions.size() * 2);
-  for (const Vec2& p : positions) {
-    delta.control_positions.push_back(static_cast<float>(p.x));
-    delta.control_positions.push_back(static_cast<float>(p.y));
-  }
+  delta.control_positions = as_floats(positions);
   return delta;
 }
 
@@ -605,11 +607,7 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
     refuse_edit(e);
   }
   // The page holds the document's control positions: previews send moves from there.
-  drag->control_shown.reserve(2 * mesh.positions.size());
-  for (const Vec2& p : mesh.positions) {
-    drag->control_shown.push_back(static_cast<float>(p.x));
-    drag->control_shown.push_back(static_cast<float>(p.y));
-  }
+  drag->control_shown = as_floats(mesh.positions);
   session.drag = std::move(drag);
   // Factor the ARAP systems for this handle set now (a zero move), so that every move of the
   // drag only back-substitutes.

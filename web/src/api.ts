@@ -41,6 +41,26 @@ export function parseFrame(buffer: ArrayBuffer): Frame {
   return frame;
 }
 
+// A drag preview's moves (docs/serve.md): the points whose bit is set in `mask` (bit i % 8 of
+// byte i / 8), in order, and their new positions, `held` (x, y per point) plus the int16 steps of
+// `offsets` times 2^-shift. In double, then rounded to float, as the server does: both then hold
+// the same positions bit for bit.
+export function decodeMoves(mask: Uint8Array, offsets: Int16Array, shift: number, held: Float32Array) {
+  const indices = new Uint32Array(offsets.length / 2), values = new Float32Array(offsets.length);
+  const step = 2 ** -shift;
+  let k = 0;
+  for (let i = 0; i < mask.length; ++i) {
+    for (let b = mask[i]; b; b &= b - 1) {
+      const g = 8 * i + 31 - Math.clz32(b & -b);
+      indices[k] = g;
+      values[2 * k] = held[2 * g] + offsets[2 * k] * step;
+      values[2 * k + 1] = held[2 * g + 1] + offsets[2 * k + 1] * step;
+      k++;
+    }
+  }
+  return { indices, values };
+}
+
 async function check(response: Response): Promise<Response> {
   if (response.ok) return response;
   let message = `${response.status} ${response.statusText}`;

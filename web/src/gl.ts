@@ -89,6 +89,14 @@ function hilbert(x: number, y: number): number {
   return d;
 }
 
+// Grows box b (x0, y0, x1, y1) to hold (x, y).
+function grow(b: number[] | Float32Array, x: number, y: number) {
+  if (x < b[0]) b[0] = x;
+  if (y < b[1]) b[1] = y;
+  if (x > b[2]) b[2] = x;
+  if (y > b[3]) b[3] = y;
+}
+
 // What a frame showed: a partial redraw needs the same canvas size, transform and overlays.
 interface Shown {
   w: number; h: number; zoom: number; panX: number; panY: number; mesh: boolean; features: boolean;
@@ -109,13 +117,10 @@ class TriangleSet {
   private neighbourOffset: Uint32Array;
   private neighbours: Uint32Array;
 
-  constructor(gl: WebGL2RenderingContext, p: Float32Array, triangles: Uint32Array) {
+  // `bounds`: the box of the positions p, which the curve's grid spans.
+  constructor(gl: WebGL2RenderingContext, p: Float32Array, bounds: number[], triangles: Uint32Array) {
     const nt = triangles.length / 3, nv = p.length / 2;
-    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-    for (let i = 0; i < p.length; i += 2) {
-      x0 = Math.min(x0, p[i]); x1 = Math.max(x1, p[i]);
-      y0 = Math.min(y0, p[i + 1]); y1 = Math.max(y1, p[i + 1]);
-    }
+    const [x0, y0, x1, y1] = bounds;
     const sx = 1023 / Math.max(x1 - x0, 1e-6), sy = 1023 / Math.max(y1 - y0, 1e-6);
     // key * 2^22 + index, sorted as doubles (exact below 2^53): a stable order by key.
     const keys = new Float64Array(nt);
@@ -193,11 +198,8 @@ class TriangleSet {
   // neighbour that moves adds its own old and new places).
   touch(g: number, p: Float32Array, d: number[]) {
     for (let k = this.neighbourOffset[g], end = this.neighbourOffset[g + 1]; k < end; ++k) {
-      const n = this.neighbours[k], x = p[2 * n], y = p[2 * n + 1];
-      if (x < d[0]) d[0] = x;
-      if (x > d[2]) d[2] = x;
-      if (y < d[1]) d[1] = y;
-      if (y > d[3]) d[3] = y;
+      const n = this.neighbours[k];
+      grow(d, p[2 * n], p[2 * n + 1]);
     }
     for (let k = this.vertexChunkOffset[g], end = this.vertexChunkOffset[g + 1]; k < end; ++k) {
       const c = this.vertexChunks[k];
@@ -211,15 +213,9 @@ class TriangleSet {
   refresh(p: Float32Array) {
     const tri = this.triangles, box = this.chunkBox, nt = tri.length / 3;
     for (const c of this.staleChunks) {
-      let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-      for (let k = 3 * c * CHUNK, end = 3 * Math.min(nt, (c + 1) * CHUNK); k < end; ++k) {
-        const x = p[2 * tri[k]], y = p[2 * tri[k] + 1];
-        if (x < x0) x0 = x;
-        if (x > x1) x1 = x;
-        if (y < y0) y0 = y;
-        if (y > y1) y1 = y;
-      }
-      box[4 * c] = x0; box[4 * c + 1] = y0; box[4 * c + 2] = x1; box[4 * c + 3] = y1;
+      const b = box.subarray(4 * c, 4 * c + 4);
+      b.set([Infinity, Infinity, -Infinity, -Infinity]);
+      for (let k = 3 * c * CHUNK, end = 3 * Math.min(nt, (c + 1) * CHUNK); k < end; ++k) grow(b, p[2 * tri[k]], p[2 * tri[k] + 1]);
       this.chunkStale[c] = 0;
     }
     this.staleChunks = [];
@@ -247,11 +243,7 @@ export class Renderer {
   private strokePos: WebGLBuffer;
   private strokeColor: WebGLBuffer;
   private tearCount = 0;
-  private controlEdgeCount = 0;
-  private highlightLineCount = 0;
-  private highlightPointCount = 0;
-  private controlPointCount = 0;  // drawn (all control points) while the points tool is on
-  private selectedPointCount = 0;
+  private allPoints = false;  // every control point drawn (the points tool is on)
   private strokeVertexCount = 0;
   // CPU copies, updated in place by deltas.
   positions = new Float32Array(0);
@@ -337,8 +329,10 @@ export class Renderer {
     this.positions = new Float32Array(positions);
     this.colors = new Uint8Array(colors);
     for (const set of [this.fine, this.coarse]) if (set) gl.deleteBuffer(set.buffer);
-    this.fine = new TriangleSet(gl, this.positions, triangles);
-    this.coarse = coarse.length > 0 ? new TriangleSet(gl, this.positions, coarse) : null;
+    const bounds = [Infinity, Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < positions.length; i += 2) grow(bounds, positions[i], positions[i + 1]);
+    this.fine = new TriangleSet(gl, this.positions, bounds, triangles);
+    this.coarse = coarse.length > 0 ? new TriangleSet(gl, this.positions, bounds, coarse) : null;
     this.active = this.fine;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.meshPos);
     gl.bufferData(gl.ARRAY_BUFFER, this.positions, gl.DYNAMIC_DRAW);
@@ -370,35 +364,27 @@ export class Renderer {
   }
 
   private touchPoint(g: number) {
-    const p = this.positions, d = this.dirty, x = p[2 * g], y = p[2 * g + 1];
-    if (x < d[0]) d[0] = x;
-    if (x > d[2]) d[2] = x;
-    if (y < d[1]) d[1] = y;
-    if (y > d[3]) d[3] = y;
+    grow(this.dirty, this.positions[2 * g], this.positions[2 * g + 1]);
   }
 
   // Grows the dirty rectangle by a control point, at its current position.
   private touchControl(v: number) {
-    const x = this.control[2 * v], y = this.control[2 * v + 1], d = this.dirty;
-    if (x < d[0]) d[0] = x;
-    if (x > d[2]) d[2] = x;
-    if (y < d[1]) d[1] = y;
-    if (y > d[3]) d[3] = y;
+    grow(this.dirty, this.control[2 * v], this.control[2 * v + 1]);
   }
 
   // Grows the dirty rectangle by the overlay points and lines on the control points flagged in
   // `changed` (current positions; call before and after a move).
   private touchControlOverlays(changed: Uint8Array) {
-    const touchLines = (pairs: Uint32Array, count: number) => {
-      for (let i = 0; i + 1 < count; i += 2) {
+    const touchLines = (pairs: Uint32Array) => {
+      for (let i = 0; i + 1 < pairs.length; i += 2) {
         if (changed[pairs[i]] || changed[pairs[i + 1]]) {
           this.touchControl(pairs[i]);
           this.touchControl(pairs[i + 1]);
         }
       }
     };
-    if (this.shown?.mesh) touchLines(this.controlEdgeList, this.controlEdgeCount);
-    touchLines(this.highlightChain, this.highlightChain.length);
+    if (this.shown?.mesh) touchLines(this.controlEdgeList);
+    touchLines(this.highlightChain);
     for (let v = 0; v < changed.length; ++v) if (changed[v]) this.touchControl(v);
   }
 
@@ -429,15 +415,6 @@ export class Renderer {
     this.movePositions(indices, (i, g) => {
       p[2 * g] = values[2 * i];
       p[2 * g + 1] = values[2 * i + 1];
-    });
-  }
-
-  // Adds (offsets[2i], offsets[2i + 1]) * step to GL vertex indices[i] (a drag preview's moves).
-  moveBy(indices: Uint32Array, offsets: Int16Array, step: number) {
-    const p = this.positions;
-    this.movePositions(indices, (i, g) => {
-      p[2 * g] += offsets[2 * i] * step;
-      p[2 * g + 1] += offsets[2 * i + 1] * step;
     });
   }
 
@@ -475,12 +452,11 @@ export class Renderer {
     this.uploadRange(this.meshColor, this.colors, 4, lo, hi);
   }
 
-  private controlVertexCount = 0;
   setControl(positions: Float32Array, edges?: Uint32Array) {
     const gl = this.gl;
     const n = positions.length / 2;
     const changed = new Uint8Array(n);
-    if (edges || n !== this.controlVertexCount) {
+    if (edges || n !== this.control.length / 2) {
       this.shown = null;
     } else {
       let any = false;
@@ -495,16 +471,13 @@ export class Renderer {
     }
     this.control = new Float32Array(positions);
     if (this.shown) this.touchControlOverlays(changed);  // where they are
-    this.controlVertexCount = n;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.controlPos);
     gl.bufferData(gl.ARRAY_BUFFER, positions, gl.DYNAMIC_DRAW);
     if (edges) {
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
       gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, edges, gl.STATIC_DRAW);
       this.controlEdgeList = new Uint32Array(edges);
-      this.controlEdgeCount = edges.length;
     }
-    if (this.controlPointCount > 0) this.controlPointCount = n;
   }
 
   // The selection: a feature chain (control vertex indices, drawn as a polyline over the control
@@ -522,24 +495,20 @@ export class Renderer {
     for (const v of this.highlightRegion) this.touchControl(v);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightLines);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.highlightChain, gl.DYNAMIC_DRAW);
-    this.highlightLineCount = lines.length;
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightPoints);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.highlightRegion, gl.DYNAMIC_DRAW);
-    this.highlightPointCount = region.length;
   }
 
   // The points tool's handles: every control point when `all`, and the selected ones.
   setPoints(all: boolean, selected: number[]) {
     const gl = this.gl;
-    const count = all ? this.controlVertexCount : 0;
-    if (count !== this.controlPointCount) this.shown = null;
-    this.controlPointCount = count;
+    if (all !== this.allPoints) this.shown = null;
+    this.allPoints = all;
     for (const v of this.selectedList) this.touchControl(v);
     this.selectedList = new Uint32Array(selected);
     for (const v of this.selectedList) this.touchControl(v);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.selectedPoints);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, this.selectedList, gl.DYNAMIC_DRAW);
-    this.selectedPointCount = selected.length;
   }
 
   // Strokes as triangle strips turned into triangles: each polyline point offset by its
@@ -656,31 +625,31 @@ export class Renderer {
       gl.drawElements(gl.LINES, this.tearCount, gl.UNSIGNED_INT, 0);
     }
     gl.bindVertexArray(this.controlVao);
-    if (overlays.mesh && this.controlEdgeCount > 0) {
+    if (overlays.mesh && this.controlEdgeList.length > 0) {
       gl.uniform4f(this.uTint, 0.1, 0.9, 1, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
-      gl.drawElements(gl.LINES, this.controlEdgeCount, gl.UNSIGNED_INT, 0);
+      gl.drawElements(gl.LINES, this.controlEdgeList.length, gl.UNSIGNED_INT, 0);
     }
-    if (this.highlightLineCount > 0) {
+    if (this.highlightChain.length > 0) {
       gl.uniform4f(this.uTint, 1, 0.2, 0.6, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightLines);
-      gl.drawElements(gl.LINES, this.highlightLineCount, gl.UNSIGNED_INT, 0);
+      gl.drawElements(gl.LINES, this.highlightChain.length, gl.UNSIGNED_INT, 0);
     }
-    if (this.highlightPointCount > 0) {
+    if (this.highlightRegion.length > 0) {
       gl.uniform4f(this.uTint, 1, 1, 1, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.highlightPoints);
-      gl.drawElements(gl.POINTS, this.highlightPointCount, gl.UNSIGNED_INT, 0);
+      gl.drawElements(gl.POINTS, this.highlightRegion.length, gl.UNSIGNED_INT, 0);
     }
-    if (this.controlPointCount > 0) {
+    if (this.allPoints && this.control.length > 0) {
       gl.uniform1f(this.uPoint, 4);
       gl.uniform4f(this.uTint, 0.1, 0.9, 1, 1);
-      gl.drawArrays(gl.POINTS, 0, this.controlPointCount);
+      gl.drawArrays(gl.POINTS, 0, this.control.length / 2);
     }
-    if (this.selectedPointCount > 0) {
+    if (this.selectedList.length > 0) {
       gl.uniform1f(this.uPoint, 8);
       gl.uniform4f(this.uTint, 1, 0.55, 0.05, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.selectedPoints);
-      gl.drawElements(gl.POINTS, this.selectedPointCount, gl.UNSIGNED_INT, 0);
+      gl.drawElements(gl.POINTS, this.selectedList.length, gl.UNSIGNED_INT, 0);
     }
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.controlEdges);
     gl.bindVertexArray(null);

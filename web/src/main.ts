@@ -8,7 +8,7 @@
 // can make a 409 conflict, and the page then reloads. A poll of /api/status notices changes made
 // elsewhere the same way.
 
-import { ApiError, Frame, getJson, postFrame, postJson } from './api';
+import { ApiError, Frame, decodeMoves, getJson, postFrame, postJson } from './api';
 import { Renderer, Transform, softwareWebGL } from './gl';
 
 type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points';
@@ -268,32 +268,18 @@ async function loadStrokes() {
   renderer.setStrokes(await getJson(`/api/strokes?level=${state.level}`));
 }
 
-// The set bits of a mask (bit i % 8 of byte i / 8), in order.
-function maskIndices(mask: Uint8Array): Uint32Array {
-  let n = 0;
-  for (let i = 0; i < mask.length; ++i) for (let b = mask[i]; b; b &= b - 1) n++;
-  const out = new Uint32Array(n);
-  let k = 0;
-  for (let i = 0; i < mask.length; ++i) {
-    for (let b = mask[i]; b; b &= b - 1) out[k++] = 8 * i + 31 - Math.clz32(b & -b);
-  }
-  return out;
-}
-
 function applyDelta(frame: Frame) {
   const h = frame.header;
   if (typeof h.version === 'number') state.version = h.version;
   if (typeof h.offset_shift === 'number') {
-    // A drag preview's moves: int16 steps of 2^-offset_shift px added to what the page holds (in
-    // double, then rounded to float, as the server does: both hold the same positions).
-    const step = 2 ** -h.offset_shift;
-    if (h.view === state.view.id) renderer.moveBy(maskIndices(frame.u8.moved), frame.i16.offsets, step);
-    const control = new Float32Array(state.control);
-    const moved = maskIndices(frame.u8.control_moved), offsets = frame.i16.control_offsets;
-    for (let i = 0; i < moved.length; ++i) {
-      control[2 * moved[i]] += offsets[2 * i] * step;
-      control[2 * moved[i] + 1] += offsets[2 * i + 1] * step;
+    // A drag preview's moves, from the positions the page holds.
+    if (h.view === state.view.id) {
+      const m = decodeMoves(frame.u8.moved, frame.i16.offsets, h.offset_shift, renderer.positions);
+      renderer.updatePositions(m.indices, m.values);
     }
+    const m = decodeMoves(frame.u8.control_moved, frame.i16.control_offsets, h.offset_shift, state.control);
+    const control = new Float32Array(state.control);
+    m.indices.forEach((v, i) => control.set(m.values.subarray(2 * i, 2 * i + 2), 2 * v));
     state.control = control;
     renderer.setControl(control);
     return;
