@@ -1,7 +1,8 @@
 // Checks that the committed builds are what their sources build to: web/dist (the editor page,
-// embedded into `subvec serve`) from web/src, and web/viewer/dist (the browser viewer's bundle and
-// type declarations) from web/viewer/src. Type-checks the sources, builds them into temporary
-// folders and compares every file.
+// embedded into `subvec serve`) from web/src, web/viewer/src/wasm-binary.ts (the viewer's
+// WebAssembly) from web/viewer/wasm, and web/viewer/dist (the browser viewer's bundle and type
+// declarations) from web/viewer/src. Type-checks the sources, builds them into temporary folders
+// and compares every file.
 // Exit 0: identical; 1: stale (run `npm run build` / `npm run build:viewer` in web/ and commit the
 // dist folders); 77: skipped.
 import { execFileSync } from 'node:child_process';
@@ -23,13 +24,14 @@ const files = (dir) => !existsSync(dir) ? [] : readdirSync(dir).flatMap((name) =
 const run = (tool, args) => execFileSync(join(bin, tool), args, { stdio: 'inherit', cwd: web });
 
 // Builds into a temporary folder with build(out) and compares it with the committed folder.
-function check(committed, command, build) {
+// `keep` picks the committed files that the build makes (all by default).
+function check(committed, command, build, keep = () => true) {
   const out = mkdtempSync(join(tmpdir(), 'subvec-dist-'));
   let stale = 0;
   try {
     build(out);
     const built = files(out).map((p) => relative(out, p)).sort();
-    const have = files(committed).map((p) => relative(committed, p)).sort();
+    const have = files(committed).map((p) => relative(committed, p)).filter(keep).sort();
     if (JSON.stringify(built) !== JSON.stringify(have)) {
       console.log(`FAIL file lists differ: built ${built.join(', ')}; committed ${have.join(', ')}`);
       stale++;
@@ -56,6 +58,9 @@ const checks = [
     run('tsc', ['--noEmit', '-p', web]);
     run('vite', ['build', '--logLevel', 'warn', '--outDir', out, '--emptyOutDir']);
   }),
+  () => check(join(web, 'viewer', 'src'), 'npm run build:viewer', (out) => {
+    execFileSync(join(web, 'viewer', 'wasm', 'build'), [join(out, 'wasm-binary.ts')], { stdio: 'inherit' });
+  }, (name) => name === 'wasm-binary.ts'),
   () => check(join(web, 'viewer', 'dist'), 'npm run build:viewer', (out) => {
     run('tsc', ['-p', 'viewer']);
     run('vite', ['build', 'viewer', '--logLevel', 'warn', '--outDir', out, '--emptyOutDir']);

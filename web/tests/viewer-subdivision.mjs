@@ -2,7 +2,9 @@
 // (OpenSubdiv, through the Python module's _subdivide): the same limit triangles, positions and
 // colors, on the examples (tears, an open tear, a junction), a crease made from a tear, and the
 // bundled photograph, at depths 0 to 3, the whole mesh and a window's faces. A change to the
-// subdivision rules on either side that the other does not follow fails here.
+// subdivision rules on either side that the other does not follow fails here. The WebAssembly
+// refinement the viewer draws with (web/viewer/wasm/subdivide.c, through src/wasm.ts) must give
+// subdivide.ts's results to the bit: topology, refinement, uniform and adaptive triangles.
 //
 //   node web/tests/viewer-subdivision.mjs PYTHON BUILD/python
 //
@@ -33,6 +35,33 @@ try {
   await build({ entryPoints: [join(root, 'web/viewer/src/subdivide.ts')], bundle: true, format: 'esm',
     outfile: join(tmp, 'subdivide.mjs'), logLevel: 'error' });
   const { buildTopology, refine, uniformIndices, adaptiveIndices } = await import(join(tmp, 'subdivide.mjs'));
+  await build({ entryPoints: [join(root, 'web/viewer/src/wasm.ts')], bundle: true, format: 'esm',
+    outfile: join(tmp, 'wasm.mjs'), logLevel: 'error' });
+  const wasm = await import(join(tmp, 'wasm.mjs'));
+  // Every field of two results equal to the bit (typed arrays compared as bytes).
+  const same = (a, b, path = '') => {
+    if (ArrayBuffer.isView(a) || ArrayBuffer.isView(b)) {
+      if (!ArrayBuffer.isView(a) || !ArrayBuffer.isView(b) || a.constructor !== b.constructor) return `${path}: types differ`;
+      const x = new Uint8Array(a.buffer, a.byteOffset, a.byteLength), y = new Uint8Array(b.buffer, b.byteOffset, b.byteLength);
+      if (x.length !== y.length) return `${path}: ${a.length} against ${b.length} elements`;
+      const i = x.findIndex((v, k) => v !== y[k]);
+      return i < 0 ? null : `${path}[${Math.floor(i / a.BYTES_PER_ELEMENT)}]: ${a[Math.floor(i / a.BYTES_PER_ELEMENT)]} against ${b[Math.floor(i / a.BYTES_PER_ELEMENT)]}`;
+    }
+    if (typeof a === 'object' && a && b) {
+      if (path.endsWith('.level')) return null; // the level itself, shared
+      for (const k of new Set([...Object.keys(a), ...Object.keys(b)])) {
+        const d = same(a[k], b[k], `${path}.${k}`);
+        if (d) return d;
+      }
+      return null;
+    }
+    return Object.is(a, b) ? null : `${path}: ${a} against ${b}`;
+  };
+  const bitwise = (label, fromJs, fromWasm) => {
+    const d = same(fromJs, fromWasm);
+    console.log(`${d ? 'FAIL' : 'PASS'} ${label}: WebAssembly and subdivide.ts agree to the bit${d ? `: first difference ${d}` : ''}`);
+    d ? failed++ : passed++;
+  };
 
   const toLevel = (L) => ({
     positions: Float64Array.from(L.vertices.flat()), colors: Float32Array.from(L.colors.flat()),
@@ -140,7 +169,9 @@ for path, depth, out in zip(sys.argv[1::3], sys.argv[2::3], sys.argv[3::3]):
   };
   for (const [name, path, depths] of cases) {
     const j = JSON.parse(readFileSync(path, 'utf8'));
-    const topo = buildTopology(toLevel(j.levels[0]), j.width, j.height);
+    const level = toLevel(j.levels[0]);
+    const topo = buildTopology(level, j.width, j.height);
+    bitwise(`${name} topology`, topo, wasm.buildTopology(level, j.width, j.height));
     for (const depth of depths) {
       const raw = new Float32Array(readFileSync(join(tmp, `${name}-${depth}.bin`)).buffer.slice(0));
       const cpp = triangles(raw, raw.length / 15, (t, k) => {
@@ -151,10 +182,20 @@ for path, depth, out in zip(sys.argv[1::3], sys.argv[2::3], sys.argv[3::3]):
         const v = 5 * indices[3 * t + k], V = r.vertices;
         return { key: key(V[v], V[v + 1]), x: V[v], y: V[v + 1], rgb: [V[v + 2], V[v + 3], V[v + 4]] };
       });
-      compare(`${name} depth ${depth}`, cpp, fromViewer(refine(topo, null, depth)), false);
+      const whole = refine(topo, null, depth);
+      compare(`${name} depth ${depth}`, cpp, fromViewer(whole), false);
+      bitwise(`${name} depth ${depth}`, whole, wasm.refine(topo, null, depth));
       // A window's faces with their one-ring: the children of those faces are exact too.
       const some = Int32Array.from({ length: Math.ceil(topo.ringBoxes.length / 4 / 7) }, (_, i) => 7 * i);
-      compare(`${name} depth ${depth}, every 7th face`, cpp, fromViewer(refine(topo, some, depth)), true);
+      const part = refine(topo, some, depth);
+      compare(`${name} depth ${depth}, every 7th face`, cpp, fromViewer(part), true);
+      bitwise(`${name} depth ${depth}, every 7th face`, part, wasm.refine(topo, some, depth));
+      for (const [scale, tolerance] of [[1, 0.5], [4, 0.25], [0.5, 2]]) {
+        for (const r of [whole, part]) {
+          bitwise(`${name} depth ${depth}, ${r === whole ? 'whole' : 'every 7th face'}, adaptive at scale ${scale}, tolerance ${tolerance}`,
+            adaptiveIndices(r, scale, tolerance, 0.25), wasm.adaptiveIndices(r, scale, tolerance, 0.25));
+        }
+      }
       if (depth >= 2) adaptive(`${name} depth ${depth}`, refine(topo, null, depth), j.width, j.height);
     }
   }

@@ -9,7 +9,7 @@
 // A view reuses the last refinement when it needs the same level and depth and a subset of its
 // faces: zooming in within one depth, and panning within the refined region, only redraw.
 import { SvecError, type SvecImage } from './image';
-import { adaptiveIndices, buildTopology, refine, uniformIndices, type Refined, type Topology } from './subdivide';
+import { adaptiveIndices, buildTopology, refine, uniformIndices, type Refined, type Topology } from './wasm';
 import { strokeChords, type ViewTransform } from './strokes';
 
 /** A region of the image, in image pixels. */

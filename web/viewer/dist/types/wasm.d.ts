@@ -1,0 +1,29 @@
+import type { Level } from './image';
+import type { Topology as Edges } from './validate';
+import type { Refined, Topology } from './subdivide';
+export { uniformIndices, type Refined, type Topology } from './subdivide';
+/** buildTopology of subdivide.ts. */
+export declare function buildTopology(level: Level, width: number, height: number): Topology;
+/** refine of subdivide.ts. */
+export declare function refine(topo: Topology, faces: Int32Array | null, depth: number): Refined;
+/** adaptiveIndices of subdivide.ts. */
+export declare function adaptiveIndices(r: Refined, scale: number, colorTolerance: number, positionTolerance: number): Uint32Array;
+/** A compact level's counts, precision and bytes (one stream, or six sections), as decode.ts read them. */
+export interface CompactInput {
+    version: number;
+    sections: Uint8Array[];
+    ops: number;
+    nv: number;
+    ncolors: number;
+    ntriangles: number;
+    ncreases: number;
+    nfeatures: number;
+    pb: number;
+    cb: number;
+    width: number;
+    height: number;
+    /** "level L ", which starts most messages */
+    name: string;
+}
+/** A compact level and its topology (edges, twins, tags), or a SvecError naming the problem. */
+export declare function decodeCompact(input: CompactInput): [Level, Edges];
