@@ -15,7 +15,9 @@
 //     rejected as by the C++ reader;
 //  5. mutations of good files (truncations; flipped bytes of the file, and of the payload wrapped
 //     in a fresh zstd frame) always give a SvecError or a valid image, quickly; accept/reject as
-//     the C++ reader does.
+//     the C++ reader does;
+//  6. the zstd content checksum (XXH64, in the viewer's WebAssembly) is the `zstd` command's, on
+//     every length from 0 to 100 bytes (each tail of the hash) and on longer inputs.
 // Exit 0 when all pass, 1 on a failure, 77 (SKIPPED) without web/node_modules or the CLI.
 import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -394,6 +396,27 @@ for (const m of mutants) fs.writeFileSync(m.file, m.bytes);
 const mutantVerdicts = await cppAll(mutants.map((m) => m.file));
 mutants.forEach((m, k) => judge(m, mutantVerdicts[k]));
 console.log(`  ${stats.runs} mutants: ${stats.rejected} rejected, ${stats.valid} valid; ${stats.agree} as C++; slowest ${stats.slowest.toFixed(1)} ms`);
+
+console.log('== 6. the zstd checksum against the zstd command');
+{
+  esbuild.buildSync({ entryPoints: [path.join(web, 'viewer/src/wasm.ts')], bundle: true, format: 'esm', platform: 'node',
+    outfile: path.join(tmp, 'wasm.mjs'), logLevel: 'error' });
+  const { checksum } = await import(pathToFileURL(path.join(tmp, 'wasm.mjs')).href);
+  const zstd = spawnSync('zstd', ['--version']).status === 0;
+  if (check(zstd, 'the zstd command is missing (scripts/setup installs it)')) {
+    let random = 12345, wrong = 0, lengths = 0;
+    const next = () => (random = (Math.imul(random, 1103515245) + 12345) >>> 0) >>> 24;
+    for (const n of [...Array(101).keys(), 127, 128, 129, 1000, 65537, 300001]) {
+      const data = Buffer.from(Array.from({ length: n }, next));
+      const frame = spawnSync('zstd', ['-q', '-c', '--check'], { input: data }).stdout;
+      const expected = frame.readUInt32LE(frame.length - 4), got = checksum(new Uint8Array(data));
+      if (got !== expected) wrong++, console.log(`  length ${n}: checksum ${got.toString(16)}, zstd ${expected.toString(16)}`);
+      lengths++;
+    }
+    check(wrong === 0, `${wrong} of ${lengths} checksums differ from zstd's`);
+    console.log(`  ${lengths} lengths: ${wrong} checksums differ from zstd's`);
+  }
+}
 
 console.log(`(${((Date.now() - started) / 1000).toFixed(1)} s)`);
 console.log(`${passed} passed, ${failed} failed`);

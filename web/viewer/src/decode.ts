@@ -11,7 +11,7 @@
 import { Decompress } from 'fzstd';
 import { Feature, Level, Stroke, SvecError, SvecImage } from './image';
 import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, Topology, escape, fail, validate } from './validate';
-import { decodeCompact } from './wasm';
+import { checksum, decodeCompact } from './wasm';
 
 const GIB = 2 ** 30; // largest file, and largest payload
 const MAGIC = [0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a]; // "SUBVEC" NUL ^Z
@@ -152,73 +152,10 @@ function unzstd(f: Uint8Array, expected: number): Uint8Array {
     if (end <= f.length || (e as { code?: number }).code !== 5) fail(`corrupt zstd frame: ${(e as Error).message}`);
   }
   if (end > f.length) fail(`truncated zstd frame: it ends after ${produced + partial} of ${expected} payload bytes`);
-  if (d & 4 && le(end - 4, 4) !== xxh64(out.subarray(0, produced))) fail("corrupt zstd frame: Restored data doesn't match checksum");
+  if (d & 4 && le(end - 4, 4) !== checksum(out.subarray(0, produced))) fail("corrupt zstd frame: Restored data doesn't match checksum");
   if (produced !== expected) fail(`zstd frame decompresses to ${produced} bytes but the header declares ${expected}`);
   if (end < f.length) fail(`${f.length - end} unexpected bytes after the zstd frame`);
   return out;
-}
-
-// The low 32 bits of XXH64 (seed 0): zstd's content checksum. A 64-bit word is a pair (hi, lo)
-// of 32-bit halves (BigInt would be ten times slower); mul leaves its product in H, L.
-const P = [0x9e3779b1, 0x85ebca87, 0xc2b2ae3d, 0x27d4eb4f, 0x165667b1, 0x9e3779f9, 0x85ebca77, 0xc2b2ae63, 0x27d4eb2f, 0x165667c5];
-let H = 0, L = 0;
-// (ah, al) times prime k (P1 to P5: 0 to 4), mod 2^64: the low halves' product in 16-bit parts.
-function mul(ah: number, al: number, k: number) {
-  const bh = P[2 * k], bl = P[2 * k + 1], a1 = al >>> 16, a0 = al & 0xffff, b1 = bl >>> 16, b0 = bl & 0xffff;
-  const mid = a1 * b0 + a0 * b1, low = a0 * b0 + (mid & 0xffff) * 65536;
-  L = low >>> 0;
-  H = (Math.imul(ah, bl) + Math.imul(al, bh) + a1 * b1 + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff)) >>> 0;
-}
-// ((ah, al) + lane (bh, bl) * P2) rotated left by 31, times P1: a lane's round.
-function round(ah: number, al: number, bh: number, bl: number) {
-  mul(bh, bl, 1);
-  const lo = al + L, hi = ah + H + +(lo > 0xffffffff);
-  mul((hi << 31) | (lo >>> 1), (lo << 31) | (hi >>> 1), 0);
-}
-function xxh64(b: Uint8Array): number {
-  const d = new DataView(b.buffer, b.byteOffset, b.length), n = b.length;
-  let i = 0, h = P[8], l = P[9];
-  // h = (h ^ (H, L)) rotated left by r (0 < r < 32, or none), times prime k, plus prime a (if a < 5)
-  const step = (r: number, k: number, a: number) => {
-    const x = h ^ H, y = l ^ L;
-    r ? mul((x << r) | (y >>> (32 - r)), (y << r) | (x >>> (32 - r)), k) : mul(x, y, k);
-    l = L + (a < 5 ? P[2 * a + 1] : 0);
-    h = (H + (a < 5 ? P[2 * a] : 0) + +(l > 0xffffffff)) >>> 0;
-    l >>>= 0;
-  };
-  if (n >= 32) {
-    const v = [0x60ea27ee, 0xadc0b5d6, P[2], P[3], 0, 0, 0x61c8864e, 0x7a143579];
-    // The stripes: round() written out, the hot loop on large payloads.
-    for (; i + 32 <= n; i += 32)
-      for (let k = 0; k < 8; k += 2) {
-        // lane * P2 + v[k], rotated left by 31, times P1
-        let ah = d.getUint32(i + 4 * k + 4, true), al = d.getUint32(i + 4 * k, true), a1 = al >>> 16, a0 = al & 0xffff;
-        let mid = a1 * 0xeb4f + a0 * 0x27d4, low = a0 * 0xeb4f + (mid & 0xffff) * 65536;
-        const lo = (low >>> 0) + v[k + 1];
-        const hi = Math.imul(ah, 0x27d4eb4f) + Math.imul(al, 0xc2b2ae3d) + a1 * 0x27d4 + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff) + v[k] + +(lo > 0xffffffff);
-        (ah = (hi << 31) | (lo >>> 1)), (al = (lo << 31) | (hi >>> 1)), (a1 = al >>> 16), (a0 = al & 0xffff);
-        (mid = a1 * 0xca87 + a0 * 0x85eb), (low = a0 * 0xca87 + (mid & 0xffff) * 65536);
-        v[k] = (Math.imul(ah, 0x85ebca87) + Math.imul(al, 0x9e3779b1) + a1 * 0x85eb + (mid - (mid & 0xffff)) / 65536 + +(low > 0xffffffff)) >>> 0;
-        v[k + 1] = low >>> 0;
-      }
-    // h = the sum of v[k] rotated by 1, 7, 12, 18; then each merged: h = (h ^ round(0, v[k])) * P1 + P4
-    h = l = 0;
-    for (let k = 0; k < 8; k += 2) {
-      const x = v[k], y = v[k + 1], r = [1, 7, 12, 18][k / 2], lo = l + (((y << r) | (x >>> (32 - r))) >>> 0);
-      h = (h + (((x << r) | (y >>> (32 - r))) >>> 0) + +(lo > 0xffffffff)) >>> 0;
-      l = lo >>> 0;
-    }
-    for (let k = 0; k < 8; k += 2) round(0, 0, v[k], v[k + 1]), step(0, 0, 3);
-  }
-  l += n;
-  h = (h + +(l > 0xffffffff)) >>> 0;
-  l >>>= 0;
-  for (; i + 8 <= n; i += 8) round(0, 0, d.getUint32(i + 4, true), d.getUint32(i, true)), step(27, 0, 3);
-  if (i + 4 <= n) mul(0, d.getUint32(i, true), 0), step(23, 1, 2), (i += 4);
-  for (; i < n; i++) mul(0, b[i], 4), step(11, 0, 5);
-  mul(h, l ^ (h >>> 1), 1);
-  mul(H ^ (H >>> 29), L ^ ((L >>> 29) | (H << 3)), 2);
-  return (H ^ L) >>> 0;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ interface Exports {
   refine(...args: number[]): number;
   adaptive(...args: number[]): number;
   compact(...args: number[]): number;
+  xxh64(bytes: number, length: number): number;
 }
 
 let instance: Exports | null = null;
@@ -44,8 +45,9 @@ function module(): Exports {
 type Typed = Int32Array | Uint32Array | Uint8Array | Float32Array | Float64Array;
 type TypedClass<T extends Typed> = { new (buffer: ArrayBuffer, offset: number, length: number): T; BYTES_PER_ELEMENT: number };
 
-// One call: the arena reset, `run` copying in with put() and calling, then the outputs read with
-// get() (copies), the arena dropped when it grew large.
+// One call: the arena reset, `run` copying in with put() and calling (a function that returns a
+// pointer returns 0 when the arena cannot grow), then the outputs read with get() (copies); the
+// arena dropped when it grew large.
 function call<R>(run: (put: (a: Typed) => number, m: Exports) => number, read: (at: number, get: <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T, i32: (at: number) => number) => R): R {
   const m = module();
   m.reset();
@@ -57,7 +59,6 @@ function call<R>(run: (put: (a: Typed) => number, m: Exports) => number, read: (
       return at;
     };
     const at = run(put, m);
-    if (!at) outOfMemory();
     const buffer = m.memory.buffer;
     const get = <T extends Typed>(c: TypedClass<T>, p: number, n: number): T => new c(buffer, p, n).slice() as T;
     return read(at, get, (p: number) => new Int32Array(buffer, p, 1)[0]);
@@ -69,6 +70,7 @@ function call<R>(run: (put: (a: Typed) => number, m: Exports) => number, read: (
 function outOfMemory(): never {
   throw new SvecError('out of memory: the image needs more than WebAssembly can hold');
 }
+const pointer = (at: number) => at || outOfMemory();
 
 // A Topology in the module's memory: the C struct's fields in order.
 function putTopology(t: Topology, put: (a: Typed) => number): number {
@@ -85,7 +87,7 @@ export function buildTopology(level: Level, width: number, height: number): Topo
   level.features.forEach((f, i) => verts.set(f.vertices, offsets[i]));
   const nv = p.length / 2, nf = tri.length / 3;
   return call(
-    (put, m) => m.topology(nv, put(p), nf, put(tri), level.creases.length / 2, put(level.creases), level.features.length, put(offsets), put(verts), width, height),
+    (put, m) => pointer(m.topology(nv, put(p), nf, put(tri), level.creases.length / 2, put(level.creases), level.features.length, put(offsets), put(verts), width, height)),
     (at, get, i32) => {
       const ne = i32(at), field = (k: number) => i32(at + 4 * k);
       return {
@@ -104,8 +106,8 @@ export function refine(topo: Topology, faces: Int32Array | null, depth: number):
   if (!(depth >= 0 && depth < 16)) throw new RangeError(`depth ${depth} is not in 0..15`);
   if (faces) for (const f of faces) if (!(f >= 0 && f < nf)) throw new RangeError(`face ${f} is not one of the level's ${nf}`);
   return call(
-    (put, m) => m.refine(putTopology(topo, put), L.positions.length / 2, put(L.positions), L.colors.length / 3, put(L.colors),
-      nf, put(L.triangles), put(L.triangleColors), faces ? put(faces) : 0, faces ? faces.length : 0, depth),
+    (put, m) => pointer(m.refine(putTopology(topo, put), L.positions.length / 2, put(L.positions), L.colors.length / 3, put(L.colors),
+      nf, put(L.triangles), put(L.triangleColors), faces ? put(faces) : 0, faces ? faces.length : 0, depth)),
     (at, get, i32) => {
       const [selected, numFaces, numValues, numEdges, vertices, sharpEdges, edgeFaces] = [0, 1, 2, 3, 4, 5, 6].map((k) => i32(at + 4 * k));
       const levels: Refined['levels'] = [];
@@ -129,10 +131,15 @@ export function adaptiveIndices(r: Refined, scale: number, colorTolerance: numbe
       const values = new Int32Array(16), sides = new Int32Array(16);
       r.levels.forEach((l, d) => ((values[d] = put(l.values)), (sides[d] = put(l.sides))));
       const head = [r.selected, numFaces, numValues, numEdges, put(r.vertices), put(r.sharpEdges), put(r.edgeFaces)];
-      return m.adaptive(put(Int32Array.from([...head, ...values, ...sides])), r.depth, scale, colorTolerance, positionTolerance);
+      return pointer(m.adaptive(put(Int32Array.from([...head, ...values, ...sides])), r.depth, scale, colorTolerance, positionTolerance));
     },
     (at, get, i32) => get(Uint32Array, i32(at + 4), i32(at)),
   );
+}
+
+/** zstd's content checksum of b: the low 32 bits of XXH64, seed 0 (wasm/checksum.c). */
+export function checksum(b: Uint8Array): number {
+  return call((put, m) => m.xxh64(put(b), b.length) >>> 0, (sum) => sum);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -8,6 +8,8 @@ export declare function buildTopology(level: Level, width: number, height: numbe
 export declare function refine(topo: Topology, faces: Int32Array | null, depth: number): Refined;
 /** adaptiveIndices of subdivide.ts. */
 export declare function adaptiveIndices(r: Refined, scale: number, colorTolerance: number, positionTolerance: number): Uint32Array;
+/** zstd's content checksum of b: the low 32 bits of XXH64, seed 0 (wasm/checksum.c). */
+export declare function checksum(b: Uint8Array): number;
 /** A compact level's counts, precision and bytes (one stream, or six sections), as decode.ts read them. */
 export interface CompactInput {
     version: number;
