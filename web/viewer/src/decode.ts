@@ -10,8 +10,8 @@
 // typed arrays sized up front: a page decodes its file once, before anything is compiled.
 import { Decompress } from 'fzstd';
 import { Feature, Level, Stroke, SvecError, SvecImage } from './image';
-import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, Topology, escape, fail, validate } from './validate';
-import { checksum, decodeCompact } from './wasm';
+import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, escape, fail, validate } from './validate';
+import { checksum, decodeCompact, type Edges } from './wasm';
 
 const GIB = 2 ** 30; // largest file, and largest payload
 const MAGIC = [0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a]; // "SUBVEC" NUL ^Z
@@ -176,7 +176,7 @@ function binary(b: Uint8Array): SvecImage {
 
   const c = new Cursor(unzstd(b.subarray(HEADER), Number(size)));
   c.what = 'image size';
-  const width = c.i32(), height = c.i32(), levels: Level[] = [], topologies: Topology[] = [];
+  const width = c.i32(), height = c.i32(), levels: Level[] = [], topologies: Edges[] = [];
   const nl = c.count('levels', 20, MAX_LEVELS);
   if (version > 1 && (width < 1 || height < 1 || width > MAX_DIMENSION || height > MAX_DIMENSION))
     fail(`image size ${width} x ${height} is out of range (1 to ${MAX_DIMENSION} a side)`);
@@ -251,7 +251,7 @@ function losslessLevel(c: Cursor, l: number): Level {
 
 const SECTIONS = ['connectivity', 'split offsets', 'positions', 'features', 'feature steps', 'colors'];
 
-function compactLevel(c: Cursor, l: number, width: number, height: number, version: number, topologies: Topology[]): Level {
+function compactLevel(c: Cursor, l: number, width: number, height: number, version: number, topologies: Edges[]): Level {
   const name = `level ${l} `;
   c.what = `${name}counts`;
   const [nv, ncolors, ntriangles, ncreases, nfeatures] = ['vertices', 'colors', 'triangles', 'creases', 'features'].map((w) => c.count(name + w, 0));

@@ -42,6 +42,16 @@ export interface SvecImage {
   metadata: Array<[string, string]>;
 }
 
+/** v as printf's "%g" writes it (6 significant digits), as the C++ messages print numbers. */
+export function num(v: number): string {
+  if (!isFinite(v)) return isNaN(v) ? 'nan' : v < 0 ? '-inf' : 'inf';
+  if (!v) return 1 / v < 0 ? '-0' : '0';
+  const [mantissa, e] = v.toExponential(5).split('e'), exponent = +e;
+  const trim = (s: string) => (s.includes('.') ? s.replace(/\.?0+$/, '') : s);
+  if (exponent >= -4 && exponent < 6) return trim(v.toFixed(5 - exponent));
+  return `${trim(mantissa)}e${exponent < 0 ? '-' : '+'}${String(Math.abs(exponent)).padStart(2, '0')}`;
+}
+
 /** Every problem with a file is reported as one of these: a one-line message naming it. */
 export class SvecError extends Error {
   constructor(message: string) {

@@ -9,8 +9,7 @@
 // calls: each call resets its arena, copies the inputs in and the outputs out.
 import { Decompress } from 'fzstd';
 import type { Feature, Level } from './image';
-import { SvecError } from './image';
-import type { Topology as Edges } from './validate';
+import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
 import { WASM } from './wasm-binary';
 
@@ -24,6 +23,7 @@ interface Exports {
   refine(...args: number[]): number;
   adaptive(...args: number[]): number;
   compact(...args: number[]): number;
+  check_level(...args: number[]): number;
   xxh64(bytes: number, length: number): number;
 }
 
@@ -37,7 +37,7 @@ function module(): Exports {
   new Decompress((part) => parts.push(part)).push(packed, true);
   const bytes = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
   parts.reduce((at, p) => (bytes.set(p, at), at + p.length), 0);
-  const env = { cos: Math.cos, hypot: Math.hypot, fail: failed, mean, exact };
+  const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact };
   instance = new WebAssembly.Instance(new WebAssembly.Module(bytes), { env }).exports as unknown as Exports;
   return instance;
 }
@@ -163,27 +163,38 @@ export interface CompactInput {
   name: string;
 }
 
-// The level being decoded, for the messages.
-let current: CompactInput | null = null;
+// The level being decoded or checked, for the messages: its name for the decoder's ("level L "),
+// the prefix of the others ("" while decoding, "level L: " while checking).
+interface Context {
+  name: string;
+  prefix: string;
+  nv: number;
+  level?: Level;
+  width?: number;
+  height?: number;
+}
+let current: Context | null = null;
 
 const SECTION = ['connectivity', 'split offsets', 'positions', 'features', 'feature steps', 'colors', 'header'];
 const chain = (feature: number, i: number, id?: number) => (feature ? `feature ${i}${id === undefined ? '' : ` (id ${id})`}` : `crease ${i}`);
-// The messages of wasm/decode.c's codes, in their order: n is the level's name, then its numbers.
-type Message = (n: string, a: number, b: number, c: number, d: number, e: number) => string;
-const connectivity = (m: (a: number, b: number) => string): Message => (n, a, b) => `${n}connectivity: ${m(a, b)}`;
+const point = (x: number, y: number) => `(${num(x)}, ${num(y)})`;
+// The messages of wasm/decode.c's codes, in their order: x is the context, then the numbers.
+type Message = (x: Context, a: number, b: number, c: number, d: number, e: number, f: number, g: number) => string;
+const connectivity = (m: (a: number, b: number) => string): Message => (x, a, b) => `${x.name}connectivity: ${m(a, b)}`;
+const at = (x: Context, v: number) => point(x.level!.positions[2 * v], x.level!.positions[2 * v + 1]);
 const MESSAGES: Message[] = [
   () => 'out of memory: the image needs more than WebAssembly can hold',
-  (n) => `${n}stream: corrupt coded data (bad first bytes)`,
-  (n, k, length) => `${n}stream ${SECTION[k]}: the coded data ends early (${length} bytes)`,
-  (n, k) => `${n}stream ${SECTION[k]}: a number of more than 56 bits`,
-  (n, left) => `${left} unexpected bytes at the end of ${n}stream`,
-  (n) => `${n}stream: corrupt coded data (the code leaves its interval)`,
-  (n, k, w, need, at, left) => `truncated payload while reading ${n}${w < 0 ? SECTION[k] : chain(1, w)} (needs ${need} bytes at offset ${at}, ${left} left)`,
-  (n, k, w) => `malformed varint while reading ${n}${w < 0 ? SECTION[k] : chain(1, w)}`,
-  (n, i) => `${n}connectivity: byte ${i} is not three operations`,
-  (n, left, k) => `${left} unexpected bytes at the end of ${n}${SECTION[k]}`,
-  (n, i, tag) => `${n}feature ${i}: unknown saliency tag ${tag}`,
-  (n, i, length) => `${n}feature ${i}: ${length + 2} vertices, too few bytes`,
+  (x) => `${x.name}stream: corrupt coded data (bad first bytes)`,
+  (x, k, length) => `${x.name}stream ${SECTION[k]}: the coded data ends early (${length} bytes)`,
+  (x, k) => `${x.name}stream ${SECTION[k]}: a number of more than 56 bits`,
+  (x, left) => `${left} unexpected bytes at the end of ${x.name}stream`,
+  (x) => `${x.name}stream: corrupt coded data (the code leaves its interval)`,
+  (x, k, w, need, p, left) => `truncated payload while reading ${x.name}${w < 0 ? SECTION[k] : chain(1, w)} (needs ${need} bytes at offset ${p}, ${left} left)`,
+  (x, k, w) => `malformed varint while reading ${x.name}${w < 0 ? SECTION[k] : chain(1, w)}`,
+  (x, i) => `${x.name}connectivity: byte ${i} is not three operations`,
+  (x, left, k) => `${left} unexpected bytes at the end of ${x.name}${SECTION[k]}`,
+  (x, i, tag) => `${x.name}feature ${i}: unknown saliency tag ${tag}`,
+  (x, i, length) => `${x.name}feature ${i}: ${length + 2} vertices, too few bytes`,
   connectivity((v) => `virtual vertex ${v} out of range`),
   connectivity(() => 'the traversal ends before the last operation'),
   connectivity(() => 'the operations outrun the stream'),
@@ -195,29 +206,51 @@ const MESSAGES: Message[] = [
   connectivity(() => 'the traversal leaves triangles unvisited'),
   connectivity((n, nv) => `${n} vertices, but ${nv} are declared`),
   connectivity((n, nt) => `${n} triangles, but ${nt} are declared`),
-  (n) => `${n}positions: residual out of range`,
-  (n, f, i, v) => `${n}${chain(f, i)}: vertex ${v} out of range`,
-  (n, f, i, r) => `${n}${chain(f, i)}: step ${r} out of range`,
-  (n, i) => `${n}feature ${i}: id out of range`,
-  (n, i, length) => `${n}feature ${i}: ${length + 2} vertices, more than the level has`,
-  // The topology's messages (MeshTopology::build's, without the level's name).
-  (_, f, x, nv) => `triangle ${f} refers to vertex ${x}, out of range (${nv} vertices)`,
-  (_, f, x) => `triangle ${f} repeats vertex ${x}`,
-  (_, x, y) => `edge (${x}, ${y}) is shared by more than two triangles`,
-  (_, f, g, x, y) => `triangles ${f} and ${g} are oriented inconsistently across edge (${x}, ${y})`,
-  (_, f, i, id, v) => `${chain(f, i, id)} refers to vertex ${v}, out of range (${current!.nv} vertices)`,
-  (_, f, i, id, x, y) => `${chain(f, i, id)}: (${x}, ${y}) is not an edge of the mesh`,
-  (_, f, i, id, x, y) => `${chain(f, i, id)}: (${x}, ${y}) lies on the image border`,
-  (_, f, i, id, x, y) => `${chain(f, i, id)}: edge (${x}, ${y}) is already a crease`,
-  (_, f, i, id, x, y) => `${chain(f, i, id)}: edge (${x}, ${y}) is already a feature edge`,
-  (_, i, id) => `${chain(1, i, id)} has fewer than two vertices`,
-  (n, nc, declared) => `${n}colors: the tears give ${nc} color values, but ${declared} are declared`,
-  (n) => `${n}colors: residual out of range`,
-  (n) => `${n}colors: value out of range`,
+  (x) => `${x.name}positions: residual out of range`,
+  (x, f, i, v) => `${x.name}${chain(f, i)}: vertex ${v} out of range`,
+  (x, f, i, r) => `${x.name}${chain(f, i)}: step ${r} out of range`,
+  (x, i) => `${x.name}feature ${i}: id out of range`,
+  (x, i, length) => `${x.name}feature ${i}: ${length + 2} vertices, more than the level has`,
+  // The topology's (MeshTopology::build's).
+  (x, f, v, nv) => `${x.prefix}triangle ${f} refers to vertex ${v}, out of range (${nv} vertices)`,
+  (x, f, v) => `${x.prefix}triangle ${f} repeats vertex ${v}`,
+  (x, u, v) => `${x.prefix}edge (${u}, ${v}) is shared by more than two triangles`,
+  (x, f, g, u, v) => `${x.prefix}triangles ${f} and ${g} are oriented inconsistently across edge (${u}, ${v})`,
+  (x, f, i, id, v) => `${x.prefix}${chain(f, i, id)} refers to vertex ${v}, out of range (${x.nv} vertices)`,
+  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: (${u}, ${v}) is not an edge of the mesh`,
+  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: (${u}, ${v}) lies on the image border`,
+  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: edge (${u}, ${v}) is already a crease`,
+  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: edge (${u}, ${v}) is already a feature edge`,
+  (x, i, id) => `${x.prefix}${chain(1, i, id)} has fewer than two vertices`,
+  (x, nc, declared) => `${x.name}colors: the tears give ${nc} color values, but ${declared} are declared`,
+  (x) => `${x.name}colors: residual out of range`,
+  (x) => `${x.name}colors: value out of range`,
+  // A level's validity rules (src/mesh/validate.cpp's).
+  (x, v) => `${x.prefix}vertex ${v} position ${at(x, v)} is not finite`,
+  (x, v) => `${x.prefix}vertex ${v} position ${at(x, v)} is outside the image [0, ${x.width}] x [0, ${x.height}]`,
+  (x, i) => `${x.prefix}color ${i} (${Array.from(x.level!.colors.subarray(3 * i, 3 * i + 3), num).join(', ')}) is not finite`,
+  (x, f, c, nc) => `${x.prefix}triangle_colors ${f} refers to color ${c}, out of range (${nc} colors)`,
+  (x, i, id) => `${x.prefix}feature ${i} repeats id ${id} (ids must be unique within a level)`,
+  (x, i, id, s) => `${x.prefix}feature ${i} (id ${id}) saliency ${num(s)} is not finite`,
+  (x, f, u, v, w, s) => `${x.prefix}triangle ${f} (${u}, ${v}, ${w}) is flipped or degenerate (signed area ${num(s)})`,
+  (x, v) => `${x.prefix}vertex ${v} ${at(x, v)} is used by no triangle`,
+  (x, u, v) =>
+    `${x.prefix}edge (${u}, ${v}) from ${at(x, u)} to ${at(x, v)} has a triangle on one side only but does not lie on the image border (a gap or a hole in the mesh)`,
+  (x, k) => `${x.prefix}no vertex at the image corner ${point(k % 3 ? x.width! : 0, k > 1 ? x.height! : 0)}`,
+  (x, v, sum, kind) => {
+    const expected = [0.5, 1, 2][kind], what = ['an image corner', 'a border vertex', 'an interior vertex'][kind];
+    return `${x.prefix}triangles ${sum > expected * Math.PI ? 'overlap' : 'leave a gap'} around vertex ${v} ${at(x, v)}: their angles there sum to ${num(sum / Math.PI)}*pi, ${what} needs ${num(expected)}*pi`;
+  },
+  (x, total) =>
+    `${x.prefix}the triangles cover an area of ${num(total)} but the image has ${num(x.width! * x.height!)} (${x.width} x ${x.height}): they overlap or leave a gap`,
+  (x, i, a, f, b, g) => `${x.prefix}color ${i} is used at vertex ${a} (triangle ${f}) and at vertex ${b} (triangle ${g}); a color value belongs to one vertex`,
+  (x, i) => `${x.prefix}color ${i} is used by no triangle corner`,
+  (x, a, b, f, g, v, cf, cg) => `${x.prefix}edge (${a}, ${b}) is not a tear but triangles ${f} and ${g} use different colors at vertex ${v} (${cf} and ${cg})`,
 ];
 
-function failed(code: number, a: number, b: number, c: number, d: number, e: number): never {
-  throw new SvecError(MESSAGES[code]?.(current?.name ?? '', a, b, c, d, e) ?? `corrupt compact level (code ${code})`);
+function failed(code: number, a: number, b: number, c: number, d: number, e: number, f: number, g: number): never {
+  const x = current ?? { name: '', prefix: '', nv: 0 };
+  throw new SvecError(MESSAGES[code]?.(x, a, b, c, d, e, f, g) ?? `corrupt level (code ${code})`);
 }
 
 // ⌊(2·s + n) / (2·n)⌋, the rounded mean of the n integers at `terms` (doubles in the module's
@@ -233,10 +266,18 @@ function mean(terms: number, n: number): number {
 // a·b + c·d for integers too large for doubles, rounded once (as C++ converts an exact int64).
 const exact = (a: number, b: number, c: number, d: number) => Number(BigInt(a) * BigInt(b) + BigInt(c) * BigInt(d));
 
-/** A compact level and its topology (edges, twins, tags), or a SvecError naming the problem. */
+/** The edges of a level the decoder built, sorted by (a, b) with a < b, and the triangle across
+ * each (-1 on the border): what check_level needs of them. */
+export interface Edges {
+  a: Int32Array;
+  b: Int32Array;
+  g: Int32Array;
+}
+
+/** A compact level and its edges, or a SvecError naming the problem. */
 export function decodeCompact(input: CompactInput): [Level, Edges] {
   const { nv, ntriangles: nt, ncreases, nfeatures } = input;
-  current = input;
+  current = { name: input.name, prefix: '', nv };
   try {
     return call(
       (put, m) => {
@@ -256,8 +297,38 @@ export function decodeCompact(input: CompactInput): [Level, Edges] {
           triangleColors: get(Int32Array, field(3), 3 * nt), creases: get(Int32Array, field(4), 2 * ncreases), features,
         };
         const ne = field(10), edge = (k: number) => get(Int32Array, field(11 + k), ne);
-        return [level, { a: edge(0), b: edge(1), f: edge(2), g: edge(3), tag: get(Uint8Array, field(15), ne), twin: get(Int32Array, field(16), 3 * nt) }];
+        return [level, { a: edge(0), b: edge(1), g: edge(3) }];
       },
+    );
+  } finally {
+    current = null;
+  }
+}
+
+/** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
+ * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
+ * by construction. */
+export function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void {
+  const { positions: p, colors: c, triangles: t, features } = level, nf = features.length;
+  current = { name: `level ${l} `, prefix: `level ${l}: `, nv: p.length / 2, level, width, height };
+  const offsets = new Int32Array(nf + 1);
+  features.forEach((f, i) => (offsets[i + 1] = offsets[i] + f.vertices.length));
+  const verts = new Int32Array(offsets[nf]);
+  features.forEach((f, i) => verts.set(f.vertices, offsets[i]));
+  try {
+    call(
+      (put, m) => {
+        let edges = 0;
+        if (built) {
+          const fields = new Int32Array(16);
+          fields.set([built.a.length, put(built.a), put(built.b), 0, put(built.g), 0, 0, -1]);
+          edges = put(fields);
+        }
+        return m.check_level(p.length / 2, put(p), c.length / 3, put(c), t.length / 3, put(t), put(level.triangleColors),
+          level.creases.length / 2, put(level.creases), nf, put(Int32Array.from(features, (f) => f.id)),
+          put(Float64Array.from(features, (f) => f.saliency)), put(offsets), put(verts), width, height, edges);
+      },
+      () => undefined,
     );
   } finally {
     current = null;

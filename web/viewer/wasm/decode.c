@@ -1,8 +1,10 @@
 // The compact levels of a .svec file (payload versions 2 and 3, docs/format.md) decoded in
-// WebAssembly: a port of the C++ reader (src/io/svec_compact.cpp, svec_range_p.h) with the same
-// checks in the same order, as src/decode.ts had it in JavaScript. The reference is the C++
-// reader: web/tests/viewer-decode.mjs compares what the viewer decodes, and what it refuses,
-// with `subvec`'s.
+// WebAssembly, and every level's validity rules checked: a port of the C++ reader
+// (src/io/svec_compact.cpp, svec_range_p.h; src/mesh/validate.cpp and the checks of
+// MeshTopology::build) with the same checks in the same order, as src/decode.ts and
+// src/validate.ts had them in JavaScript. The reference is the C++ reader:
+// web/tests/viewer-decode.mjs compares what the viewer decodes, and what it refuses, with
+// `subvec`'s.
 //
 // Problems are reported through the imported fail(code, ...), which throws the SvecError
 // (src/wasm.ts writes the messages, one per code below); it never returns. Numbers that the
@@ -27,16 +29,20 @@ enum {
   E_ALREADY_CREASE, E_ALREADY_TEAR, E_SHORT_FEATURE,
   // colors
   E_COLOR_COUNT, E_COLOR_RESIDUAL, E_COLOR_VALUE,
+  // a level's validity rules (check_level)
+  V_POSITION_NOT_FINITE, V_POSITION_OUTSIDE, V_COLOR_NOT_FINITE, V_TRIANGLE_COLOR, V_REPEATED_ID, V_SALIENCY,
+  V_FLIPPED, V_UNUSED_VERTEX, V_GAP_EDGE, V_NO_CORNER, V_ANGLES, V_AREA, V_COLOR_OWNER, V_UNUSED_COLOR, V_COLOR_EDGE,
 };
 
-IMPORT(fail) __attribute__((noreturn)) void js_fail(int32_t code, double a, double b, double c, double d, double e);
+IMPORT(fail) __attribute__((noreturn)) void js_fail(int32_t code, double a, double b, double c, double d, double e, double f, double g);
 // The BigInt fallbacks of src/decode.ts, for integers too large for one rounding in doubles.
 IMPORT(mean) double js_mean(const double *terms, int32_t n);
 IMPORT(exact) double js_exact(double a, double b, double c, double d);
 
-// fail(code) with up to five numbers.
-#define FAIL(...) FAIL_(__VA_ARGS__, 0, 0, 0, 0, 0, 0)
-#define FAIL_(code, a, b, c, d, e, ...) js_fail(code, a, b, c, d, e)
+// fail(code) with up to seven numbers.
+#define FAIL(...) FAIL_(__VA_ARGS__, 0, 0, 0, 0, 0, 0, 0, 0)
+#define FAIL_(code, a, b, c, d, e, f, g, ...) js_fail(code, a, b, c, d, e, f, g)
+IMPORT(atan2) double js_atan2(double, double);
 static void *need(void *p) {
   if (!p) FAIL(E_OUT_OF_MEMORY);
   return p;
@@ -536,6 +542,17 @@ static void mark(const Edges *E, int32_t nv, int32_t x, int32_t y, uint8_t kind,
   E->tag[l] = kind;
 }
 
+// MeshTopology::build's marking: the creases, then the features (chains of two or more).
+static void mark_chains(const Edges *E, int32_t nv, const int32_t *creases, int32_t ncreases, const int32_t *ids,
+                        const int32_t *offsets, const int32_t *verts, int32_t nfeatures) {
+  for (int32_t i = 0; i < ncreases; ++i) mark(E, nv, creases[2 * i], creases[2 * i + 1], TAG_CREASE, i, 0);
+  for (int32_t i = 0; i < nfeatures; ++i) {
+    int32_t n = offsets[i + 1] - offsets[i];
+    if (n < 2) FAIL(E_SHORT_FEATURE, i, ids[i]);
+    for (int32_t k = 1; k < n; ++k) mark(E, nv, verts[offsets[i] + k - 1], verts[offsets[i] + k], TAG_TEAR, i, ids[i]);
+  }
+}
+
 static int32_t find(int32_t *root, int32_t c) {
   while (root[c] != c) c = root[c] = root[root[c]];
   return c;
@@ -695,12 +712,7 @@ Level *compact(int32_t version, const Section *sections, double ops, int32_t nv,
   // The topology: the edges' problem, then creases and features marked.
   Edges *E = &L->edges;
   if (E->problem >= 0) FAIL(E->problem, E->args[0], E->args[1], E->args[2], E->args[3]);
-  for (int32_t i = 0; i < ncreases; ++i) mark(E, nv, creases[2 * i], creases[2 * i + 1], TAG_CREASE, i, 0);
-  for (int32_t i = 0; i < nfeatures; ++i) {
-    int32_t n = offsets[i + 1] - offsets[i];
-    if (n < 2) FAIL(E_SHORT_FEATURE, i, ids[i], 0, 0);
-    for (int32_t k = 1; k < n; ++k) mark(E, nv, verts[offsets[i] + k - 1], verts[offsets[i] + k], TAG_TEAR, i, ids[i]);
-  }
+  mark_chains(E, nv, creases, ncreases, ids, offsets, verts, nfeatures);
   // The tears are known now: the wedges, and their colors.
   int32_t nc;
   int32_t *tc = L->triangleColors = wedges(t, nh, E, &nc);
@@ -708,4 +720,139 @@ Level *compact(int32_t version, const Section *sections, double ops, int32_t nv,
   L->colors = colors(s, tc, nh, nc, cb);
   finish(s);
   return L;
+}
+
+// ---- a level's validity rules -----------------------------------------------------------------
+
+static const double PI = 3.141592653589793;
+
+// validateLevel of the old validate.ts (src/mesh/validate.cpp), in its order: finite positions in
+// the image; (*) finite colors and indices in range; unique feature ids, finite saliencies;
+// (*) the topology; positive areas; used vertices; border edges on the image rectangle and its
+// corners present; tiling (angle sums per vertex, the total area); (*) the wedge color rules.
+// `built`: the topology of a level this module decoded (compact), which makes the checks marked *
+// true by construction; 0 for the others (JSON, version 1). Returns 1; problems go to fail().
+EXPORT(check_level)
+int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
+                    int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
+                    const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built) {
+  int32_t nh = 3 * nt;
+  for (int32_t v = 0; v < nv; ++v) {
+    double x = p[2 * v], y = p[2 * v + 1];
+    if (!__builtin_isfinite(x) || !__builtin_isfinite(y)) FAIL(V_POSITION_NOT_FINITE, v);
+    if (x < 0 || x > width || y < 0 || y > height) FAIL(V_POSITION_OUTSIDE, v);
+  }
+  if (!built) {
+    for (int32_t i = 0; i < 3 * nc; ++i)
+      if (!__builtin_isfinite(c[i])) FAIL(V_COLOR_NOT_FINITE, i / 3);
+    // Vertex indices before color indices: without triangle_colors (JSON) these are copies of them.
+    for (int32_t h = 0; h < nh; ++h)
+      if (t[h] < 0 || t[h] >= nv) FAIL(E_TRIANGLE_VERTEX, h / 3, t[h], nv);
+    for (int32_t h = 0; h < nh; ++h)
+      if (tc[h] < 0 || tc[h] >= nc) FAIL(V_TRIANGLE_COLOR, h / 3, tc[h], nc);
+  }
+  // Feature ids: the first feature that repeats an earlier id, or whose saliency is not finite.
+  {
+    int32_t *order = MAKE(int32_t, nfeatures), *scratch = MAKE(int32_t, nfeatures), repeat = nfeatures;
+    for (int32_t i = 0; i < nfeatures; ++i) order[i] = i;
+    for (int32_t width2 = 1; width2 < nfeatures; width2 *= 2) { // merge sort by (id, index)
+      for (int32_t lo = 0; lo < nfeatures; lo += 2 * width2) {
+        int32_t mid = imin(lo + width2, nfeatures), hi = imin(lo + 2 * width2, nfeatures), i = lo, j = mid, k = lo;
+        while (i < mid && j < hi) scratch[k++] = ids[order[j]] < ids[order[i]] ? order[j++] : order[i++];
+        while (i < mid) scratch[k++] = order[i++];
+        while (j < hi) scratch[k++] = order[j++];
+      }
+      int32_t *swap = order;
+      order = scratch, scratch = swap;
+    }
+    for (int32_t k = 1; k < nfeatures; ++k)
+      if (ids[order[k]] == ids[order[k - 1]] && (k == 1 || ids[order[k - 2]] != ids[order[k]]) && order[k] < repeat) repeat = order[k];
+    for (int32_t i = 0; i < nfeatures; ++i) {
+      if (i == repeat) FAIL(V_REPEATED_ID, i, ids[i]);
+      if (!__builtin_isfinite(saliency[i])) FAIL(V_SALIENCY, i, ids[i], saliency[i]);
+    }
+  }
+  Edges own;
+  const Edges *E = built;
+  if (!built) {
+    edges(t, nh, nv, &own);
+    if (own.problem >= 0) FAIL(own.problem, own.args[0], own.args[1], own.args[2], own.args[3]);
+    mark_chains(&own, nv, creases, ncreases, ids, offsets, verts, nfeatures);
+    E = &own;
+  }
+
+  // Signed areas, and the used vertices.
+  double *area = MAKE(double, nt);
+  uint8_t *used = MAKE(uint8_t, nv), *sides = MAKE(uint8_t, nv), *border = MAKE(uint8_t, nv);
+  for (int32_t f = 0; f < nt; ++f) {
+    int32_t u = t[3 * f], v = t[3 * f + 1], w = t[3 * f + 2];
+    double s = area[f] = 0.5 * ((p[2 * v] - p[2 * u]) * (p[2 * w + 1] - p[2 * u + 1]) - (p[2 * v + 1] - p[2 * u + 1]) * (p[2 * w] - p[2 * u]));
+    if (!(s > 0)) FAIL(V_FLIPPED, f, u, v, w, s);
+    used[u] = used[v] = used[w] = 1;
+  }
+  for (int32_t v = 0; v < nv; ++v)
+    if (!used[v]) FAIL(V_UNUSED_VERTEX, v);
+
+  // Sides of the image rectangle each vertex lies on, exactly: 1 left, 2 right, 4 top, 8 bottom;
+  // and the image corners: 1 (0, 0), 2 (W, 0), 4 (W, H), 8 (0, H).
+  int corners = 0;
+  for (int32_t v = 0; v < nv; ++v) {
+    double x = p[2 * v], y = p[2 * v + 1];
+    int s = sides[v] = (uint8_t)((x == 0) | (x == width) << 1 | (y == 0) << 2 | (y == height) << 3);
+    corners |= s == 5 ? 1 : s == 6 ? 2 : s == 10 ? 4 : s == 9 ? 8 : 0;
+  }
+  for (int32_t e = 0; e < E->numEdges; ++e) {
+    if (E->g[e] >= 0) continue;
+    int32_t u = E->a[e], v = E->b[e];
+    if (!(sides[u] & sides[v])) FAIL(V_GAP_EDGE, u, v);
+    border[u] = border[v] = 1;
+  }
+  for (int k = 0; k < 4; ++k)
+    if (!(corners & (1 << k))) FAIL(V_NO_CORNER, k);
+
+  // Tiling: angle sums per vertex, then the total area (summed compensated, as C++ sums it in
+  // long double).
+  double *angles = MAKE(double, nv), total = 0, lost = 0;
+  for (int32_t h = 0; h < nh; ++h) {
+    int32_t u = t[h], v = t[next3(h)], w = t[prev3(h)];
+    double ux = p[2 * v] - p[2 * u], uy = p[2 * v + 1] - p[2 * u + 1], vx = p[2 * w] - p[2 * u], vy = p[2 * w + 1] - p[2 * u + 1];
+    angles[u] += js_atan2(ux * vy - uy * vx, ux * vx + uy * vy);
+  }
+  for (int32_t f = 0; f < nt; ++f) {
+    double s = area[f], sum = total + s;
+    lost += __builtin_fabs(total) >= __builtin_fabs(s) ? total - sum + s : s - sum + total;
+    total = sum;
+  }
+  total += lost;
+  for (int32_t v = 0; v < nv; ++v) {
+    int corner = border[v] && sides[v] & 3 && sides[v] & 12, kind = corner ? 0 : border[v] ? 1 : 2;
+    double expected = corner ? PI / 2 : border[v] ? PI : 2 * PI;
+    if (__builtin_fabs(angles[v] - expected) > 1e-6) FAIL(V_ANGLES, v, angles[v], kind);
+  }
+  double image = width * height;
+  if (__builtin_fabs(total - image) > 1e-9 * image) FAIL(V_AREA, total);
+  if (built) return 1;
+
+  // Colors: each value belongs to one vertex and is used; across an edge that is not a tear, both
+  // triangles use the same value at each end.
+  int32_t *owner = MAKE(int32_t, nc), *first = MAKE(int32_t, nc);
+  for (int32_t i = 0; i < nc; ++i) owner[i] = -1;
+  for (int32_t h = 0; h < nh; ++h) {
+    int32_t v = t[h], i = tc[h], f = h / 3;
+    if (owner[i] < 0)
+      owner[i] = v, first[i] = f;
+    else if (owner[i] != v)
+      FAIL(V_COLOR_OWNER, i, owner[i], first[i], v, f);
+  }
+  for (int32_t i = 0; i < nc; ++i)
+    if (owner[i] < 0) FAIL(V_UNUSED_COLOR, i);
+  for (int32_t e = 0; e < E->numEdges; ++e) {
+    int32_t f = E->f[e], g = E->g[e];
+    if (g >= 0 && E->tag[e] != TAG_TEAR)
+      for (int32_t v = E->a[e], k = 0; k < 2; k++, v = E->b[e]) {
+        int32_t cf = tc[corner_of(t, f, v)], cg = tc[corner_of(t, g, v)];
+        if (cf != cg) FAIL(V_COLOR_EDGE, E->a[e], E->b[e], f, g, v, cf, cg);
+      }
+  }
+  return 1;
 }

@@ -34,6 +34,8 @@ export interface SvecImage {
     strokes: Stroke[];
     metadata: Array<[string, string]>;
 }
+/** v as printf's "%g" writes it (6 significant digits), as the C++ messages print numbers. */
+export declare function num(v: number): string;
 /** Every problem with a file is reported as one of these: a one-line message naming it. */
 export declare class SvecError extends Error {
     constructor(message: string);

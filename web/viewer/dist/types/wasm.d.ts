@@ -1,5 +1,4 @@
 import type { Level } from './image';
-import type { Topology as Edges } from './validate';
 import type { Refined, Topology } from './subdivide';
 export { uniformIndices, type Refined, type Topology } from './subdivide';
 /** buildTopology of subdivide.ts. */
@@ -27,5 +26,16 @@ export interface CompactInput {
     /** "level L ", which starts most messages */
     name: string;
 }
-/** A compact level and its topology (edges, twins, tags), or a SvecError naming the problem. */
+/** The edges of a level the decoder built, sorted by (a, b) with a < b, and the triangle across
+ * each (-1 on the border): what check_level needs of them. */
+export interface Edges {
+    a: Int32Array;
+    b: Int32Array;
+    g: Int32Array;
+}
+/** A compact level and its edges, or a SvecError naming the problem. */
 export declare function decodeCompact(input: CompactInput): [Level, Edges];
+/** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
+ * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
+ * by construction. */
+export declare function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void;
