@@ -87,9 +87,6 @@ class Cursor {
       if (b < 128) return v;
     }
   }
-  svarint() {
-    return unzigzag(this.varint());
-  }
   // An element count, capped by `max` and by the bytes left (each element takes `min` or more).
   count(what: string, min: number, max = MAX_ELEMENTS): number {
     this.what = `${what} count`;

@@ -11,7 +11,7 @@ import { Decompress } from 'fzstd';
 import type { Feature, Level } from './image';
 import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
-import { WASM } from './wasm-binary';
+import { WASM, WASM_BYTES } from './wasm-binary';
 
 export { uniformIndices, type Refined, type Topology } from './subdivide';
 
@@ -30,15 +30,43 @@ interface Exports {
 let instance: Exports | null = null;
 const MAX_KEPT = 64 * 2 ** 20; // an arena grown past this is dropped after the call
 
-function module(): Exports {
-  if (instance) return instance;
-  const packed = Uint8Array.from(atob(WASM), (c) => c.charCodeAt(0));
+// The module's bytes: base 85 (wasm/build: 5 characters # to ~, without ' and \, per 4 bytes,
+// big-endian) of its zstd frame.
+function unpack(): Uint8Array<ArrayBuffer> {
+  const packed = new Uint8Array((WASM.length / 5) * 4), view = new DataView(packed.buffer);
+  for (let i = 0; i < WASM.length; i += 5) {
+    let v = 0;
+    for (let k = i; k < i + 5; k++) {
+      const c = WASM.charCodeAt(k);
+      v = v * 85 + c - 35 - +(c > 39) - +(c > 92);
+    }
+    view.setUint32((i / 5) * 4, v);
+  }
   const parts: Uint8Array[] = [];
-  new Decompress((part) => parts.push(part)).push(packed, true);
+  new Decompress((part) => parts.push(part)).push(packed.subarray(0, WASM_BYTES), true);
   const bytes = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
   parts.reduce((at, p) => (bytes.set(p, at), at + p.length), 0);
+  return bytes;
+}
+
+// Compiled in the background from the moment the module is imported (a page fetches its file
+// meanwhile); a call that comes first compiles it itself.
+let compiled: WebAssembly.Module | null = null;
+if (typeof WebAssembly === 'object')
+  WebAssembly.compile(unpack()).then(
+    (m) => (compiled = m),
+    () => {}, // reported by the first call
+  );
+
+function module(): Exports {
+  if (instance) return instance;
   const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact };
-  instance = new WebAssembly.Instance(new WebAssembly.Module(bytes), { env }).exports as unknown as Exports;
+  try {
+    instance = new WebAssembly.Instance(compiled ?? new WebAssembly.Module(unpack()), { env }).exports as unknown as Exports;
+  } catch (e) {
+    // A Content-Security-Policy without 'wasm-unsafe-eval', or an engine without WebAssembly.
+    throw new SvecError(`WebAssembly is not available here: ${e instanceof Error ? e.message : String(e)}`);
+  }
   return instance;
 }
 
