@@ -47,7 +47,7 @@ static void *need(void *p) {
   if (!p) FAIL(E_OUT_OF_MEMORY);
   return p;
 }
-#define MAKE(type, count) ((type *)need(alloc(sizeof(type) * (size_t)(count))))
+#define MAKE(type, count) ((type *)need(alloc_array(sizeof(type), (double)(count))))
 
 enum { CONNECTIVITY, SPLITS, POSITIONS, FEATURES, STEPS, COLORS, HEADER_CONTEXT };
 enum { OP_C, OP_L, OP_R, OP_E, OP_S };
@@ -637,9 +637,11 @@ typedef struct {
   Edges edges;
 } Level;
 
-// src/wasm.ts reads the fields by position.
+// src/wasm.ts reads the fields by position (of 32-bit pointers).
+#ifdef __wasm__
 _Static_assert(__builtin_offsetof(Level, featureSaliency) == 36 && __builtin_offsetof(Level, edges) == 40, "Level's layout");
 _Static_assert(__builtin_offsetof(Edges, twin) == 24, "Edges' layout");
+#endif
 
 typedef struct {
   const uint8_t *bytes;

@@ -15,4 +15,12 @@ void *alloc(size_t n) {
   return __builtin_memset((void *)start, 0, n);
 }
 
+void *alloc(size_t n);
+
+void *alloc_array(size_t size, double count) {
+  // Counts are integers below 2^53, exact in a double; a negative one is a caller's bug: refuse.
+  if (!(count >= 0) || count * (double)size > 4294967295.0) return 0;
+  return alloc(size * (size_t)count);
+}
+
 EXPORT(alloc) void *alloc_export(size_t n) { return alloc(n); }
