@@ -1,7 +1,8 @@
 // <subvec-image> in headless Chromium (run by viewer-compare.mjs, in its page and browser): layout
 // like an <img>, the same pixels as the module API, contain-fit and centring, setView, a lost WebGL
 // context restored, wheel zoom with `interactive` only, and errors as events (bad file, missing
-// file, bad level, bad window) with nothing thrown to the page; then the demo page.
+// file, bad level, bad window, a page that forbids WebAssembly) with nothing thrown to the page;
+// then the demo page.
 import { execFileSync } from 'node:child_process';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
@@ -170,8 +171,35 @@ export async function checkElement(viewer, binary, dir) {
     check(s.type === 'load' && s.error === null, `a good src after a bad one loads (error ${s.error})`);
   });
   check(errors.length === 0, `nothing thrown to the page${errors.length ? ': ' + errors.join('; ') : ''}`);
+  await run('no WebAssembly', () => checkNoWasm(viewer, check));
   await run('demo', () => checkDemo(viewer, check));
   return { passed, failed };
+}
+
+// A page whose Content-Security-Policy lacks 'wasm-unsafe-eval': the element reports an error
+// event that names WebAssembly, and nothing is thrown to the page.
+async function checkNoWasm(viewer, check) {
+  const page = await viewer.page.context().browser().newPage({ deviceScaleFactor: 1 });
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  try {
+    await page.goto(`${viewer.origin}/csp`);
+    const detail = await page.evaluate(async () => {
+      await import('/subvec-viewer.js');
+      const el = document.createElement('subvec-image');
+      const event = new Promise((ok) => {
+        for (const type of ['load', 'error']) el.addEventListener(type, (e) => ok({ type, message: e.detail?.message ?? '' }));
+      });
+      el.src = '/viewer/demo/rocket.svec';
+      document.body.append(el);
+      return event;
+    });
+    check(detail.type === 'error' && /rocket\.svec: WebAssembly is not available here: /.test(detail.message) && !detail.message.includes('\n'),
+      `a page that forbids WebAssembly: error event '${detail.message}'`);
+    check(errors.length === 0, `no WebAssembly: nothing thrown to the page${errors.length ? ': ' + errors.join('; ') : ''}`);
+  } finally {
+    await page.close();
+  }
 }
 
 // The demo page (web/viewer/demo) as a static server serves it: the photograph shown, the zoom

@@ -73,9 +73,15 @@ function startServer(state) {
     const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
     let body = null;
     let type = 'application/octet-stream';
+    const headers = {};
     if (path === '/') {
       body = PAGE;
       type = 'text/html';
+    } else if (path === '/csp') {
+      // A page whose Content-Security-Policy does not allow WebAssembly (viewer-element.mjs).
+      body = '<!doctype html><meta charset="utf-8"><title>csp</title>';
+      type = 'text/html';
+      headers['Content-Security-Policy'] = "script-src 'self'";
     } else if (path === '/subvec-viewer.js' && existsSync(state.bundle)) {
       body = readFileSync(state.bundle);
       type = 'text/javascript';
@@ -90,7 +96,7 @@ function startServer(state) {
       }
     }
     if (body === null) res.writeHead(404).end();
-    else res.writeHead(200, { 'Content-Type': type, 'Cache-Control': 'no-store' }).end(body);
+    else res.writeHead(200, { 'Content-Type': type, 'Cache-Control': 'no-store', ...headers }).end(body);
   });
   return new Promise((ok) => server.listen(0, '127.0.0.1', () => ok(server)));
 }
