@@ -137,6 +137,7 @@ export function refine(topo: Topology, faces: Int32Array | null, depth: number):
     (put, m) => pointer(m.refine(putTopology(topo, put), L.positions.length / 2, put(L.positions), L.colors.length / 3, put(L.colors),
       nf, put(L.triangles), put(L.triangleColors), faces ? put(faces) : 0, faces ? faces.length : 0, depth)),
     (at, get, i32) => {
+      // The C struct Refined: seven 32-bit fields, then values[16] (offset 28) and sides[16] (92).
       const [selected, numFaces, numValues, numEdges, vertices, sharpEdges, edgeFaces] = [0, 1, 2, 3, 4, 5, 6].map((k) => i32(at + 4 * k));
       const levels: Refined['levels'] = [];
       for (let d = 0; d <= depth; ++d) {
@@ -314,6 +315,9 @@ export function decodeCompact(input: CompactInput): [Level, Edges] {
         return m.compact(input.version, put(sections), input.ops, nv, input.ncolors, nt, ncreases, nfeatures, input.pb, input.cb, input.width, input.height);
       },
       (at, get, i32) => {
+        // The C struct Level (32-bit fields): positions, colors, triangles, triangleColors,
+        // creases, numFeatures, featureIds, featureOffsets, featureVertices, featureSaliency, then
+        // Edges: numEdges, a, b, f, g, tag, twin (decode.c asserts the layout).
         const field = (k: number) => i32(at + 4 * k);
         const offsets = get(Int32Array, field(7), nfeatures + 1), ids = get(Int32Array, field(6), nfeatures);
         const saliency = get(Float64Array, field(9), nfeatures), vertices = get(Int32Array, field(8), offsets[nfeatures]);
