@@ -324,10 +324,8 @@ void run_info(const std::string& input, bool json) {
 
 // ---- convert ---------------------------------------------------------------------------------
 
-void run_convert(const std::string& input, const std::string& output, bool lossless) {
+void run_convert(const std::string& input, const std::string& output, const subvec::SvecWriteOptions& options) {
   subvec::svec_format_for(output);  // rejects an unknown extension before any work
-  subvec::SvecWriteOptions options;
-  options.lossless = lossless;
   subvec::write_svec(output, subvec::read_svec(input), options);
 }
 
@@ -552,19 +550,23 @@ void add_file_commands(CLI::App& app) {
 
   // convert
   static std::string convert_input, convert_output;
-  static bool convert_lossless = false;
+  static subvec::SvecWriteOptions convert_options;
   CLI::App* convert =
       app.add_subcommand("convert", "Convert between .svec (binary) and .svec.json");
   convert->add_option("input", convert_input, "Vector image (.svec or .svec.json)")->required();
   convert->add_option("-o,--output", convert_output, "Output; the format follows the extension")
       ->required();
-  convert->add_flag("--lossless", convert_lossless,
+  convert->add_flag("--lossless", convert_options.lossless,
                     ".svec: keep every value and the order of vertices exactly (version 1) instead "
                     "of the compact form");
+  convert->add_option("--compact-version", convert_options.compact_version,
+                      ".svec: the compact form's version, 3 (range-coded, the default) or 2 (for "
+                      "readers that predate version 3)");
   convert->footer(
       "Examples:\n"
       "  subvec convert in.svec.json -o in.svec     # compact binary\n"
       "  subvec convert in.svec.json -o in.svec --lossless   # exact binary\n"
+      "  subvec convert in.svec -o old.svec --compact-version 2   # for readers before version 3\n"
       "  subvec convert in.svec -o in.svec.json     # readable JSON");
 
   // compare
@@ -581,7 +583,7 @@ void add_file_commands(CLI::App& app) {
       "  subvec compare photo.png render.png\n"
       "  subvec compare photo.png render.png --json   # psnr is null for identical images");
   info->callback([] { run_info(info_input, info_json); });
-  convert->callback([] { run_convert(convert_input, convert_output, convert_lossless); });
+  convert->callback([] { run_convert(convert_input, convert_output, convert_options); });
   compare->callback([] { run_compare(compare_ref, compare_test, compare_json); });
 }
 

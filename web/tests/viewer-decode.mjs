@@ -5,7 +5,7 @@
 // Bundles decode.ts for node with esbuild, then checks that
 //  1. it rejects exactly the files of the bad-input corpora (tests/data/bad, fuzz/corpus) that
 //     `subvec info` rejects, each with a SvecError of one non-empty line (both messages printed);
-//  2. good files (the examples as JSON and as .svec versions 1 and 3, a vectorized and a stylized
+//  2. good files (the examples as JSON and as .svec versions 1, 2 and 3, a vectorized and a stylized
 //     photograph, a hand-made image with strokes and metadata) decode to what the C++ reader
 //     gives, as `subvec convert X -o X.svec.json --lossless` writes it: same numbering, same
 //     values (positions within 1e-9 relative, colors exact in float32);
@@ -195,6 +195,7 @@ for (const e of fs.readdirSync(path.join(root, 'examples')).filter((f) => f.ends
   const src = path.join(root, 'examples', e), base = e.replace('.svec.json', '');
   goods.push(src);
   make(`${base}-v1.svec`, 'convert', src, '-o', '@', '--lossless');
+  make(`${base}-v2.svec`, 'convert', src, '-o', '@', '--compact-version', '2');
   make(`${base}-v3.svec`, 'convert', src, '-o', '@');
 }
 // Strokes, metadata (with escapes and UTF-8), creases, two levels with a pyramid record.
@@ -213,6 +214,7 @@ const rocket = make('rocket.svec', 'vectorize', rocketPng, '-o', '@');
 make('rocket-1.svec', 'vectorize', rocketPng, '-o', '@', '--levels', '1');
 if (rocket) {
   make('rocket-v1.svec', 'convert', rocket, '-o', '@', '--lossless');
+  make('rocket-v2.svec', 'convert', rocket, '-o', '@', '--compact-version', '2');
   make('rocket.svec.json', 'convert', rocket, '-o', '@');
   make('rocket-styled.svec', 'stylize', rocket, '-o', '@');
 }
@@ -368,7 +370,7 @@ function judge({ bytes, what, file }, c) {
   if (check(c.ok === j.ok, `${what}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`)) stats.agree++;
   if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${what}: differs from the C++ decode`);
 }
-const sources = ['rocket.svec', 'rocket-v1.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
+const sources = ['rocket.svec', 'rocket-v1.svec', 'rocket-v2.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
 for (const file of sources) {
   const bytes = fs.readFileSync(file), label = path.basename(file), version = bytes.readUInt32LE(8);
   for (let k = 0; k < (label.startsWith('rocket') ? 20 : 8); k++) {
