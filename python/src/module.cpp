@@ -393,22 +393,24 @@ void def_vector_image(PyVectorImage& vi) {
           "depth"_a = -1)
       .def(
           "save",
-          [](const VectorImage& v, const std::filesystem::path& path, bool lossless) {
+          [](const VectorImage& v, const std::filesystem::path& path, bool lossless, int compact_version) {
             subvec::SvecWriteOptions options;
             options.lossless = lossless;
+            options.compact_version = compact_version;
             py::gil_scoped_release release;
             subvec::write_svec(path, v, options);
           },
-          "path"_a, py::kw_only(), "lossless"_a = false)
+          "path"_a, py::kw_only(), "lossless"_a = false, "compact_version"_a = 3)
       .def(
           "to_bytes",
-          [](const VectorImage& v, const std::string& format, bool lossless) {
+          [](const VectorImage& v, const std::string& format, bool lossless, int compact_version) {
             std::string bytes;
             {
               py::gil_scoped_release release;
               if (format == "svec") {
                 subvec::SvecWriteOptions options;
                 options.lossless = lossless;
+                options.compact_version = compact_version;
                 const std::vector<uint8_t> b = subvec::to_svec_binary(v, options);
                 bytes.assign(b.begin(), b.end());
               } else if (format == "json") {
@@ -419,7 +421,7 @@ void def_vector_image(PyVectorImage& vi) {
             }
             return py::bytes(bytes);
           },
-          py::kw_only(), "format"_a = "svec", "lossless"_a = false)
+          py::kw_only(), "format"_a = "svec", "lossless"_a = false, "compact_version"_a = 3)
       .def("info", &info)
       .def("mesh", &mesh_dict, py::kw_only(), "level"_a = 0)
       .def(

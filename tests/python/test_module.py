@@ -113,6 +113,24 @@ def test_pickle_and_bytes_round_trip(disk):
         image.to_bytes(lossless=True)
 
 
+def test_compact_version_2_on_request(tmp_path, disk):
+    # compact_version=2 writes the older payload (the header's version field), holding the same
+    # mesh and picture as version 3 (which alone rounds saliencies to float32, docs/format.md);
+    # other versions raise the library's message and write nothing.
+    _, image = disk
+    v2, v3 = image.to_bytes(compact_version=2), image.to_bytes()
+    assert v2[8] == 2 and v3[8] == 3
+    a, b = subvec.from_bytes(v2), subvec.from_bytes(v3)
+    for key in ("positions", "colors", "triangles", "triangle_colors"):
+        assert np.array_equal(a.mesh()[key], b.mesh()[key]), key
+    assert np.array_equal(a.render(), b.render())
+    image.save(tmp_path / "old.svec", compact_version=2)
+    assert (tmp_path / "old.svec").read_bytes() == v2
+    with pytest.raises(subvec.InvalidArgumentError, match=r"compact \.svec version 4 is not one this build writes \(2 or 3\)"):
+        image.save(tmp_path / "bad.svec", compact_version=4)
+    assert not (tmp_path / "bad.svec").exists()
+
+
 # ---- render() against the CLI ----------------------------------------------------------------
 
 RENDER_CASES = [
