@@ -30,17 +30,17 @@ interface Exports {
 let instance: Exports | null = null;
 const MAX_KEPT = 64 * 2 ** 20; // an arena grown past this is dropped after the call
 
-// The module's bytes: base 85 (wasm/build: 5 characters # to ~, without ' and \, per 4 bytes,
-// big-endian) of its zstd frame.
+// The module's bytes: base 116 (wasm/build: 7 characters, 1 to 126 without 7 to 13, escape, '
+// and \, per 6 bytes, big-endian) of its zstd frame.
 function unpack(): Uint8Array<ArrayBuffer> {
-  const packed = new Uint8Array((WASM.length / 5) * 4), view = new DataView(packed.buffer);
-  for (let i = 0; i < WASM.length; i += 5) {
+  const packed = new Uint8Array((WASM.length / 7) * 6);
+  for (let i = 0, o = 0; i < WASM.length; o += 6) {
     let v = 0;
-    for (let k = i; k < i + 5; k++) {
-      const c = WASM.charCodeAt(k);
-      v = v * 85 + c - 35 - +(c > 39) - +(c > 92);
+    for (const end = i + 7; i < end; i++) {
+      const c = WASM.charCodeAt(i);
+      v = v * 116 + c - (c > 13 ? 8 : 1) - +(c > 27) - +(c > 39) - +(c > 92);
     }
-    view.setUint32((i / 5) * 4, v);
+    for (let k = o + 6; k-- > o; v = Math.floor(v / 256)) packed[k] = v % 256;
   }
   const parts: Uint8Array[] = [];
   new Decompress((part) => parts.push(part)).push(packed.subarray(0, WASM_BYTES), true);
