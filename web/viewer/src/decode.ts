@@ -266,7 +266,7 @@ function compactLevel(c: Cursor, l: number, width: number, height: number, versi
     if (version === 2 && k === 0 && n !== expected) fail(`${name}connectivity: ${n} bytes for ${nv} vertices (expected ${expected})`);
     return bytes;
   });
-  const [level, topology] = decodeCompact({ version, sections, ops, nv, ncolors, ntriangles, ncreases, nfeatures, pb, cb, width, height, name });
+  const [level, topology] = decodeCompact({ version, sections, ops, nv, ncolors, ntriangles, ncreases, nfeatures, pb, cb, width, height, level: l });
   topologies[l] = topology;
   return level;
 }

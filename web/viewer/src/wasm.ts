@@ -17,6 +17,7 @@ export { uniformIndices, type Refined, type Topology } from './subdivide';
 
 interface Exports {
   memory: WebAssembly.Memory;
+  __stack_pointer: WebAssembly.Global;
   reset(): void;
   alloc(bytes: number): number;
   topology(...args: number[]): number;
@@ -77,7 +78,9 @@ type TypedClass<T extends Typed> = { new (buffer: ArrayBuffer, offset: number, l
 // pointer returns 0 when the arena cannot grow), then the outputs read with get() (copies); the
 // arena dropped when it grew large.
 function call<R>(run: (put: (a: Typed) => number, m: Exports) => number, read: (at: number, get: <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T, i32: (at: number) => number) => R): R {
-  const m = module();
+  // A SvecError thrown from inside the module skips the C functions' epilogues: the stack
+  // pointer is put back here, or each failed call would leave the stack lower.
+  const m = module(), stack = m.__stack_pointer.value;
   m.reset();
   try {
     const put = (a: Typed) => {
@@ -91,6 +94,7 @@ function call<R>(run: (put: (a: Typed) => number, m: Exports) => number, read: (
     const get = <T extends Typed>(c: TypedClass<T>, p: number, n: number): T => new c(buffer, p, n).slice() as T;
     return read(at, get, (p: number) => new Int32Array(buffer, p, 1)[0]);
   } finally {
+    m.__stack_pointer.value = stack;
     if (m.memory.buffer.byteLength > MAX_KEPT) instance = null;
   }
 }
@@ -188,98 +192,30 @@ export interface CompactInput {
   cb: number;
   width: number;
   height: number;
-  /** "level L ", which starts most messages */
-  name: string;
+  /** the level's number, for the messages */
+  level: number;
 }
 
-// The level being decoded or checked, for the messages: its name for the decoder's ("level L "),
-// the prefix of the others ("" while decoding, "level L: " while checking).
-interface Context {
-  name: string;
-  prefix: string;
-  nv: number;
-  level?: Level;
-  width?: number;
-  height?: number;
+const utf8 = new TextDecoder();
+
+// A number as nlohmann's dump() writes it: 4.0, 0.5, 4e+38, 1e-05.
+function dump(v: number): string {
+  const [digits, exponent] = v.toExponential().split('e'), e = +exponent;
+  if (e > 14 || e < -4) return `${digits}e${e < 0 ? '-' : '+'}${String(Math.abs(e)).padStart(2, '0')}`;
+  return Number.isInteger(v) ? v.toFixed(1) : String(v);
 }
-let current: Context | null = null;
 
-const SECTION = ['connectivity', 'split offsets', 'positions', 'features', 'feature steps', 'colors', 'header'];
-const chain = (feature: number, i: number, id?: number) => (feature ? `feature ${i}${id === undefined ? '' : ` (id ${id})`}` : `crease ${i}`);
-const point = (x: number, y: number) => `(${num(x)}, ${num(y)})`;
-// The messages of wasm/decode.c's codes, in their order: x is the context, then the numbers.
-type Message = (x: Context, a: number, b: number, c: number, d: number, e: number, f: number, g: number) => string;
-const connectivity = (m: (a: number, b: number) => string): Message => (x, a, b) => `${x.name}connectivity: ${m(a, b)}`;
-const at = (x: Context, v: number) => point(x.level!.positions[2 * v], x.level!.positions[2 * v + 1]);
-const MESSAGES: Message[] = [
-  () => 'out of memory: the image needs more than WebAssembly can hold',
-  (x) => `${x.name}stream: corrupt coded data (bad first bytes)`,
-  (x, k, length) => `${x.name}stream ${SECTION[k]}: the coded data ends early (${length} bytes)`,
-  (x, k) => `${x.name}stream ${SECTION[k]}: a number of more than 56 bits`,
-  (x, left) => `${left} unexpected bytes at the end of ${x.name}stream`,
-  (x) => `${x.name}stream: corrupt coded data (the code leaves its interval)`,
-  (x, k, w, need, p, left) => `truncated payload while reading ${x.name}${w < 0 ? SECTION[k] : chain(1, w)} (needs ${need} bytes at offset ${p}, ${left} left)`,
-  (x, k, w) => `malformed varint while reading ${x.name}${w < 0 ? SECTION[k] : chain(1, w)}`,
-  (x, i) => `${x.name}connectivity: byte ${i} is not three operations`,
-  (x, left, k) => `${left} unexpected bytes at the end of ${x.name}${SECTION[k]}`,
-  (x, i, tag) => `${x.name}feature ${i}: unknown saliency tag ${tag}`,
-  (x, i, length) => `${x.name}feature ${i}: ${length + 2} vertices, too few bytes`,
-  connectivity((v) => `virtual vertex ${v} out of range`),
-  connectivity(() => 'the traversal ends before the last operation'),
-  connectivity(() => 'the operations outrun the stream'),
-  connectivity((nv) => `more vertices than the ${nv} declared`),
-  connectivity((i, size) => `operation ${i} closes a loop of ${size} edges`),
-  connectivity((i) => `operation ${i} on a loop of 3 edges`),
-  connectivity(() => 'split offset out of range'),
-  connectivity((i) => `operation ${i} makes a degenerate triangle`),
-  connectivity(() => 'the traversal leaves triangles unvisited'),
-  connectivity((n, nv) => `${n} vertices, but ${nv} are declared`),
-  connectivity((n, nt) => `${n} triangles, but ${nt} are declared`),
-  (x) => `${x.name}positions: residual out of range`,
-  (x, f, i, v) => `${x.name}${chain(f, i)}: vertex ${v} out of range`,
-  (x, f, i, r) => `${x.name}${chain(f, i)}: step ${r} out of range`,
-  (x, i) => `${x.name}feature ${i}: id out of range`,
-  (x, i, length) => `${x.name}feature ${i}: ${length + 2} vertices, more than the level has`,
-  // The topology's (MeshTopology::build's).
-  (x, f, v, nv) => `${x.prefix}triangle ${f} refers to vertex ${v}, out of range (${nv} vertices)`,
-  (x, f, v) => `${x.prefix}triangle ${f} repeats vertex ${v}`,
-  (x, u, v) => `${x.prefix}edge (${u}, ${v}) is shared by more than two triangles`,
-  (x, f, g, u, v) => `${x.prefix}triangles ${f} and ${g} are oriented inconsistently across edge (${u}, ${v})`,
-  (x, f, i, id, v) => `${x.prefix}${chain(f, i, id)} refers to vertex ${v}, out of range (${x.nv} vertices)`,
-  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: (${u}, ${v}) is not an edge of the mesh`,
-  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: (${u}, ${v}) lies on the image border`,
-  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: edge (${u}, ${v}) is already a crease`,
-  (x, f, i, id, u, v) => `${x.prefix}${chain(f, i, id)}: edge (${u}, ${v}) is already a feature edge`,
-  (x, i, id) => `${x.prefix}${chain(1, i, id)} has fewer than two vertices`,
-  (x, nc, declared) => `${x.name}colors: the tears give ${nc} color values, but ${declared} are declared`,
-  (x) => `${x.name}colors: residual out of range`,
-  (x) => `${x.name}colors: value out of range`,
-  // A level's validity rules (src/mesh/validate.cpp's).
-  (x, v) => `${x.prefix}vertex ${v} position ${at(x, v)} is not finite`,
-  (x, v) => `${x.prefix}vertex ${v} position ${at(x, v)} is outside the image [0, ${x.width}] x [0, ${x.height}]`,
-  (x, i) => `${x.prefix}color ${i} (${Array.from(x.level!.colors.subarray(3 * i, 3 * i + 3), num).join(', ')}) is not finite`,
-  (x, f, c, nc) => `${x.prefix}triangle_colors ${f} refers to color ${c}, out of range (${nc} colors)`,
-  (x, i, id) => `${x.prefix}feature ${i} repeats id ${id} (ids must be unique within a level)`,
-  (x, i, id, s) => `${x.prefix}feature ${i} (id ${id}) saliency ${num(s)} is not finite`,
-  (x, f, u, v, w, s) => `${x.prefix}triangle ${f} (${u}, ${v}, ${w}) is flipped or degenerate (signed area ${num(s)})`,
-  (x, v) => `${x.prefix}vertex ${v} ${at(x, v)} is used by no triangle`,
-  (x, u, v) =>
-    `${x.prefix}edge (${u}, ${v}) from ${at(x, u)} to ${at(x, v)} has a triangle on one side only but does not lie on the image border (a gap or a hole in the mesh)`,
-  (x, k) => `${x.prefix}no vertex at the image corner ${point(k % 3 ? x.width! : 0, k > 1 ? x.height! : 0)}`,
-  (x, v, sum, kind) => {
-    const expected = [0.5, 1, 2][kind], what = ['an image corner', 'a border vertex', 'an interior vertex'][kind];
-    return `${x.prefix}triangles ${sum > expected * Math.PI ? 'overlap' : 'leave a gap'} around vertex ${v} ${at(x, v)}: their angles there sum to ${num(sum / Math.PI)}*pi, ${what} needs ${num(expected)}*pi`;
-  },
-  (x, total) =>
-    `${x.prefix}the triangles cover an area of ${num(total)} but the image has ${num(x.width! * x.height!)} (${x.width} x ${x.height}): they overlap or leave a gap`,
-  (x, i, a, f, b, g) => `${x.prefix}color ${i} is used at vertex ${a} (triangle ${f}) and at vertex ${b} (triangle ${g}); a color value belongs to one vertex`,
-  (x, i) => `${x.prefix}color ${i} is used by no triangle corner`,
-  (x, a, b, f, g, v, cf, cg) => `${x.prefix}edge (${a}, ${b}) is not a tear but triangles ${f} and ${g} use different colors at vertex ${v} (${cf} and ${cg})`,
-];
-
-function failed(code: number, a: number, b: number, c: number, d: number, e: number, f: number, g: number): never {
-  const x = current ?? { name: '', prefix: '', nv: 0 };
-  throw new SvecError(MESSAGES[code]?.(x, a, b, c, d, e, f, g) ?? `corrupt level (code ${code})`);
+// The module's message (wasm/message.h): UTF-8, with each number as a marker byte (0xfd: an
+// integer, 0xfe: "%g", 0xff: dump()) and its 8 bytes.
+function failed(at: number, n: number): never {
+  const b = new Uint8Array(instance!.memory.buffer, at, n), d = new DataView(b.buffer, at, n);
+  let s = '', from = 0;
+  for (let i = 0; i < n; i++)
+    if (b[i] > 0xfc) {
+      s += utf8.decode(b.subarray(from, i)) + [String, num, dump][b[i] - 0xfd](d.getFloat64(i + 1, true));
+      from = (i += 8) + 1;
+    }
+  throw new SvecError(s + utf8.decode(b.subarray(from)));
 }
 
 // ⌊(2·s + n) / (2·n)⌋, the rounded mean of the n integers at `terms` (doubles in the module's
@@ -306,13 +242,11 @@ export interface Edges {
 /** A compact level and its edges, or a SvecError naming the problem. */
 export function decodeCompact(input: CompactInput): [Level, Edges] {
   const { nv, ntriangles: nt, ncreases, nfeatures } = input;
-  current = { name: input.name, prefix: '', nv };
-  try {
-    return call(
+  return call(
       (put, m) => {
         const sections = new Int32Array(12);
         input.sections.forEach((s, k) => ((sections[2 * k] = put(s)), (sections[2 * k + 1] = s.length)));
-        return m.compact(input.version, put(sections), input.ops, nv, input.ncolors, nt, ncreases, nfeatures, input.pb, input.cb, input.width, input.height);
+        return m.compact(input.version, put(sections), input.ops, nv, input.ncolors, nt, ncreases, nfeatures, input.pb, input.cb, input.width, input.height, input.level);
       },
       (at, get, i32) => {
         // The C struct Level (32-bit fields): positions, colors, triangles, triangleColors,
@@ -332,9 +266,6 @@ export function decodeCompact(input: CompactInput): [Level, Edges] {
         return [level, { a: edge(0), b: edge(1), g: edge(3) }];
       },
     );
-  } finally {
-    current = null;
-  }
 }
 
 /** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
@@ -342,13 +273,11 @@ export function decodeCompact(input: CompactInput): [Level, Edges] {
  * by construction. */
 export function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void {
   const { positions: p, colors: c, triangles: t, features } = level, nf = features.length;
-  current = { name: `level ${l} `, prefix: `level ${l}: `, nv: p.length / 2, level, width, height };
   const offsets = new Int32Array(nf + 1);
   features.forEach((f, i) => (offsets[i + 1] = offsets[i] + f.vertices.length));
   const verts = new Int32Array(offsets[nf]);
   features.forEach((f, i) => verts.set(f.vertices, offsets[i]));
-  try {
-    call(
+  call(
       (put, m) => {
         let edges = 0;
         if (built) {
@@ -358,11 +287,8 @@ export function checkLevel(level: Level, width: number, height: number, l: numbe
         }
         return m.check_level(p.length / 2, put(p), c.length / 3, put(c), t.length / 3, put(t), put(level.triangleColors),
           level.creases.length / 2, put(level.creases), nf, put(Int32Array.from(features, (f) => f.id)),
-          put(Float64Array.from(features, (f) => f.saliency)), put(offsets), put(verts), width, height, edges);
+          put(Float64Array.from(features, (f) => f.saliency)), put(offsets), put(verts), width, height, edges, l);
       },
       () => undefined,
     );
-  } finally {
-    current = null;
-  }
 }

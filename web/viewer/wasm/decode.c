@@ -6,42 +6,14 @@
 // web/tests/viewer-decode.mjs compares what the viewer decodes, and what it refuses, with
 // `subvec`'s.
 //
-// Problems are reported through the imported fail(code, ...), which throws the SvecError
-// (src/wasm.ts writes the messages, one per code below); it never returns. Numbers that the
+// Problems are reported through FAIL(code, ...) (message.c writes the messages), which throws the
+// SvecError; it never returns. Numbers that the
 // format lets exceed 32 bits are doubles, as in JavaScript: exact integers below 2^53, which
 // every range check lies below.
-#include "memory.h"
+#include "message.h"
 
-// Codes of fail(); src/wasm.ts keeps the messages in this order.
-enum {
-  E_OUT_OF_MEMORY,
-  // range-coded stream (version 3)
-  E_FIRST_BYTES, E_ENDS_EARLY, E_WIDE_NUMBER, E_TRAILING_STREAM, E_LEAVES_INTERVAL,
-  // varint sections (version 2)
-  E_TRUNCATED, E_MALFORMED_VARINT, E_OPERATION_BYTE, E_TRAILING_SECTION, E_SALIENCY_TAG, E_FEW_STEP_BYTES,
-  // connectivity
-  E_VIRTUAL, E_ENDS_BEFORE, E_OUTRUN, E_MORE_VERTICES, E_CLOSES_LOOP, E_LOOP_OF_3, E_SPLIT_OFFSET, E_DEGENERATE,
-  E_UNVISITED, E_VERTEX_COUNT, E_TRIANGLE_COUNT,
-  // positions, creases and features
-  E_POSITION_RESIDUAL, E_VERTEX_RANGE, E_STEP_RANGE, E_FEATURE_ID, E_FEATURE_LENGTH,
-  // topology (as MeshTopology::build words them)
-  E_TRIANGLE_VERTEX, E_REPEATS_VERTEX, E_SHARED_EDGE, E_ORIENTATION, E_MARK_RANGE, E_NOT_AN_EDGE, E_ON_BORDER,
-  E_ALREADY_CREASE, E_ALREADY_TEAR, E_SHORT_FEATURE,
-  // colors
-  E_COLOR_COUNT, E_COLOR_RESIDUAL, E_COLOR_VALUE,
-  // a level's validity rules (check_level)
-  V_POSITION_NOT_FINITE, V_POSITION_OUTSIDE, V_COLOR_NOT_FINITE, V_TRIANGLE_COLOR, V_REPEATED_ID, V_SALIENCY,
-  V_FLIPPED, V_UNUSED_VERTEX, V_GAP_EDGE, V_NO_CORNER, V_ANGLES, V_AREA, V_COLOR_OWNER, V_UNUSED_COLOR, V_COLOR_EDGE,
-};
-
-IMPORT(fail) __attribute__((noreturn)) void js_fail(int32_t code, double a, double b, double c, double d, double e, double f, double g);
-// The BigInt fallbacks of src/decode.ts, for integers too large for one rounding in doubles.
 IMPORT(mean) double js_mean(const double *terms, int32_t n);
 IMPORT(exact) double js_exact(double a, double b, double c, double d);
-
-// fail(code) with up to seven numbers.
-#define FAIL(...) FAIL_(__VA_ARGS__, 0, 0, 0, 0, 0, 0, 0, 0)
-#define FAIL_(code, a, b, c, d, e, f, g, ...) js_fail(code, a, b, c, d, e, f, g)
 IMPORT(atan2) double js_atan2(double, double);
 static void *need(void *p) {
   if (!p) FAIL(E_OUT_OF_MEMORY);
@@ -241,7 +213,7 @@ static double saliency(Source *s, int32_t what) {
 static double length(Source *s, int32_t what) {
   if (s->version == 3) return read(s, 0, LENGTH, 0, -1);
   double n = varint(s, FEATURES);
-  if (n > s->section[STEPS].n - s->section[STEPS].pos) FAIL(E_FEW_STEP_BYTES, what, n);
+  if (n > s->section[STEPS].n - s->section[STEPS].pos) FAIL(E_FEW_STEP_BYTES, what, n + 2);
   return n;
 }
 
@@ -527,7 +499,7 @@ static int32_t step(Steps *c, int32_t from, int32_t at, int first, int isFeature
 // Marks edge (x, y) as kind (topology() of validate.ts); `what`: crease i, or feature i (id).
 static void mark(const Edges *E, int32_t nv, int32_t x, int32_t y, uint8_t kind, int32_t i, int32_t id) {
   double isFeature = kind == TAG_TEAR;
-  if (x < 0 || x >= nv || y < 0 || y >= nv) FAIL(E_MARK_RANGE, isFeature, i, id, x < 0 || x >= nv ? x : y);
+  if (x < 0 || x >= nv || y < 0 || y >= nv) FAIL(E_MARK_RANGE, isFeature, i, id, x < 0 || x >= nv ? x : y, nv);
   int32_t u = x < y ? x : y, v = x < y ? y : x, l = 0, r = E->numEdges;
   while (l < r) {
     int32_t mid = (l + r) >> 1;
@@ -653,7 +625,8 @@ typedef struct {
 // of the payload can hold). Returns the level and its topology; 0 never (fail() throws).
 EXPORT(compact)
 Level *compact(int32_t version, const Section *sections, double ops, int32_t nv, int32_t ncolors, int32_t ntriangles,
-               int32_t ncreases, int32_t nfeatures, int32_t pb, int32_t cb, double width, double height) {
+               int32_t ncreases, int32_t nfeatures, int32_t pb, int32_t cb, double width, double height, int32_t level) {
+  message_level = level, message_prefix = 0;
   Level *L = MAKE(Level, 1);
   Source *s = MAKE(Source, 1);
   if (version == 3) {
@@ -698,7 +671,7 @@ Level *compact(int32_t version, const Section *sections, double ops, int32_t nv,
     ids[i] = (int32_t)id;
     saliencies[i] = saliency(s, i);
     double n = length(s, i);
-    if (n > fmin2(nv, MAX_ELEMENTS - 2)) FAIL(E_FEATURE_LENGTH, i, n);
+    if (n > fmin2(nv, MAX_ELEMENTS - 2)) FAIL(E_FEATURE_LENGTH, i, n + 2);
     int32_t *v = chains[i] = MAKE(int32_t, n + 2);
     offsets[i + 1] = offsets[i] + (int32_t)n + 2;
     v[0] = checked(&c, vertex(s), 1, i);
@@ -737,16 +710,18 @@ static const double PI = 3.141592653589793;
 EXPORT(check_level)
 int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
                     int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
-                    const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built) {
+                    const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built,
+                    int32_t level) {
+  message_level = level, message_prefix = 1, message_positions = p;
   int32_t nh = 3 * nt;
   for (int32_t v = 0; v < nv; ++v) {
     double x = p[2 * v], y = p[2 * v + 1];
-    if (!__builtin_isfinite(x) || !__builtin_isfinite(y)) FAIL(V_POSITION_NOT_FINITE, v);
-    if (x < 0 || x > width || y < 0 || y > height) FAIL(V_POSITION_OUTSIDE, v);
+    if (!__builtin_isfinite(x) || !__builtin_isfinite(y)) FAIL(V_POSITION_NOT_FINITE, v, v);
+    if (x < 0 || x > width || y < 0 || y > height) FAIL(V_POSITION_OUTSIDE, v, v, width, height);
   }
   if (!built) {
     for (int32_t i = 0; i < 3 * nc; ++i)
-      if (!__builtin_isfinite(c[i])) FAIL(V_COLOR_NOT_FINITE, i / 3);
+      if (!__builtin_isfinite(c[i])) FAIL(V_COLOR_NOT_FINITE, i / 3, c[i - i % 3], c[i - i % 3 + 1], c[i - i % 3 + 2]);
     // Vertex indices before color indices: without triangle_colors (JSON) these are copies of them.
     for (int32_t h = 0; h < nh; ++h)
       if (t[h] < 0 || t[h] >= nv) FAIL(E_TRIANGLE_VERTEX, h / 3, t[h], nv);
@@ -793,7 +768,7 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
     used[u] = used[v] = used[w] = 1;
   }
   for (int32_t v = 0; v < nv; ++v)
-    if (!used[v]) FAIL(V_UNUSED_VERTEX, v);
+    if (!used[v]) FAIL(V_UNUSED_VERTEX, v, v);
 
   // Sides of the image rectangle each vertex lies on, exactly: 1 left, 2 right, 4 top, 8 bottom;
   // and the image corners: 1 (0, 0), 2 (W, 0), 4 (W, H), 8 (0, H).
@@ -806,11 +781,11 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
   for (int32_t e = 0; e < E->numEdges; ++e) {
     if (E->g[e] >= 0) continue;
     int32_t u = E->a[e], v = E->b[e];
-    if (!(sides[u] & sides[v])) FAIL(V_GAP_EDGE, u, v);
+    if (!(sides[u] & sides[v])) FAIL(V_GAP_EDGE, u, v, u, v);
     border[u] = border[v] = 1;
   }
   for (int k = 0; k < 4; ++k)
-    if (!(corners & (1 << k))) FAIL(V_NO_CORNER, k);
+    if (!(corners & (1 << k))) FAIL(V_NO_CORNER, k % 3 ? width : 0, k > 1 ? height : 0);
 
   // Tiling: angle sums per vertex, then the total area (summed compensated, as C++ sums it in
   // long double).
@@ -829,10 +804,10 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
   for (int32_t v = 0; v < nv; ++v) {
     int corner = border[v] && sides[v] & 3 && sides[v] & 12, kind = corner ? 0 : border[v] ? 1 : 2;
     double expected = corner ? PI / 2 : border[v] ? PI : 2 * PI;
-    if (__builtin_fabs(angles[v] - expected) > 1e-6) FAIL(V_ANGLES, v, angles[v], kind);
+    if (__builtin_fabs(angles[v] - expected) > 1e-6) FAIL(V_ANGLES, angles[v] > expected ? W_OVERLAP : W_GAP, v, v, angles[v] / PI, W_CORNER + kind, expected / PI);
   }
   double image = width * height;
-  if (__builtin_fabs(total - image) > 1e-9 * image) FAIL(V_AREA, total);
+  if (__builtin_fabs(total - image) > 1e-9 * image) FAIL(V_AREA, total, width * height, width, height);
   if (built) return 1;
 
   // Colors: each value belongs to one vertex and is used; across an edge that is not a tear, both

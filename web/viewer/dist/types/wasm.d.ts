@@ -23,8 +23,8 @@ export interface CompactInput {
     cb: number;
     width: number;
     height: number;
-    /** "level L ", which starts most messages */
-    name: string;
+    /** the level's number, for the messages */
+    level: number;
 }
 /** The edges of a level the decoder built, sorted by (a, b) with a < b, and the triangle across
  * each (-1 on the border): what check_level needs of them. */
