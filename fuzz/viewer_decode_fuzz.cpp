@@ -26,7 +26,7 @@ void *alloc_array(size_t size, double count) {
   if (!(count >= 0) || count * static_cast<double>(size) > 4294967295.0) return nullptr;
   return alloc(size * static_cast<size_t>(count));
 }
-[[noreturn]] void js_fail(int32_t code, double, double, double, double, double, double, double) { std::longjmp(failed, 1 + code); }
+[[noreturn]] void js_fail(const uint8_t *, int32_t) { std::longjmp(failed, 1); }
 double js_mean(const double *terms, int32_t n) {
   long double s = 0;
   for (int32_t i = 0; i < n; ++i) s += terms[i];
@@ -36,6 +36,7 @@ double js_exact(double a, double b, double c, double d) {
   return static_cast<double>(static_cast<long double>(a) * b + static_cast<long double>(c) * d);
 }
 double js_atan2(double y, double x) { return std::atan2(y, x); }
+#include "../web/viewer/wasm/message.c"
 #include "../web/viewer/wasm/decode.c"
 }
 
@@ -83,7 +84,7 @@ void level(int version, Reader &r, int32_t width, int32_t height) {
   if (!setjmp(failed))
     decoded = compact(version, sections, ops, static_cast<int32_t>(count[0]), static_cast<int32_t>(count[1]),
                       static_cast<int32_t>(count[2]), static_cast<int32_t>(count[3]), static_cast<int32_t>(count[4]), pb, cb,
-                      width, height);
+                      width, height, 0);
   Level *L = const_cast<Level *>(decoded);
   if (!L) return release();
   int32_t nv = static_cast<int32_t>(count[0]), nt = static_cast<int32_t>(count[2]);
@@ -91,7 +92,7 @@ void level(int version, Reader &r, int32_t width, int32_t height) {
     if (!setjmp(failed))
       check_level(nv, L->positions, static_cast<int32_t>(count[1]), L->colors, nt, L->triangles, L->triangleColors,
                   static_cast<int32_t>(count[3]), L->creases, L->numFeatures, L->featureIds, L->featureSaliency, L->featureOffsets,
-                  L->featureVertices, width, height, built);
+                  L->featureVertices, width, height, built, 0);
   release();
 }
 }  // namespace

@@ -1,25 +1,25 @@
 #include "message.h"
 
-IMPORT(fail) __attribute__((noreturn)) void js_fail(const uint8_t *message, int32_t length);
+IMPORT(fail) __attribute__((noreturn)) void js_fail(const uint8_t *message, int32_t n);
 
 int32_t message_level, message_prefix;
 const double *message_positions;
 
 static uint8_t *text;
-static int32_t length, capacity;
+static int32_t said, room;
 
-void say_start(void) { length = capacity = 0; }
+void say_start(void) { said = room = 0; }
 
 void say_bytes(const uint8_t *bytes, int32_t n) {
-  if (length + n > capacity) {
-    int32_t grown = 2 * (length + n) + 256;
-    uint8_t *to = alloc((size_t)grown);
+  if (said + n > room) {
+    int32_t grown = 2 * (said + n) + 256;
+    uint8_t *to = (uint8_t *)alloc((size_t)grown);
     if (!to) js_fail((const uint8_t *)"out of memory: the image needs more than WebAssembly can hold", 61);
-    if (length) __builtin_memcpy(to, text, (size_t)length);
-    text = to, capacity = grown;
+    if (said) __builtin_memcpy(to, text, (size_t)said);
+    text = to, room = grown;
   }
-  __builtin_memcpy(text + length, bytes, (size_t)n);
-  length += n;
+  __builtin_memcpy(text + said, bytes, (size_t)n);
+  said += n;
 }
 void say(const char *s) {
   int32_t n = 0;
@@ -31,7 +31,7 @@ void say_number(int as, double v) {
   say_bytes(&marker, 1);
   say_bytes((const uint8_t *)&v, 8);
 }
-void say_fail(void) { js_fail(text, length); }
+void say_fail(void) { js_fail(text, said); }
 
 // The templates: text, and directives that take the next numbers: \3 an integer, \4 a number as
 // "%g", \5 a word, \6 chain (is feature, i): "feature i" or "crease i", \7 the same with the id
