@@ -8,7 +8,8 @@
 // The module is small (compiled synchronously on first use, 2-3 ms) and keeps no state between
 // calls: each call resets its arena, copies the inputs in and the outputs out.
 import { Decompress } from 'fzstd';
-import type { Feature, Level } from './image';
+import type { Feature, Level, Stroke, SvecImage } from './image';
+import type { PyramidRecord } from './validate';
 import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
 import { WASM, WASM_BYTES } from './wasm-binary';
@@ -26,6 +27,7 @@ interface Exports {
   compact(...args: number[]): number;
   check_level(...args: number[]): number;
   xxh64(bytes: number, length: number): number;
+  json(bytes: number, length: number): number;
 }
 
 let instance: Exports | null = null;
@@ -61,7 +63,7 @@ if (typeof WebAssembly === 'object')
 
 function module(): Exports {
   if (instance) return instance;
-  const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact };
+  const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact, number: (at: number, n: number) => Number(utf8.decode(new Uint8Array(instance!.memory.buffer, at, n))) };
   try {
     instance = new WebAssembly.Instance(compiled ?? new WebAssembly.Module(unpack()), { env }).exports as unknown as Exports;
   } catch (e) {
@@ -196,7 +198,7 @@ export interface CompactInput {
   level: number;
 }
 
-const utf8 = new TextDecoder();
+const utf8 = new TextDecoder('utf-8', { ignoreBOM: true });
 
 // A number as nlohmann's dump() writes it: 4.0, 0.5, 4e+38, 1e-05.
 function dump(v: number): string {
@@ -291,4 +293,37 @@ export function checkLevel(level: Level, width: number, height: number, l: numbe
       },
       () => undefined,
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// The JSON form (wasm/json.c).
+
+/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
+export function readJson(b: Uint8Array): [SvecImage, PyramidRecord[]] {
+  return call(
+    (put, m) => m.json(put(b), b.length),
+    (at, get, i32) => {
+      // The C structs JsonImage, JsonLevel, JsonStroke, JsonEntry: 32-bit fields; an Array is (n, pointer).
+      const f = (p: number, k: number) => i32(p + 4 * k);
+      const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
+      const text = (p: number, k: number) => utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
+      const records: PyramidRecord[] = [];
+      const levels = Array.from({ length: f(at, 2) }, (_, l): Level => {
+        const p = f(at, 3) + 72 * l, triangles = ints(p, 4), nf = f(p, 14);
+        const saliency = get(Float64Array, f(p, 16), nf);
+        records[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
+        return {
+          positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles,
+          triangleColors: f(p, 7) ? ints(p, 6) : triangles.slice(), creases: ints(p, 8),
+          features: Array.from({ length: nf }, (_, k) => ({ id: f(f(p, 15), k), vertices: ints(f(p, 17) + 8 * k, 0), saliency: saliency[k] })),
+        };
+      });
+      const strokes = Array.from({ length: f(at, 4) }, (_, k): Stroke => {
+        const p = f(at, 5) + 32 * k, v = get(Float32Array, p + 4, 5);
+        return { level: f(p, 0), points: get(Float64Array, f(p, 7), f(p, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
+      });
+      const metadata = Array.from({ length: f(at, 6) }, (_, k): [string, string] => [text(f(at, 7) + 16 * k, 0), text(f(at, 7) + 16 * k, 2)]);
+      return [{ width: f(at, 0), height: f(at, 1), levels, strokes, metadata }, records];
+    },
+  );
 }

@@ -1,4 +1,5 @@
-import type { Level } from './image';
+import type { Level, SvecImage } from './image';
+import type { PyramidRecord } from './validate';
 import type { Refined, Topology } from './subdivide';
 export { uniformIndices, type Refined, type Topology } from './subdivide';
 /** buildTopology of subdivide.ts. */
@@ -39,3 +40,5 @@ export declare function decodeCompact(input: CompactInput): [Level, Edges];
  * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
  * by construction. */
 export declare function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void;
+/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
+export declare function readJson(b: Uint8Array): [SvecImage, PyramidRecord[]];

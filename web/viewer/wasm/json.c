@@ -1,0 +1,501 @@
+// The .svec.json form (docs/format.md): a port of the JSON reader that decode.ts had, itself the
+// C++ reader's (src/io/svec_json.cpp) checks and messages: an exact tokenizer (duplicate keys,
+// integers vs numbers, depth 32, UTF-8, JSON.parse's escapes), then a walk that names the path of
+// each problem ("levels[0].triangles[12][1]: ..."). Numbers are parsed by JavaScript (Number()),
+// and written by it (message.h); the image-wide rules stay in JavaScript (validate.ts).
+#include "message.h"
+
+IMPORT(number) double js_number(const uint8_t *text, int32_t n);
+
+enum { K_NULL, K_FALSE, K_TRUE, K_INT, K_FRAC, K_STR, K_ARR, K_OBJ };
+#define MAX_ELEMENTS 67108864.0
+#define MAX_LEVELS 64
+
+typedef struct Node {
+  struct Node *next, *first; // siblings; a container's children
+  const uint8_t *s, *key;    // a string's UTF-8; an object member's key
+  int32_t n, keyn, kind;     // a string's length or a container's count; the key's length
+  double v;
+} Node;
+
+static const uint8_t *b;
+static int32_t len, i, depth;
+static struct { int32_t object, keyn, index; const uint8_t *key; } frames[32];
+
+static void *need_memory(void *p) {
+  if (!p) say_start(), say("out of memory: the image needs more than WebAssembly can hold"), say_fail();
+  return p;
+}
+static int ch(int32_t at) { return at >= 0 && at < len ? b[at] : -1; }
+static void space(void) {
+  while (ch(i) == 32 || ch(i) == 9 || ch(i) == 10 || ch(i) == 13) ++i;
+}
+static void say_index(int32_t k) { say("["), say_number(AS_INTEGER, k), say("]"); }
+
+static void say_path(int top_key) {
+  int said_any = 0;
+  for (int32_t k = 0; k < depth; ++k) {
+    if (!frames[k].object) {
+      if (frames[k].index >= 0) say_index(frames[k].index), said_any = 1;
+    } else if (frames[k].keyn && (top_key || k + 1 < depth)) {
+      if (said_any) say(".");
+      say_bytes(frames[k].key, frames[k].keyn), said_any = 1;
+    }
+  }
+  if (!said_any) say("(top level)");
+}
+
+__attribute__((noreturn)) static void syntax(const char *what) {
+  int32_t end = i < len ? i : len, line = 1, column = 1;
+  for (int32_t k = 0; k < end; ++k) b[k] == 10 ? (++line, column = 1) : ++column;
+  say_start(), say("invalid JSON near "), say_path(1), say(" (byte "), say_number(AS_INTEGER, (double)i + 1);
+  say("): parse error at line "), say_number(AS_INTEGER, line), say(", column "), say_number(AS_INTEGER, column);
+  say(": syntax error - "), say(what), say_fail();
+}
+
+static int hexdigit(int c) { return c >= '0' && c <= '9' ? c - '0' : (c | 32) >= 'a' && (c | 32) <= 'f' ? (c | 32) - 'a' + 10 : -1; }
+
+// A string literal at i: its UTF-8 into node->s (JSON.parse's escapes; the bytes valid UTF-8; no
+// lone surrogate).
+static void string(Node *node) {
+  int32_t from = i++;
+  while (i < len && b[i] != 34) i += b[i] == 92 ? 2 : 1;
+  if (i++ >= len) syntax("invalid string: missing closing quote");
+  int32_t end = i - 1;
+  uint8_t *out = (uint8_t *)need_memory(alloc((size_t)(end - from)));
+  int32_t n = 0, pending = -1; // a high surrogate escape waiting for its low half
+  for (int32_t k = from + 1; k < end;) {
+    uint32_t c = b[k], cp;
+    if (c < 0x20) goto invalid;
+    if (c == 92) {
+      int e = b[k + 1];
+      k += 2;
+      const char *simple = "\"\"\\\\//b\bf\fn\nr\rt\t";
+      cp = 0x110000;
+      for (const char *s = simple; *s; s += 2)
+        if (e == s[0]) cp = (uint8_t)s[1];
+      if (e == 'u') {
+        if (k + 4 > end) goto invalid;
+        cp = 0;
+        for (int q = 0; q < 4; ++q) {
+          int h = hexdigit(b[k + q]);
+          if (h < 0) goto invalid;
+          cp = cp * 16 + (uint32_t)h;
+        }
+        k += 4;
+      } else if (cp == 0x110000) goto invalid;
+    } else if (c < 0x80) {
+      cp = c, ++k;
+    } else {
+      // UTF-8, strictly (as TextDecoder's fatal mode)
+      int extra = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : 1;
+      if (c < 0xc2 || c > 0xf4) goto invalid;
+      cp = c & (0x3f >> extra);
+      for (int q = 1; q <= extra; ++q) {
+        if (k + q >= end || (b[k + q] & 0xc0) != 0x80) goto invalid;
+        cp = cp << 6 | (b[k + q] & 0x3f);
+      }
+      if ((extra == 2 && (cp < 0x800 || (cp >= 0xd800 && cp < 0xe000))) || (extra == 3 && (cp < 0x10000 || cp > 0x10ffff))) goto invalid;
+      k += extra + 1;
+    }
+    if (pending >= 0) {
+      if (cp >= 0xdc00 && cp < 0xe000) {
+        cp = 0x10000 + (((uint32_t)pending - 0xd800) << 10) + (cp - 0xdc00);
+        pending = -1;
+      } else goto invalid;
+    } else if (cp >= 0xd800 && cp < 0xdc00) {
+      pending = (int32_t)cp;
+      continue;
+    } else if (cp >= 0xdc00 && cp < 0xe000) goto invalid;
+    if (cp < 0x80) out[n++] = (uint8_t)cp;
+    else if (cp < 0x800) out[n++] = (uint8_t)(0xc0 | cp >> 6), out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
+    else if (cp < 0x10000) out[n++] = (uint8_t)(0xe0 | cp >> 12), out[n++] = (uint8_t)(0x80 | (cp >> 6 & 0x3f)), out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
+    else
+      out[n++] = (uint8_t)(0xf0 | cp >> 18), out[n++] = (uint8_t)(0x80 | (cp >> 12 & 0x3f)), out[n++] = (uint8_t)(0x80 | (cp >> 6 & 0x3f)),
+      out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
+  }
+  if (pending >= 0) goto invalid;
+  node->kind = K_STR, node->s = out, node->n = n;
+  return;
+invalid:
+  syntax("invalid string");
+}
+
+static int same(const uint8_t *a, int32_t an, const uint8_t *c, int32_t cn) {
+  if (an != cn) return 0;
+  for (int32_t k = 0; k < an; ++k)
+    if (a[k] != c[k]) return 0;
+  return 1;
+}
+static int is_digit(int c) { return c >= '0' && c <= '9'; }
+
+static Node *value(void) {
+  Node *node = (Node *)need_memory(alloc(sizeof(Node)));
+  space();
+  int c = ch(i);
+  if (c == '{' || c == '[') {
+    if (depth >= 32) say_start(), say_path(1), say(": JSON nested deeper than 32 levels"), say_fail();
+    int object = c == '{', close = object ? '}' : ']';
+    int32_t f = depth++;
+    frames[f].object = object, frames[f].keyn = 0, frames[f].index = -1;
+    node->kind = object ? K_OBJ : K_ARR;
+    Node **tail = &node->first;
+    ++i;
+    space();
+    if (ch(i) == close) ++i;
+    else
+      for (;;) {
+        Node *child;
+        if (object) {
+          space();
+          if (ch(i) != '"') syntax("expected string literal");
+          Node key;
+          string(&key);
+          frames[f].key = key.s, frames[f].keyn = key.n;
+          for (Node *m = node->first; m; m = m->next)
+            if (same(m->key, m->keyn, key.s, key.n))
+              say_start(), say_path(0), say(": duplicate key \""), say_bytes(key.s, key.n), say("\""), say_fail();
+          space();
+          if (ch(i++) != ':') syntax("expected ':'");
+          child = value();
+          child->key = key.s, child->keyn = key.n;
+        } else ++frames[f].index, child = value();
+        *tail = child, tail = &child->next, ++node->n;
+        space();
+        int d = ch(i++);
+        if (d == close) break;
+        if (d != ',') syntax(object ? "expected ',' or '}'" : "expected ',' or ']'");
+      }
+    --depth;
+    return node;
+  }
+  if (c == '"') return string(node), node;
+  int32_t p = i;
+  if (ch(p) == '-') ++p;
+  if (ch(p) == '0') ++p;
+  else if (ch(p) >= '1' && ch(p) <= '9')
+    while (is_digit(ch(p))) ++p;
+  else p = -1;
+  if (p >= 0) {
+    int integer = 1;
+    if (ch(p) == '.' && is_digit(ch(p + 1))) {
+      for (p += 1; is_digit(ch(p)); ++p) {}
+      integer = 0;
+    }
+    int32_t e = p + 1 + (ch(p + 1) == '+' || ch(p + 1) == '-');
+    if ((ch(p) | 32) == 'e' && is_digit(ch(e))) {
+      for (p = e; is_digit(ch(p)); ++p) {}
+      integer = 0;
+    }
+    double v = js_number(b + i, p - i);
+    if (v - v != 0) {
+      say_start(), say("invalid JSON at "), say_path(1), say(": number overflow parsing '"), say_bytes(b + i, p - i), say("'"), say_fail();
+    }
+    i = p;
+    if (integer && v >= -9223372036854775808.0 && v < 18446744073709551616.0) node->kind = K_INT, node->v = v + 0;
+    else node->kind = K_FRAC, node->v = v; // a fraction, an exponent, or beyond 64 bits: the same below
+    return node;
+  }
+  static const char *const literals[] = {"null", "false", "true"};
+  for (int k = 0; k < 3; ++k) {
+    const char *w = literals[k];
+    int32_t q = 0;
+    while (w[q] && ch(i + q) == w[q]) ++q;
+    if (!w[q]) return i += q, node->kind = K_NULL + k, node;
+  }
+  syntax(c < 0 ? "unexpected end of input" : "invalid literal");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The walk.
+
+typedef struct Path { const struct Path *up; const uint8_t *key; int32_t keyn, index; } Path;
+
+static void say_p(const Path *p) {
+  if (!p) return;
+  say_p(p->up);
+  if (!p->key) say_index(p->index);
+  else {
+    if (p->up) say(".");
+    say_bytes(p->key, p->keyn);
+  }
+}
+static void bad_start(const Path *p) {
+  say_start();
+  if (p) say_p(p);
+  else say("(top level)");
+  say(": ");
+}
+static const char *type_name(const Node *j) {
+  static const char *const names[] = {"null", "a boolean", "a boolean", "an integer", "a number with a fraction or exponent", "a string", "an array", "an object"};
+  return names[j->kind];
+}
+__attribute__((noreturn)) static void expected(const Path *p, const char *what, const Node *j) {
+  bad_start(p), say("expected "), say(what), say(", got "), say(type_name(j)), say_fail();
+}
+#define AT_KEY(name, up_, k) const Path name = {up_, (const uint8_t *)(k), sizeof(k) - 1, 0}
+#define AT_INDEX(name, up_, k) const Path name = {up_, 0, 0, k}
+
+static Node *find(const Node *m, const char *key) {
+  int32_t n = 0;
+  while (key[n]) ++n;
+  for (Node *c = m->first; c; c = c->next)
+    if (same(c->key, c->keyn, (const uint8_t *)key, n)) return c;
+  return 0;
+}
+static Node *need(const Node *m, const Path *p, const char *key) {
+  Node *c = find(m, key);
+  if (!c) bad_start(p), say("missing key \""), say(key), say("\""), say_fail();
+  return c;
+}
+static double number(const Node *j, const Path *p) {
+  if (j->kind != K_INT && j->kind != K_FRAC) expected(p, "a number", j);
+  return j->v;
+}
+static double to_float(const Node *j, const Path *p) {
+  double v = number(j, p);
+  if (__builtin_fabs(v) > 3.4028234663852886e38)
+    bad_start(p), say("number "), say_number(AS_DUMP, v), say(" is out of range for a 32-bit float"), say_fail();
+  return (float)v;
+}
+static double to_int(const Node *j, const Path *p) {
+  if (j->kind != K_INT) {
+    bad_start(p), say("expected an integer, got "), say(type_name(j));
+    if (j->kind == K_FRAC) say(" ("), say_number(AS_DUMP, j->v), say(")");
+    say_fail();
+  }
+  if (j->v < -2147483648.0 || j->v > 2147483647.0)
+    bad_start(p), say("integer "), say_number(AS_INTEGER, j->v), say(" is out of the 32-bit range"), say_fail();
+  return j->v;
+}
+static const Node *object(const Node *j, const Path *p) {
+  if (j->kind != K_OBJ) expected(p, "an object", j);
+  return j;
+}
+// UTF-16 order of UTF-8 strings: the characters from U+E000 sort after the supplementary ones.
+static int before(const Node *a, const Node *c) {
+  for (int32_t k = 0;; ++k) {
+    if (k == c->keyn) return 0;
+    if (k == a->keyn) return 1;
+    int x = a->key[k], y = c->key[k];
+    if (x != y) return (x == 0xee || x == 0xef ? x + 7 : x) < (y == 0xee || y == 0xef ? y + 7 : y);
+  }
+}
+static const Node *known(const Node *m, const Path *p, const char *allowed) {
+  object(m, p);
+  const Node *unknown = 0;
+  for (const Node *c = m->first; c; c = c->next) {
+    int ok = 0;
+    for (const char *a = allowed; *a;) {
+      int32_t n = 0;
+      while (a[n] && a[n] != ',') ++n;
+      if (same(c->key, c->keyn, (const uint8_t *)a, n)) ok = 1;
+      a += n + (a[n] ? 2 : 0);
+    }
+    if (!ok && (!unknown || before(c, unknown))) unknown = c;
+  }
+  if (unknown) bad_start(p), say("unknown key \""), say_bytes(unknown->key, unknown->keyn), say("\" (expected one of: "), say(allowed), say(")"), say_fail();
+  return m;
+}
+static const Node *list(const Node *j, const Path *p) {
+  if (j->kind != K_ARR) expected(p, "an array", j);
+  if (j->n > MAX_ELEMENTS) bad_start(p), say_number(AS_INTEGER, j->n), say(" elements is over the limit of 67108864"), say_fail();
+  return j;
+}
+typedef double Read(const Node *, const Path *);
+enum { F64, F32, I32 };
+static void store(void *out, int type, int32_t k, double v) {
+  if (type == F64) ((double *)out)[k] = v;
+  else if (type == F32) ((float *)out)[k] = (float)v;
+  else ((int32_t *)out)[k] = (int32_t)v;
+}
+static void tuple(const Node *t, const Path *p, int32_t n, const char *shape, Read *read, void *out, int type, int32_t at) {
+  if (t->kind != K_ARR || t->n != n) {
+    bad_start(p), say("expected "), say(shape), say(", got ");
+    if (t->kind == K_ARR) say("an array of "), say_number(AS_INTEGER, t->n), say(" elements");
+    else say(type_name(t));
+    say_fail();
+  }
+  int32_t k = 0;
+  for (const Node *x = t->first; x; x = x->next, ++k) {
+    AT_INDEX(q, p, k);
+    store(out, type, at + k, read(x, &q));
+  }
+}
+typedef struct { int32_t n; void *data; } Array; // n values
+static Array tuples(int type, const Node *j, const Path *p, int32_t n, const char *shape, Read *read) {
+  const Node *items = list(j, p);
+  Array a = {n * items->n, need_memory(alloc_array(type == F64 ? 8 : 4, (double)n * items->n + 1))};
+  int32_t k = 0;
+  for (const Node *t = items->first; t; t = t->next, ++k) {
+    AT_INDEX(q, p, k);
+    tuple(t, &q, n, shape, read, a.data, type, n * k);
+  }
+  return a;
+}
+static Array ints(const Node *j, const Path *p) {
+  const Node *items = list(j, p);
+  Array a = {items->n, need_memory(alloc_array(4, (double)items->n + 1))};
+  int32_t k = 0;
+  for (const Node *x = items->first; x; x = x->next, ++k) {
+    AT_INDEX(q, p, k);
+    ((int32_t *)a.data)[k] = (int32_t)to_int(x, &q);
+  }
+  return a;
+}
+#define TRIANGLE "[a, b, c] (three integers)"
+
+static int32_t length(const char *s) {
+  int32_t n = 0;
+  while (s[n]) ++n;
+  return n;
+}
+// m's `key`: a number read as `type` (out null), a list of n-tuples (n > 0) or of integers (n 0)
+// into *out; `otherwise` when absent (NaN: required). Returns otherwise, 1 or the number.
+static double field(const Node *m, const Path *up, const char *key, int type, int n, const char *shape, double otherwise, Array *out) {
+  const Path p = {up, (const uint8_t *)key, length(key), 0};
+  const Node *j = find(m, key);
+  if (!j) {
+    if (otherwise != otherwise) need(m, up, key);
+    return otherwise;
+  }
+  Read *read = type == F64 ? number : type == F32 ? to_float : to_int;
+  if (!out) return read(j, &p);
+  *out = n ? tuples(type, j, &p, n, shape, read) : ints(j, &p);
+  return 1;
+}
+#define REQUIRED __builtin_nan("")
+
+// What JavaScript reads back (wasm.ts): 32-bit fields.
+typedef struct {
+  Array positions, colors, triangles, triangle_colors, creases, parents, collapses;
+  int32_t num_features;
+  int32_t *feature_ids;
+  double *saliency;
+  Array *feature_vertices;
+} JsonLevel;
+typedef struct { int32_t level; float width, color[3], taper; Array points; } JsonStroke;
+typedef struct { const uint8_t *key; int32_t keyn; const uint8_t *value; int32_t valuen; } JsonEntry;
+typedef struct {
+  int32_t width, height, num_levels;
+  JsonLevel *levels;
+  int32_t num_strokes;
+  JsonStroke *strokes;
+  int32_t num_metadata;
+  JsonEntry *metadata;
+} JsonImage;
+
+// JSON.stringify of a value (format's), numbers as String().
+static void say_json(const Node *j) {
+  if (j->kind == K_STR) {
+    say("\"");
+    for (int32_t k = 0; k < j->n; ++k) {
+      uint8_t c = j->s[k];
+      const char *e = c == '"' ? "\\\"" : c == '\\' ? "\\\\" : c == 8 ? "\\b" : c == 12 ? "\\f" : c == 10 ? "\\n" : c == 13 ? "\\r" : c == 9 ? "\\t" : 0;
+      if (e) say(e);
+      else if (c < 0x20) {
+        char u[7] = "\\u00";
+        u[4] = "0123456789abcdef"[c >> 4], u[5] = "0123456789abcdef"[c & 15], u[6] = 0;
+        say(u);
+      } else say_bytes(&c, 1);
+    }
+    say("\"");
+  } else if (j->kind == K_INT || j->kind == K_FRAC) say_number(AS_INTEGER, j->v);
+  else if (j->kind == K_ARR) {
+    say("[");
+    for (const Node *x = j->first; x; x = x->next) say_json(x), x->next ? say(",") : (void)0;
+    say("]");
+  } else say(j->kind == K_OBJ ? "{}" : j->kind == K_NULL ? "null" : j->kind == K_TRUE ? "true" : "false");
+}
+
+EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
+  b = bytes, len = n, i = depth = 0;
+  const Node *top = value();
+  space();
+  if (i < len) syntax("unexpected character after the value; expected end of input");
+  if (top->kind != K_OBJ) bad_start(0), say("expected a JSON object, got "), say(type_name(top)), say_fail();
+  const Node *format = need(top, 0, "format");
+  AT_KEY(pf, 0, "format");
+  if (!(format->kind == K_STR && same(format->s, format->n, (const uint8_t *)"subvec", 6)))
+    bad_start(&pf), say("expected \"subvec\", got "), say_json(format), say(" (this is not a subvec file)"), say_fail();
+  AT_KEY(pv, 0, "version");
+  double version = field(top, 0, "version", I32, 0, 0, REQUIRED, 0);
+  if (version != 1) bad_start(&pv), say("unsupported .svec.json version "), say_number(AS_INTEGER, version), say(" (this build reads 1)"), say_fail();
+  known(top, 0, "format, version, width, height, levels, strokes, metadata");
+  JsonImage *image = (JsonImage *)need_memory(alloc(sizeof(JsonImage)));
+  AT_KEY(pl, 0, "levels");
+  image->width = (int32_t)field(top, 0, "width", I32, 0, 0, REQUIRED, 0), image->height = (int32_t)field(top, 0, "height", I32, 0, 0, REQUIRED, 0);
+  const Node *items = list(need(top, 0, "levels"), &pl);
+  if (items->n > MAX_LEVELS) bad_start(&pl), say_number(AS_INTEGER, items->n), say(" levels is over the limit of 64"), say_fail();
+  image->num_levels = items->n, image->levels = NEW(JsonLevel, items->n + 1);
+  int32_t l = 0;
+  for (const Node *j = items->first; j; j = j->next, ++l) {
+    AT_INDEX(p, &pl, l);
+    const Node *m = known(j, &p, "vertices, colors, triangles, triangle_colors, creases, features, parent_vertices, collapses");
+    JsonLevel *level = &image->levels[l];
+    AT_KEY(ptc, &p, "triangle_colors");
+    field(m, &p, "vertices", F64, 2, "[x, y]", REQUIRED, &level->positions);
+    field(m, &p, "colors", F32, 3, "[r, g, b]", REQUIRED, &level->colors);
+    field(m, &p, "triangles", I32, 3, TRIANGLE, REQUIRED, &level->triangles);
+    if (field(m, &p, "triangle_colors", I32, 3, TRIANGLE, 0, &level->triangle_colors) != 0) {
+      if (level->triangle_colors.n != level->triangles.n)
+        bad_start(&ptc), say_number(AS_INTEGER, level->triangle_colors.n / 3), say(" entries but there are "), say_number(AS_INTEGER, level->triangles.n / 3),
+          say(" triangles (one entry per triangle)"), say_fail();
+    } else if (level->colors.n / 3 != level->positions.n / 2) {
+      bad_start(&p), say("\"triangle_colors\" is absent, so color i belongs to vertex i, but there are "), say_number(AS_INTEGER, level->positions.n / 2),
+        say(" vertices and "), say_number(AS_INTEGER, level->colors.n / 3), say(" colors"), say_fail();
+    }
+    const Node *o;
+    field(m, &p, "creases", I32, 2, "[a, b] (two vertex indices)", 0, &level->creases);
+    AT_KEY(pfe, &p, "features");
+    if ((o = find(m, "features"))) {
+      const Node *fs = list(o, &pfe);
+      level->num_features = fs->n, level->feature_ids = NEW(int32_t, fs->n + 1), level->saliency = NEW(double, fs->n + 1);
+      level->feature_vertices = NEW(Array, fs->n + 1);
+      need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
+      int32_t k = 0;
+      for (const Node *f = fs->first; f; f = f->next, ++k) {
+        AT_INDEX(r, &pfe, k);
+        const Node *fo = known(f, &r, "id, vertices, saliency");
+        level->feature_ids[k] = (int32_t)field(fo, &r, "id", I32, 0, 0, REQUIRED, 0);
+        field(fo, &r, "vertices", I32, 0, 0, REQUIRED, &level->feature_vertices[k]);
+        level->saliency[k] = field(fo, &r, "saliency", F64, 0, 0, 0, 0);
+      }
+    }
+    field(m, &p, "parent_vertices", I32, 0, 0, 0, &level->parents);
+    field(m, &p, "collapses", I32, 2, "[removed, kept] (two vertex indices)", 0, &level->collapses);
+  }
+  need_memory(image->levels);
+  const Node *o;
+  AT_KEY(ps, 0, "strokes");
+  if ((o = find(top, "strokes"))) {
+    const Node *ss = list(o, &ps);
+    image->num_strokes = ss->n, image->strokes = (JsonStroke *)need_memory(NEW(JsonStroke, ss->n + 1));
+    int32_t k = 0;
+    for (const Node *j = ss->first; j; j = j->next, ++k) {
+      AT_INDEX(p, &ps, k);
+      const Node *m = known(j, &p, "level, points, width, color, taper");
+      JsonStroke *s = &image->strokes[k];
+      AT_KEY(pcl, &p, "color");
+      s->level = (int32_t)field(m, &p, "level", I32, 0, 0, 0, 0);
+      field(m, &p, "points", F64, 2, "[x, y]", REQUIRED, &s->points);
+      s->width = (float)field(m, &p, "width", F32, 0, 0, REQUIRED, 0);
+      tuple(need(m, &p, "color"), &pcl, 3, "[r, g, b]", to_float, s->color, F32, 0);
+      s->taper = (float)field(m, &p, "taper", F32, 0, 0, 0.25, 0);
+    }
+  }
+  AT_KEY(pm, 0, "metadata");
+  if ((o = find(top, "metadata"))) {
+    const Node *mm = object(o, &pm);
+    image->num_metadata = mm->n, image->metadata = (JsonEntry *)need_memory(NEW(JsonEntry, mm->n + 1));
+    int32_t k = 0;
+    for (const Node *x = mm->first; x; x = x->next, ++k) {
+      if (x->kind != K_STR) {
+        const Path q = {&pm, x->key, x->keyn, 0};
+        expected(&q, "a string", x);
+      }
+      image->metadata[k] = (JsonEntry){x->key, x->keyn, x->s, x->n};
+    }
+  }
+  return image;
+}
