@@ -13,6 +13,7 @@ enum { K_NULL, K_FALSE, K_TRUE, K_INT, K_FRAC, K_STR, K_ARR, K_OBJ };
 
 typedef struct Node {
   struct Node *next, *first; // siblings; a container's children
+  const struct Node *owner;  // an object member's object
   const uint8_t *s, *key;    // a string's UTF-8; an object member's key
   int32_t n, keyn, kind;     // a string's length or a container's count; the key's length
   double v;
@@ -127,6 +128,31 @@ static int same(const uint8_t *a, int32_t an, const uint8_t *c, int32_t cn) {
     if (a[k] != c[k]) return 0;
   return 1;
 }
+// The keys read so far, by object: an open-addressed table of members, doubled at half full.
+static Node **table;
+static uint32_t slots, used;
+static uint32_t slot(const Node *owner, const uint8_t *key, int32_t n) {
+  uint32_t h = (uint32_t)(uintptr_t)owner * 2654435761u;
+  for (int32_t k = 0; k < n; ++k) h = (h ^ key[k]) * 16777619u;
+  for (h &= slots - 1; table[h] && !(table[h]->owner == owner && same(table[h]->key, table[h]->keyn, key, n)); h = (h + 1) & (slots - 1)) {}
+  return h;
+}
+// 0 when owner already has the key.
+static int remember(Node *member) {
+  if (2 * (used + 1) > slots) {
+    Node **old = table;
+    uint32_t n = slots;
+    slots = slots ? 2 * slots : 64, used = 0;
+    table = (Node **)need_memory(NEW(Node *, slots));
+    for (uint32_t k = 0; k < n; ++k)
+      if (old[k]) table[slot(old[k]->owner, old[k]->key, old[k]->keyn)] = old[k], ++used;
+  }
+  uint32_t h = slot(member->owner, member->key, member->keyn);
+  if (table[h]) return 0;
+  table[h] = member, ++used;
+  return 1;
+}
+
 static int is_digit(int c) { return c >= '0' && c <= '9'; }
 
 static Node *value(void) {
@@ -152,13 +178,13 @@ static Node *value(void) {
           Node key;
           string(&key);
           frames[f].key = key.s, frames[f].keyn = key.n;
-          for (Node *m = node->first; m; m = m->next)
-            if (same(m->key, m->keyn, key.s, key.n))
-              say_start(), say_path(0), say(": duplicate key \""), say_bytes(key.s, key.n), say("\""), say_fail();
+          key.owner = node, key.key = key.s, key.keyn = key.n;
+          if (!remember(&key)) say_start(), say_path(0), say(": duplicate key \""), say_bytes(key.s, key.n), say("\""), say_fail();
           space();
           if (ch(i++) != ':') syntax("expected ':'");
           child = value();
-          child->key = key.s, child->keyn = key.n;
+          child->key = key.s, child->keyn = key.n, child->owner = node;
+          table[slot(node, key.s, key.n)] = child;
         } else ++frames[f].index, child = value();
         *tail = child, tail = &child->next, ++node->n;
         space();
@@ -409,7 +435,7 @@ static void say_json(const Node *j) {
 }
 
 EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
-  b = bytes, len = n, i = depth = 0;
+  b = bytes, len = n, i = depth = 0, table = 0, slots = used = 0;
   const Node *top = value();
   space();
   if (i < len) syntax("unexpected character after the value; expected end of input");
