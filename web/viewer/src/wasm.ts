@@ -63,7 +63,7 @@ if (typeof WebAssembly === 'object')
 
 function module(): Exports {
   if (instance) return instance;
-  const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact, number: (at: number, n: number) => Number(utf8.decode(new Uint8Array(instance!.memory.buffer, at, n))) };
+  const env = { cos: Math.cos, hypot: Math.hypot, atan2: Math.atan2, fail: failed, mean, exact, number, string };
   try {
     instance = new WebAssembly.Instance(compiled ?? new WebAssembly.Module(unpack()), { env }).exports as unknown as Exports;
   } catch (e) {
@@ -297,6 +297,19 @@ export function checkLevel(level: Level, width: number, height: number, l: numbe
 
 // ---------------------------------------------------------------------------------------------
 // The JSON form (wasm/json.c).
+
+// wasm/json.c's numerals and string literals (the literal's UTF-8 out, or -1 where JSON.parse
+// refuses it, the bytes are not UTF-8 or it holds a lone surrogate).
+const bytes = (at: number, n: number) => new Uint8Array(instance!.memory.buffer, at, n);
+const number = (at: number, n: number) => Number(utf8.decode(bytes(at, n)));
+const strict = new TextDecoder('utf-8', { fatal: true, ignoreBOM: true });
+function string(at: number, n: number, out: number): number {
+  try {
+    const s: string = JSON.parse(strict.decode(bytes(at, n)));
+    if (!/[\ud800-\udfff]/u.test(s)) return new TextEncoder().encodeInto(s, bytes(out, n)).written;
+  } catch {}
+  return -1;
+}
 
 /** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
 export function readJson(b: Uint8Array): [SvecImage, PyramidRecord[]] {

@@ -6,6 +6,7 @@
 #include "message.h"
 
 IMPORT(number) double js_number(const uint8_t *text, int32_t n);
+IMPORT(string) int32_t js_string(const uint8_t *literal, int32_t n, uint8_t *out);
 
 enum { K_NULL, K_FALSE, K_TRUE, K_INT, K_FRAC, K_STR, K_ARR, K_OBJ };
 #define MAX_ELEMENTS 67108864.0
@@ -54,72 +55,16 @@ __attribute__((noreturn)) static void syntax(const char *what) {
   say(": syntax error - "), say(what), say_fail();
 }
 
-static int hexdigit(int c) { return c >= '0' && c <= '9' ? c - '0' : (c | 32) >= 'a' && (c | 32) <= 'f' ? (c | 32) - 'a' + 10 : -1; }
-
-// A string literal at i: its UTF-8 into node->s (JSON.parse's escapes; the bytes valid UTF-8; no
-// lone surrogate).
+// A string literal at i: its UTF-8 into node->s. JavaScript reads it (JSON.parse's escapes, the
+// bytes valid UTF-8, no lone surrogate) and writes its UTF-8 (never longer than the literal).
 static void string(Node *node) {
   int32_t from = i++;
   while (i < len && b[i] != 34) i += b[i] == 92 ? 2 : 1;
   if (i++ >= len) syntax("invalid string: missing closing quote");
-  int32_t end = i - 1;
-  uint8_t *out = (uint8_t *)need_memory(alloc((size_t)(end - from)));
-  int32_t n = 0, pending = -1; // a high surrogate escape waiting for its low half
-  for (int32_t k = from + 1; k < end;) {
-    uint32_t c = b[k], cp;
-    if (c < 0x20) goto invalid;
-    if (c == 92) {
-      int e = b[k + 1];
-      k += 2;
-      const char *simple = "\"\"\\\\//b\bf\fn\nr\rt\t";
-      cp = 0x110000;
-      for (const char *s = simple; *s; s += 2)
-        if (e == s[0]) cp = (uint8_t)s[1];
-      if (e == 'u') {
-        if (k + 4 > end) goto invalid;
-        cp = 0;
-        for (int q = 0; q < 4; ++q) {
-          int h = hexdigit(b[k + q]);
-          if (h < 0) goto invalid;
-          cp = cp * 16 + (uint32_t)h;
-        }
-        k += 4;
-      } else if (cp == 0x110000) goto invalid;
-    } else if (c < 0x80) {
-      cp = c, ++k;
-    } else {
-      // UTF-8, strictly (as TextDecoder's fatal mode)
-      int extra = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : 1;
-      if (c < 0xc2 || c > 0xf4) goto invalid;
-      cp = c & (0x3f >> extra);
-      for (int q = 1; q <= extra; ++q) {
-        if (k + q >= end || (b[k + q] & 0xc0) != 0x80) goto invalid;
-        cp = cp << 6 | (b[k + q] & 0x3f);
-      }
-      if ((extra == 2 && (cp < 0x800 || (cp >= 0xd800 && cp < 0xe000))) || (extra == 3 && (cp < 0x10000 || cp > 0x10ffff))) goto invalid;
-      k += extra + 1;
-    }
-    if (pending >= 0) {
-      if (cp >= 0xdc00 && cp < 0xe000) {
-        cp = 0x10000 + (((uint32_t)pending - 0xd800) << 10) + (cp - 0xdc00);
-        pending = -1;
-      } else goto invalid;
-    } else if (cp >= 0xd800 && cp < 0xdc00) {
-      pending = (int32_t)cp;
-      continue;
-    } else if (cp >= 0xdc00 && cp < 0xe000) goto invalid;
-    if (cp < 0x80) out[n++] = (uint8_t)cp;
-    else if (cp < 0x800) out[n++] = (uint8_t)(0xc0 | cp >> 6), out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
-    else if (cp < 0x10000) out[n++] = (uint8_t)(0xe0 | cp >> 12), out[n++] = (uint8_t)(0x80 | (cp >> 6 & 0x3f)), out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
-    else
-      out[n++] = (uint8_t)(0xf0 | cp >> 18), out[n++] = (uint8_t)(0x80 | (cp >> 12 & 0x3f)), out[n++] = (uint8_t)(0x80 | (cp >> 6 & 0x3f)),
-      out[n++] = (uint8_t)(0x80 | (cp & 0x3f));
-  }
-  if (pending >= 0) goto invalid;
+  uint8_t *out = (uint8_t *)need_memory(alloc((size_t)(i - from)));
+  int32_t n = js_string(b + from, i - from, out);
+  if (n < 0) syntax("invalid string");
   node->kind = K_STR, node->s = out, node->n = n;
-  return;
-invalid:
-  syntax("invalid string");
 }
 
 static int same(const uint8_t *a, int32_t an, const uint8_t *c, int32_t cn) {
@@ -412,7 +357,7 @@ typedef struct {
 } JsonImage;
 
 // JSON.stringify of a value (format's), numbers as String().
-static void say_json(const Node *j) {
+static void say_json(const Node *j, int nested) {
   if (j->kind == K_STR) {
     say("\"");
     for (int32_t k = 0; k < j->n; ++k) {
@@ -426,10 +371,16 @@ static void say_json(const Node *j) {
       } else say_bytes(&c, 1);
     }
     say("\"");
-  } else if (j->kind == K_INT || j->kind == K_FRAC) say_number(AS_INTEGER, j->v);
-  else if (j->kind == K_ARR) {
+  } else if (j->kind == K_INT || j->kind == K_FRAC) {
+    // decode.ts held an integral number written with a fraction or exponent as an object, and
+    // JSON.stringify wrote it so inside an array
+    int boxed = nested && j->kind == K_FRAC && j->v == __builtin_trunc(j->v);
+    if (boxed) say("{\"value\":");
+    say_number(AS_INTEGER, j->v);
+    if (boxed) say("}");
+  } else if (j->kind == K_ARR) {
     say("[");
-    for (const Node *x = j->first; x; x = x->next) say_json(x), x->next ? say(",") : (void)0;
+    for (const Node *x = j->first; x; x = x->next) say_json(x, 1), x->next ? say(",") : (void)0;
     say("]");
   } else say(j->kind == K_OBJ ? "{}" : j->kind == K_NULL ? "null" : j->kind == K_TRUE ? "true" : "false");
 }
@@ -443,7 +394,7 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
   const Node *format = need(top, 0, "format");
   AT_KEY(pf, 0, "format");
   if (!(format->kind == K_STR && same(format->s, format->n, (const uint8_t *)"subvec", 6)))
-    bad_start(&pf), say("expected \"subvec\", got "), say_json(format), say(" (this is not a subvec file)"), say_fail();
+    bad_start(&pf), say("expected \"subvec\", got "), say_json(format, 0), say(" (this is not a subvec file)"), say_fail();
   AT_KEY(pv, 0, "version");
   double version = field(top, 0, "version", I32, 0, 0, REQUIRED, 0);
   if (version != 1) bad_start(&pv), say("unsupported .svec.json version "), say_number(AS_INTEGER, version), say(" (this build reads 1)"), say_fail();
