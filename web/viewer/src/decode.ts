@@ -9,98 +9,19 @@
 // and whatever goes wrong inside surfaces as a SvecError. The hot loops are plain loops over
 // typed arrays sized up front: a page decodes its file once, before anything is compiled.
 import { Decompress } from 'fzstd';
-import { Level, Stroke, SvecError, SvecImage } from './image';
-import { MAX_DIMENSION, MAX_ELEMENTS, MAX_LEVELS, PyramidRecord, escape, fail, validate } from './validate';
-import { checksum, decodeCompact, readJson, type Edges } from './wasm';
+import { SvecError, SvecImage } from './image';
+import { escape, fail, validate } from './validate';
+import { checksum, readJson, readPayload } from './wasm';
 
 const GIB = 2 ** 30; // largest file, and largest payload
 const MAGIC = [0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a]; // "SUBVEC" NUL ^Z
 const HEADER = 32;
-const utf8 = new TextDecoder('utf-8', { fatal: true, ignoreBOM: true });
 
 const latin1 = (b: Uint8Array) => String.fromCharCode(...b);
 const hex = (b: ArrayLike<number>) => Array.from(b, (x) => x.toString(16).padStart(2, '0')).join(' ');
-const unzigzag = (v: number) => (v % 2 ? -(v + 1) / 2 : v / 2);
-
-// Invalid UTF-8 gets a lone surrogate, which validate() reports in its place in the order.
-function text(b: Uint8Array): string {
-  try {
-    return utf8.decode(b);
-  } catch {
-    return '\ud800';
-  }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Bytes.
-
-/** A bounds-checked little-endian cursor that names what it was reading when the bytes run out. */
-class Cursor {
-  pos = 0;
-  what = 'the payload';
-  readonly #d: DataView;
-  constructor(readonly b: Uint8Array) {
-    this.#d = new DataView(b.buffer, b.byteOffset, b.length);
-  }
-  left() {
-    return this.b.length - this.pos;
-  }
-  take(n: number): number {
-    const p = this.pos;
-    if (n > this.left()) fail(`truncated payload while reading ${this.what} (needs ${n} bytes at offset ${p}, ${this.left()} left)`);
-    this.pos += n;
-    return p;
-  }
-  bytes(n: number) {
-    const p = this.take(n);
-    return this.b.subarray(p, p + n);
-  }
-  u8() {
-    return this.b[this.take(1)];
-  }
-  u32() {
-    return this.#d.getUint32(this.take(4), true);
-  }
-  i32() {
-    return this.#d.getInt32(this.take(4), true);
-  }
-  f32() {
-    return this.#d.getFloat32(this.take(4), true);
-  }
-  f64() {
-    return this.#d.getFloat64(this.take(8), true);
-  }
-  // n values of `size` bytes each, copied into a typed array (little-endian, as every browser
-  // is); short of bytes, it fails where reading them one by one would.
-  array<T>(type: new (b: ArrayBuffer) => T, n: number, size: number): T {
-    const p = this.pos, fit = Math.min(n, Math.floor(this.left() / size));
-    this.pos += fit * size;
-    if (fit < n) this.take(size);
-    return new type(this.b.slice(p, this.pos).buffer);
-  }
-  // Unsigned LEB128 of at most 64 bits; exact below 2^53, which every range check lies below.
-  varint(): number {
-    for (let v = 0, shift = 0; ; shift += 7) {
-      const b = this.u8();
-      if (shift === 63 && b > 1) fail(`malformed varint while reading ${this.what}`);
-      v += (b & 0x7f) * 2 ** shift;
-      if (b < 128) return v;
-    }
-  }
-  // An element count, capped by `max` and by the bytes left (each element takes `min` or more).
-  count(what: string, min: number, max = MAX_ELEMENTS): number {
-    this.what = `${what} count`;
-    const n = this.u32();
-    if (n > max) fail(`${what}: count ${n} is over the limit of ${max}`);
-    this.what = what;
-    if (n * min > this.left())
-      fail(`truncated payload while reading ${what} (${n} declared, needing ${n * min} bytes at offset ${this.pos}, ${this.left()} left)`);
-    return n;
-  }
-  string(what: string) {
-    return text(this.bytes(this.count(what, 1)));
-  }
-}
 
 // ---------------------------------------------------------------------------------------------
 // zstd: one frame that must decompress to exactly `expected` bytes (fzstd, plus the checks
@@ -171,104 +92,9 @@ function binary(b: Uint8Array): SvecImage {
   if (frame > available) fail(`truncated .svec file: the header declares a ${frame}-byte zstd frame but only ${available} bytes follow`);
   if (frame < available) fail(`${available - frame} unexpected bytes after the zstd frame`);
 
-  const c = new Cursor(unzstd(b.subarray(HEADER), Number(size)));
-  c.what = 'image size';
-  const width = c.i32(), height = c.i32(), levels: Level[] = [], topologies: Edges[] = [];
-  const nl = c.count('levels', 20, MAX_LEVELS);
-  if (version > 1 && (width < 1 || height < 1 || width > MAX_DIMENSION || height > MAX_DIMENSION))
-    fail(`image size ${width} x ${height} is out of range (1 to ${MAX_DIMENSION} a side)`);
-  for (let l = 0; l < nl; l++) levels.push(version > 1 ? compactLevel(c, l, width, height, version, topologies) : losslessLevel(c, l));
-
-  const strokes: Stroke[] = [], metadata: Array<[string, string]> = [];
-  for (let i = 0, n = c.count('strokes', 28); i < n; i++) {
-    const what = (c.what = `stroke ${i}`);
-    const level = c.i32(), width = c.f32(), color: [number, number, number] = [c.f32(), c.f32(), c.f32()], taper = c.f32();
-    strokes.push({ level, points: c.array(Float64Array, 2 * c.count(`${what} points`, 16), 8), width, color, taper });
-  }
-  for (let i = 0, n = c.count('metadata entries', 8); i < n; i++)
-    metadata.push([c.string(`metadata entry ${i} key`), c.string(`metadata entry ${i} value`)]);
-
-  // Optional: the pyramid records of levels 1 and up (files written before them end here).
-  const records: PyramidRecord[] = [];
-  if (c.left() && c.left() < 4) fail(`${c.left()} unexpected bytes after the payload's metadata`);
-  if (c.left()) {
-    c.what = 'pyramid records';
-    for (let i = 0, n = c.count('pyramid records', 3, MAX_LEVELS); i < n; i++) {
-      const what = (c.what = `pyramid record ${i}`), l = c.u32(), old = records[l];
-      if (l < 1 || l >= levels.length || (old && (old.parents.length || old.collapses.length)))
-        fail(`${what}: level ${l} is out of range or named twice`);
-      // base + delta as a vertex index; both are checked before they are added.
-      const index = (base: number, code: number) => {
-        const delta = unzigzag(code);
-        if (Math.abs(delta) > 2 ** 32 || base + delta < 0 || base + delta > 2 ** 31 - 1) fail(`${what}: a vertex index is out of range`);
-        return base + delta;
-      };
-      const parents = new Int32Array(c.count(`${what} parent vertices`, 1));
-      for (let k = 0, previous = 0; k < parents.length; k++) parents[k] = previous = index(previous, c.varint());
-      const collapses = new Int32Array(2 * c.count(`${what} collapses`, 2));
-      for (let k = 0; k < collapses.length; k += 2) {
-        collapses[k] = index(0, 2 * Math.min(c.varint(), 2 ** 40));
-        collapses[k + 1] = index(collapses[k], c.varint());
-      }
-      records[l] = { parents, collapses };
-    }
-  }
-  if (c.left()) fail(`${c.left()} unexpected bytes after the payload's pyramid records`);
-  const image = { width, height, levels, strokes, metadata };
+  const [image, records, topologies] = readPayload(unzstd(b.subarray(HEADER), Number(size)), version);
   validate(image, records, topologies);
   return image;
-}
-
-function losslessLevel(c: Cursor, l: number): Level {
-  const at = `level ${l} `;
-  c.what = `${at}counts`;
-  const [nv, nc, nt, nr, nf] = ([['vertices', 16], ['colors', 12], ['triangles', 24], ['creases', 8], ['features', 16]] as const).map(
-    ([what, min]) => c.count(at + what, min),
-  );
-  const read = <T>(what: string, type: new (b: ArrayBuffer) => T, n: number, size = 4) => ((c.what = at + what), c.array(type, n, size));
-  const level: Level = {
-    positions: read('vertices', Float64Array, 2 * nv, 8),
-    colors: read('colors', Float32Array, 3 * nc),
-    triangles: read('triangles', Int32Array, 3 * nt),
-    triangleColors: read('triangle colors', Int32Array, 3 * nt),
-    creases: read('creases', Int32Array, 2 * nr),
-    features: [],
-  };
-  for (let i = 0; i < nf; i++) {
-    const what = (c.what = `${at}feature ${i}`), id = c.i32(), saliency = c.f64();
-    level.features.push({ id, saliency, vertices: c.array(Int32Array, c.count(`${what} vertices`, 4), 4) });
-  }
-  return level;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Compact levels (versions 2 and 3): the counts and precision here; the symbols (from one
-// range-coded stream, or from six varint sections), the traversal, predictions, chains, topology
-// and canonical colors in WebAssembly (wasm/decode.c, through wasm.ts).
-
-const SECTIONS = ['connectivity', 'split offsets', 'positions', 'features', 'feature steps', 'colors'];
-
-function compactLevel(c: Cursor, l: number, width: number, height: number, version: number, topologies: Edges[]): Level {
-  const name = `level ${l} `;
-  c.what = `${name}counts`;
-  const [nv, ncolors, ntriangles, ncreases, nfeatures] = ['vertices', 'colors', 'triangles', 'creases', 'features'].map((w) => c.count(name + w, 0));
-  c.what = `${name}precision`;
-  const pb = c.u8(), cb = (c.u8() << 24) >> 24;
-  if (pb > 12 || cb < -4 || cb > 12) fail(`${name}precision: position bits ${pb}, color bits ${cb} (expected 0 to 12 and -4 to 12)`);
-  if (nv < 3) fail(`${name}vertices: ${nv} (a level has at least 3)`);
-  // Version 2's sections, each a count and its bytes; version 3's one stream.
-  const ops = 3 * c.left();
-  const labels = version === 2 ? SECTIONS : ['stream'];
-  const sections = labels.map((section, k) => {
-    const label = name + section, n = c.count(label, 1, MAX_ELEMENTS * 64);
-    c.what = label;
-    const bytes = c.bytes(n), expected = Math.ceil((2 * nv - 3) / 3);
-    if (version === 2 && k === 0 && n !== expected) fail(`${name}connectivity: ${n} bytes for ${nv} vertices (expected ${expected})`);
-    return bytes;
-  });
-  const [level, topology] = decodeCompact({ version, sections, ops, nv, ncolors, ntriangles, ncreases, nfeatures, pb, cb, width, height, level: l });
-  topologies[l] = topology;
-  return level;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -28,6 +28,7 @@ interface Exports {
   check_level(...args: number[]): number;
   xxh64(bytes: number, length: number): number;
   json(bytes: number, length: number): number;
+  payload(bytes: number, length: number, version: number): number;
 }
 
 let instance: Exports | null = null;
@@ -180,24 +181,6 @@ export function checksum(b: Uint8Array): number {
 // ---------------------------------------------------------------------------------------------
 // Compact levels (wasm/decode.c).
 
-/** A compact level's counts, precision and bytes (one stream, or six sections), as decode.ts read them. */
-export interface CompactInput {
-  version: number;
-  sections: Uint8Array[];
-  ops: number;
-  nv: number;
-  ncolors: number;
-  ntriangles: number;
-  ncreases: number;
-  nfeatures: number;
-  pb: number;
-  cb: number;
-  width: number;
-  height: number;
-  /** the level's number, for the messages */
-  level: number;
-}
-
 const utf8 = new TextDecoder('utf-8', { ignoreBOM: true });
 
 // A number as nlohmann's dump() writes it: 4.0, 0.5, 4e+38, 1e-05.
@@ -241,35 +224,6 @@ export interface Edges {
   g: Int32Array;
 }
 
-/** A compact level and its edges, or a SvecError naming the problem. */
-export function decodeCompact(input: CompactInput): [Level, Edges] {
-  const { nv, ntriangles: nt, ncreases, nfeatures } = input;
-  return call(
-      (put, m) => {
-        const sections = new Int32Array(12);
-        input.sections.forEach((s, k) => ((sections[2 * k] = put(s)), (sections[2 * k + 1] = s.length)));
-        return m.compact(input.version, put(sections), input.ops, nv, input.ncolors, nt, ncreases, nfeatures, input.pb, input.cb, input.width, input.height, input.level);
-      },
-      (at, get, i32) => {
-        // The C struct Level (32-bit fields): positions, colors, triangles, triangleColors,
-        // creases, numFeatures, featureIds, featureOffsets, featureVertices, featureSaliency, then
-        // Edges: numEdges, a, b, f, g, tag, twin (decode.c asserts the layout).
-        const field = (k: number) => i32(at + 4 * k);
-        const offsets = get(Int32Array, field(7), nfeatures + 1), ids = get(Int32Array, field(6), nfeatures);
-        const saliency = get(Float64Array, field(9), nfeatures), vertices = get(Int32Array, field(8), offsets[nfeatures]);
-        const features: Feature[] = [];
-        for (let i = 0; i < nfeatures; i++) features.push({ id: ids[i], saliency: saliency[i], vertices: vertices.subarray(offsets[i], offsets[i + 1]) });
-        const triangles = get(Int32Array, field(2), 3 * nt);
-        const level: Level = {
-          positions: get(Float64Array, field(0), 2 * nv), colors: get(Float32Array, field(1), 3 * input.ncolors), triangles,
-          triangleColors: get(Int32Array, field(3), 3 * nt), creases: get(Int32Array, field(4), 2 * ncreases), features,
-        };
-        const ne = field(10), edge = (k: number) => get(Int32Array, field(11 + k), ne);
-        return [level, { a: edge(0), b: edge(1), g: edge(3) }];
-      },
-    );
-}
-
 /** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
  * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
  * by construction. */
@@ -311,32 +265,59 @@ function string(at: number, n: number, out: number): number {
   return -1;
 }
 
-/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
-export function readJson(b: Uint8Array): [SvecImage, PyramidRecord[]] {
-  return call(
-    (put, m) => m.json(put(b), b.length),
-    (at, get, i32) => {
-      // The C structs JsonImage, JsonLevel, JsonStroke, JsonEntry: 32-bit fields; an Array is (n, pointer).
-      const f = (p: number, k: number) => i32(p + 4 * k);
-      const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
-      const text = (p: number, k: number) => utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
-      const records: PyramidRecord[] = [];
-      const levels = Array.from({ length: f(at, 2) }, (_, l): Level => {
-        const p = f(at, 3) + 72 * l, triangles = ints(p, 4), nf = f(p, 14);
-        const saliency = get(Float64Array, f(p, 16), nf);
-        records[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
-        return {
-          positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles,
-          triangleColors: f(p, 7) ? ints(p, 6) : triangles.slice(), creases: ints(p, 8),
-          features: Array.from({ length: nf }, (_, k) => ({ id: f(f(p, 15), k), vertices: ints(f(p, 17) + 8 * k, 0), saliency: saliency[k] })),
-        };
-      });
-      const strokes = Array.from({ length: f(at, 4) }, (_, k): Stroke => {
-        const p = f(at, 5) + 32 * k, v = get(Float32Array, p + 4, 5);
-        return { level: f(p, 0), points: get(Float64Array, f(p, 7), f(p, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
-      });
-      const metadata = Array.from({ length: f(at, 6) }, (_, k): [string, string] => [text(f(at, 7) + 16 * k, 0), text(f(at, 7) + 16 * k, 2)]);
-      return [{ width: f(at, 0), height: f(at, 1), levels, strokes, metadata }, records];
-    },
-  );
+type Get = <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T;
+
+// wasm/json.c's JsonImage, JsonLevel, JsonStroke, JsonEntry (32-bit fields; an Array is n, then
+// a pointer), and a compact level in decode.c's Level: positions, colors, triangles,
+// triangleColors, creases, numFeatures, featureIds, featureOffsets, featureVertices,
+// featureSaliency, then Edges: numEdges, a, b, f, g (decode.c asserts the layout).
+function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): [SvecImage, PyramidRecord[], Edges[]] {
+  const f = (p: number, k: number) => i32(p + 4 * k);
+  const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
+  const text = (p: number, k: number) => {
+    try {
+      return strict.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
+    } catch {
+      return '\ud800'; // invalid UTF-8, which validate() reports in its place in the order
+    }
+  };
+  const records: PyramidRecord[] = [], topologies: Edges[] = [];
+  const levels = Array.from({ length: f(at, 2) }, (_, l): Level => {
+    const p = f(at, 3) + 76 * l, nf = f(p, 14), c = f(p, 18);
+    records[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
+    if (c) {
+      const field = (k: number) => f(c, k), nt = f(p, 4);
+      const offsets = get(Int32Array, field(7), nf + 1), ids = get(Int32Array, field(6), nf);
+      const saliency = get(Float64Array, field(9), nf), vertices = get(Int32Array, field(8), offsets[nf]);
+      const ne = field(10), edge = (k: number) => get(Int32Array, field(11 + k), ne);
+      topologies[l] = { a: edge(0), b: edge(1), g: edge(3) };
+      return {
+        positions: get(Float64Array, field(0), f(p, 0)), colors: get(Float32Array, field(1), f(p, 2)), triangles: get(Int32Array, field(2), nt),
+        triangleColors: get(Int32Array, field(3), nt), creases: get(Int32Array, field(4), f(p, 8)),
+        features: Array.from({ length: nf }, (_, i) => ({ id: ids[i], saliency: saliency[i], vertices: vertices.subarray(offsets[i], offsets[i + 1]) })),
+      };
+    }
+    const triangles = ints(p, 4), saliency = get(Float64Array, f(p, 16), nf);
+    return {
+      positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles,
+      triangleColors: f(p, 7) ? ints(p, 6) : triangles.slice(), creases: ints(p, 8),
+      features: Array.from({ length: nf }, (_, k): Feature => {
+        const id = f(f(p, 15), k), vertices = ints(f(p, 17) + 8 * k, 0);
+        return binary ? { id, saliency: saliency[k], vertices } : { id, vertices, saliency: saliency[k] };
+      }),
+    };
+  });
+  const strokes = Array.from({ length: f(at, 4) }, (_, k): Stroke => {
+    const p = f(at, 5) + 32 * k, v = get(Float32Array, p + 4, 5);
+    return { level: f(p, 0), points: get(Float64Array, f(p, 7), f(p, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
+  });
+  const metadata = Array.from({ length: f(at, 6) }, (_, k): [string, string] => [text(f(at, 7) + 16 * k, 0), text(f(at, 7) + 16 * k, 2)]);
+  return [{ width: f(at, 0), height: f(at, 1), levels, strokes, metadata }, records, topologies];
 }
+
+/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
+export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), (at, get, i32) => image(at, get, i32, false));
+
+/** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
+export const readPayload = (b: Uint8Array, version: number) =>
+  call((put, m) => m.payload(put(b), b.length, version), (at, get, i32) => image(at, get, i32, true));

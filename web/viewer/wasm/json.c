@@ -344,6 +344,7 @@ typedef struct {
   int32_t *feature_ids;
   double *saliency;
   Array *feature_vertices;
+  void *compact; // a compact level (decode.c's Level, which wasm.ts reads), its counts above
 } JsonLevel;
 typedef struct { int32_t level; float width, color[3], taper; Array points; } JsonStroke;
 typedef struct { const uint8_t *key; int32_t keyn; const uint8_t *value; int32_t valuen; } JsonEntry;
@@ -474,5 +475,220 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
       image->metadata[k] = (JsonEntry){x->key, x->keyn, x->s, x->n};
     }
   }
+  return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The binary form's payload (docs/format.md), as the zstd frame gave it: a bounds-checked
+// little-endian cursor that names what it was reading when the bytes run out; the compact levels
+// by decode.c.
+
+typedef struct { const uint8_t *bytes; int32_t length; } Section;
+void *compact(int32_t version, const Section *sections, double ops, int32_t nv, int32_t ncolors, int32_t ntriangles, int32_t ncreases,
+              int32_t nfeatures, int32_t pb, int32_t cb, double width, double height, int32_t level);
+
+static int32_t pos, what_count;
+static char what[96];
+
+// what = fmt with its #s replaced by a, then b.
+static void name(const char *fmt, int32_t a, int32_t c) {
+  int32_t n = 0;
+  for (; *fmt; ++fmt) {
+    if (*fmt != '#') {
+      what[n++] = *fmt;
+      continue;
+    }
+    char digits[12];
+    int32_t d = 0;
+    for (uint32_t v = (uint32_t)a; d == 0 || v; v /= 10) digits[d++] = (char)('0' + v % 10);
+    while (d) what[n++] = digits[--d];
+    a = c;
+  }
+  what[n] = 0;
+}
+static void say_what(void) {
+  say(what);
+  if (what_count) say(" count");
+}
+static int32_t left(void) { return len - pos; }
+static int32_t take(double n) {
+  int32_t p = pos;
+  if (n > left())
+    say_start(), say("truncated payload while reading "), say_what(), say(" (needs "), say_number(AS_INTEGER, n), say(" bytes at offset "),
+      say_number(AS_INTEGER, p), say(", "), say_number(AS_INTEGER, left()), say(" left)"), say_fail();
+  pos += (int32_t)n;
+  return p;
+}
+static uint32_t u32(void) {
+  uint32_t v;
+  __builtin_memcpy(&v, b + take(4), 4);
+  return v;
+}
+static double f32(void) {
+  float v;
+  __builtin_memcpy(&v, b + take(4), 4);
+  return v;
+}
+static double f64(void) {
+  double v;
+  __builtin_memcpy(&v, b + take(8), 8);
+  return v;
+}
+// n values of `size` bytes, copied (aligned); short of bytes, it fails where reading them one by
+// one would.
+static Array array(double n, int32_t size) {
+  int32_t fit = n < left() / size ? (int32_t)n : left() / size;
+  Array a = {(int32_t)n, need_memory(alloc_array((size_t)size, n + 1))};
+  __builtin_memcpy(a.data, b + pos, (size_t)(fit * size));
+  pos += fit * size;
+  if (fit < n) take(size);
+  return a;
+}
+// Unsigned LEB128 of at most 64 bits; exact below 2^53, which every range check lies below.
+static double varint(void) {
+  double v = 0, scale = 1;
+  for (int shift = 0;; shift += 7, scale *= 128) {
+    uint32_t c = b[take(1)];
+    if (shift == 63 && c > 1) say_start(), say("malformed varint while reading "), say_what(), say_fail();
+    v += (c & 0x7f) * scale;
+    if (c < 128) return v;
+  }
+}
+// An element count, capped by `max` and by the bytes left (each element takes `min` or more).
+static int32_t count(double min, double max) {
+  what_count = 1;
+  double n = u32();
+  what_count = 0;
+  if (n > max) say_start(), say(what), say(": count "), say_number(AS_INTEGER, n), say(" is over the limit of "), say_number(AS_INTEGER, max), say_fail();
+  if (n * min > left())
+    say_start(), say("truncated payload while reading "), say(what), say(" ("), say_number(AS_INTEGER, n), say(" declared, needing "), say_number(AS_INTEGER, n * min),
+      say(" bytes at offset "), say_number(AS_INTEGER, pos), say(", "), say_number(AS_INTEGER, left()), say(" left)"), say_fail();
+  return (int32_t)n;
+}
+static Array string_of(const char *fmt, int32_t a) {
+  name(fmt, a, 0);
+  int32_t n = count(1, MAX_ELEMENTS);
+  Array s = {n, (void *)(b + take(n))};
+  return s;
+}
+
+static const char *const SECTIONS[] = {"connectivity", "split offsets", "positions", "features", "feature steps", "colors"};
+static const char *const COUNTS[] = {"vertices", "colors", "triangles", "creases", "features"};
+// what = "level l " + w
+static void level_name(const char *w, int32_t l) {
+  char fmt[32] = "level # ";
+  int32_t q = 8;
+  while (*w) fmt[q++] = *w++;
+  fmt[q] = 0;
+  name(fmt, l, 0);
+}
+
+// base + delta (a zigzag code) as a vertex index; both are checked before they are added.
+static int32_t vertex_index(int32_t record, double base, double code) {
+  double half = __builtin_floor(code / 2), delta = code - 2 * half != 0 ? -(code + 1) / 2 : code / 2;
+  if (__builtin_fabs(delta) > 4294967296.0 || base + delta < 0 || base + delta > 2147483647.0)
+    say_start(), say("pyramid record "), say_number(AS_INTEGER, record), say(": a vertex index is out of range"), say_fail();
+  return (int32_t)(base + delta);
+}
+
+EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t version) {
+  b = bytes, len = n, pos = what_count = 0;
+  JsonImage *image = (JsonImage *)need_memory(alloc(sizeof(JsonImage)));
+  name("image size", 0, 0);
+  int32_t width = image->width = (int32_t)u32(), height = image->height = (int32_t)u32();
+  name("levels", 0, 0);
+  int32_t nl = image->num_levels = count(20, MAX_LEVELS);
+  if (version > 1 && (width < 1 || height < 1 || width > 65536 || height > 65536))
+    say_start(), say("image size "), say_number(AS_INTEGER, width), say(" x "), say_number(AS_INTEGER, height), say(" is out of range (1 to 65536 a side)"), say_fail();
+  image->levels = (JsonLevel *)need_memory(NEW(JsonLevel, nl + 1));
+  for (int32_t l = 0; l < nl; ++l) {
+    JsonLevel *level = &image->levels[l];
+    int32_t c[5];
+    if (version > 1) {
+      for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l), c[k] = count(0, MAX_ELEMENTS);
+      name("level # precision", l, 0);
+      int32_t pb = b[take(1)], cb = (int8_t)b[take(1)];
+      if (pb > 12 || cb < -4 || cb > 12)
+        say_start(), say("level "), say_number(AS_INTEGER, l), say(" precision: position bits "), say_number(AS_INTEGER, pb), say(", color bits "), say_number(AS_INTEGER, cb),
+          say(" (expected 0 to 12 and -4 to 12)"), say_fail();
+      if (c[0] < 3) say_start(), say("level "), say_number(AS_INTEGER, l), say(" vertices: "), say_number(AS_INTEGER, c[0]), say(" (a level has at least 3)"), say_fail();
+      double ops = 3.0 * left();
+      Section sections[6];
+      for (int k = 0; k < (version == 2 ? 6 : 1); ++k) {
+        level_name(version == 2 ? SECTIONS[k] : "stream", l);
+        int32_t m = count(1, MAX_ELEMENTS * 64);
+        sections[k] = (Section){b + take(m), m};
+        int32_t expected = (2 * c[0] - 3 + 2) / 3;
+        if (version == 2 && k == 0 && m != expected)
+          say_start(), say("level "), say_number(AS_INTEGER, l), say(" connectivity: "), say_number(AS_INTEGER, m), say(" bytes for "), say_number(AS_INTEGER, c[0]),
+            say(" vertices (expected "), say_number(AS_INTEGER, expected), say(")"), say_fail();
+      }
+      level->compact = compact(version, sections, ops, c[0], c[1], c[2], c[3], c[4], pb, cb, width, height, l);
+      level->positions.n = 2 * c[0], level->colors.n = 3 * c[1], level->triangles.n = 3 * c[2], level->creases.n = 2 * c[3], level->num_features = c[4];
+      continue;
+    }
+    static const double MIN[] = {16, 12, 24, 8, 16};
+    for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l), c[k] = count(MIN[k], MAX_ELEMENTS);
+    name("level # vertices", l, 0), level->positions = array(2.0 * c[0], 8);
+    name("level # colors", l, 0), level->colors = array(3.0 * c[1], 4);
+    name("level # triangles", l, 0), level->triangles = array(3.0 * c[2], 4);
+    name("level # triangle colors", l, 0), level->triangle_colors = array(3.0 * c[2], 4);
+    name("level # creases", l, 0), level->creases = array(2.0 * c[3], 4);
+    level->num_features = c[4], level->feature_ids = NEW(int32_t, c[4] + 1), level->saliency = NEW(double, c[4] + 1);
+    level->feature_vertices = NEW(Array, c[4] + 1);
+    need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
+    for (int32_t k = 0; k < c[4]; ++k) {
+      name("level # feature #", l, k);
+      level->feature_ids[k] = (int32_t)u32(), level->saliency[k] = f64();
+      name("level # feature # vertices", l, k);
+      level->feature_vertices[k] = array(count(4, MAX_ELEMENTS), 4);
+    }
+  }
+  name("strokes", 0, 0);
+  int32_t ns = image->num_strokes = count(28, MAX_ELEMENTS);
+  image->strokes = (JsonStroke *)need_memory(NEW(JsonStroke, ns + 1));
+  for (int32_t k = 0; k < ns; ++k) {
+    JsonStroke *s = &image->strokes[k];
+    name("stroke #", k, 0);
+    s->level = (int32_t)u32(), s->width = (float)f32();
+    for (int q = 0; q < 3; ++q) s->color[q] = (float)f32();
+    s->taper = (float)f32();
+    name("stroke # points", k, 0);
+    s->points = array(2.0 * count(16, MAX_ELEMENTS), 8);
+  }
+  name("metadata entries", 0, 0);
+  int32_t nm = image->num_metadata = count(8, MAX_ELEMENTS);
+  image->metadata = (JsonEntry *)need_memory(NEW(JsonEntry, nm + 1));
+  for (int32_t k = 0; k < nm; ++k) {
+    Array key = string_of("metadata entry # key", k), value = string_of("metadata entry # value", k);
+    image->metadata[k] = (JsonEntry){key.data, key.n, value.data, value.n};
+  }
+  // Optional: the pyramid records of levels 1 and up (files written before them end here).
+  if (left() && left() < 4) say_start(), say_number(AS_INTEGER, left()), say(" unexpected bytes after the payload's metadata"), say_fail();
+  if (left()) {
+    name("pyramid records", 0, 0);
+    for (int32_t k = 0, nr = count(3, MAX_LEVELS); k < nr; ++k) {
+      name("pyramid record #", k, 0);
+      uint32_t l = u32();
+      JsonLevel *level = l < (uint32_t)nl ? &image->levels[l] : 0;
+      if (l < 1 || !level || level->parents.n || level->collapses.n)
+        say_start(), say(what), say(": level "), say_number(AS_INTEGER, l), say(" is out of range or named twice"), say_fail();
+      name("pyramid record # parent vertices", k, 0);
+      Array parents = {count(1, MAX_ELEMENTS), 0}, collapses;
+      parents.data = need_memory(NEW(int32_t, parents.n + 1));
+      int32_t *pv = (int32_t *)parents.data, previous = 0;
+      for (int32_t q = 0; q < parents.n; ++q) pv[q] = previous = vertex_index(k, previous, varint());
+      name("pyramid record # collapses", k, 0);
+      collapses.n = 2 * count(2, MAX_ELEMENTS);
+      int32_t *cv = (int32_t *)(collapses.data = need_memory(NEW(int32_t, collapses.n + 1)));
+      for (int32_t q = 0; q < collapses.n; q += 2) {
+        double code = varint();
+        cv[q] = vertex_index(k, 0, 2 * (code < 1099511627776.0 ? code : 1099511627776.0));
+        cv[q + 1] = vertex_index(k, cv[q], varint());
+      }
+      level->parents = parents, level->collapses = collapses;
+    }
+  }
+  if (left()) say_start(), say_number(AS_INTEGER, left()), say(" unexpected bytes after the payload's pyramid records"), say_fail();
   return image;
 }

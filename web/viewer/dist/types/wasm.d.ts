@@ -10,23 +10,6 @@ export declare function refine(topo: Topology, faces: Int32Array | null, depth: 
 export declare function adaptiveIndices(r: Refined, scale: number, colorTolerance: number, positionTolerance: number): Uint32Array;
 /** zstd's content checksum of b: the low 32 bits of XXH64, seed 0 (wasm/checksum.c). */
 export declare function checksum(b: Uint8Array): number;
-/** A compact level's counts, precision and bytes (one stream, or six sections), as decode.ts read them. */
-export interface CompactInput {
-    version: number;
-    sections: Uint8Array[];
-    ops: number;
-    nv: number;
-    ncolors: number;
-    ntriangles: number;
-    ncreases: number;
-    nfeatures: number;
-    pb: number;
-    cb: number;
-    width: number;
-    height: number;
-    /** the level's number, for the messages */
-    level: number;
-}
 /** The edges of a level the decoder built, sorted by (a, b) with a < b, and the triangle across
  * each (-1 on the border): what check_level needs of them. */
 export interface Edges {
@@ -34,11 +17,11 @@ export interface Edges {
     b: Int32Array;
     g: Int32Array;
 }
-/** A compact level and its edges, or a SvecError naming the problem. */
-export declare function decodeCompact(input: CompactInput): [Level, Edges];
 /** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
  * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
  * by construction. */
 export declare function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void;
 /** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
-export declare function readJson(b: Uint8Array): [SvecImage, PyramidRecord[]];
+export declare const readJson: (b: Uint8Array) => [SvecImage, PyramidRecord[], Edges[]];
+/** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
+export declare const readPayload: (b: Uint8Array, version: number) => [SvecImage, PyramidRecord[], Edges[]];
