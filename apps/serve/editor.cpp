@@ -719,8 +719,10 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
   VectorImage edited = image_;
   EditOp op = op_to(to, rotate);
   try {
-    subvec::apply_edit_ops(edited, std::span(&op, 1));
-    log = said(to, rotate);
+    const std::vector<std::string> lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
+    // The fold-free path stopped short (issue 25): the frame or a crossing holds the drag.
+    const bool stopped = !lines.empty() && lines.front().find("; stopped at ") != std::string::npos;
+    log = (stopped ? "stopped at the last position the mesh could take: " : "") + said(to, rotate);
   } catch (const Error& e) {
     const bool moved = drag->last_to.x != drag->start.at.x || drag->last_to.y != drag->start.at.y ||
                        drag->last_rotate != 0;

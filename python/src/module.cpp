@@ -603,6 +603,8 @@ void def_edit_parts(PyVectorImage& vi) {
             py::gil_scoped_release release;
             subvec::ShapeEditor editor(mesh, v.width, v.height);
             mesh.positions = editor.deform(h);
+            // How far the handles went: 1, or less where the mesh would fold (edit/shape.h).
+            return editor.reached();
           },
           "vertices"_a, "targets"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0);
 }

@@ -341,6 +341,67 @@ void ArapDeformer::solve(std::span<const Vec2> targets, std::span<Vec2> out,
   }
 }
 
+double ArapDeformer::rigid_step(std::span<const Vec2> targets, std::span<const Vec2> current,
+                                std::span<Vec2> out) const {
+  const Impl& m = *impl_;
+  m.check_targets(targets, out);
+  const size_t n = m.rest.size();
+  if (current.size() != n) invalid("the current positions have the wrong size");
+  Eigen::VectorXd b[2] = {Eigen::VectorXd::Zero(Eigen::Index(n)), Eigen::VectorXd::Zero(Eigen::Index(n))};
+  double energy = 0;
+  for (size_t f = 0; f < m.triangles.size(); ++f) {
+    const Tri& t = m.triangles[f];
+    V2 p[3], q[3];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], c = t[(k + 1) % 3];
+      p[k] = {m.rest[c].x - m.rest[a].x, m.rest[c].y - m.rest[a].y};
+      q[k] = {current[c].x - current[a].x, current[c].y - current[a].y};
+    }
+    // The best rotation maximises sum q . (R p): its angle is atan2(S10 - S01, S00 + S11) with
+    // S = sum q p^T.
+    Mat2 s = Mat2::Zero();
+    for (int k = 0; k < 3; ++k) s += q[k] * p[k].transpose();
+    const double angle = std::atan2(s(1, 0) - s(0, 1), s(0, 0) + s(1, 1));
+    const double cs = std::cos(angle), sn = std::sin(angle);
+    const Mat2 r = (Mat2() << cs, -sn, sn, cs).finished();
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], c = t[(k + 1) % 3];
+      const V2 e = r * p[k];
+      energy += m.weight[f] * (q[k] - e).squaredNorm();
+      for (int axis = 0; axis < 2; ++axis) {
+        b[axis][a] -= m.weight[f] * e[axis], b[axis][c] += m.weight[f] * e[axis];
+      }
+    }
+  }
+  for (int axis = 0; axis < 2; ++axis) {
+    Eigen::VectorXd x(static_cast<Eigen::Index>(n));
+    for (size_t v = 0; v < n; ++v) x[Eigen::Index(v)] = axis ? targets[v].y : targets[v].x;
+    m.scale[axis].solve(b[axis], x);
+    for (size_t v = 0; v < n; ++v) {
+      double& o = axis ? out[v].y : out[v].x;
+      o = has(m.fixed[v], axis) ? (axis ? targets[v].y : targets[v].x) : x[Eigen::Index(v)];
+    }
+  }
+  return energy;
+}
+
+void ArapDeformer::precondition(std::span<const Vec2> gradient, std::span<Vec2> direction) const {
+  const Impl& m = *impl_;
+  const size_t n = m.rest.size();
+  if (gradient.size() != n || direction.size() != n) invalid("precondition: wrong sizes");
+  for (int axis = 0; axis < 2; ++axis) {
+    Eigen::VectorXd b(static_cast<Eigen::Index>(n)), x(static_cast<Eigen::Index>(n));
+    for (size_t v = 0; v < n; ++v) {
+      b[Eigen::Index(v)] = -(axis ? gradient[v].y : gradient[v].x);
+      x[Eigen::Index(v)] = axis ? direction[v].y : direction[v].x;
+    }
+    m.scale[axis].solve(b, x);
+    for (size_t v = 0; v < n; ++v) {
+      if (!has(m.fixed[v], axis)) (axis ? direction[v].y : direction[v].x) = x[Eigen::Index(v)];
+    }
+  }
+}
+
 double rigidity_energy(std::span<const Vec2> rest, std::span<const Vec2> deformed,
                        std::span<const Tri> triangles) {
   if (rest.size() != deformed.size()) {

@@ -424,7 +424,11 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           }
           done += "; " + std::to_string(handles.vertices.size()) + " handle vertices, largest move " +
                   num(moved) + " px";
-          if (editor.scale_fraction() < 1) {
+          if (editor.reached() < 1) {
+            done += "; stopped at " + num(std::floor(editor.reached() * 1000) / 10) +
+                    " % of the way, the last position before the control mesh would fold" +
+                    (editor.framed() ? " (the image frame stops it)" : "");
+          } else if (editor.scale_fraction() < 1) {
             done += " (scale adjustment applied at " + num(editor.scale_fraction()) +
                     " to avoid a flip)";
           }

@@ -89,7 +89,7 @@ Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 trans
 }
 
 ShapeEditor::ShapeEditor(const ControlMesh& mesh, int width, int height)
-    : rest_(mesh.positions), triangles_(mesh.triangles) {
+    : rest_(mesh.positions), triangles_(mesh.triangles), width_(width), height_(height) {
   sides_.resize(rest_.size());
   for (size_t v = 0; v < rest_.size(); ++v) {
     const Vec2 p = rest_[v];
@@ -145,6 +145,7 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
             std::to_string(handles.targets.size()) + " targets");
   }
   targets_ = rest_;
+  framed_ = false;
   std::vector<uint8_t> seen(rest_.size(), 0);
   for (size_t i = 0; i < handles.vertices.size(); ++i) {
     const int v = handles.vertices[i];
@@ -154,9 +155,14 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
     if (!std::isfinite(t.x) || !std::isfinite(t.y)) {
       invalid("the target of vertex " + std::to_string(v) + " is not finite");
     }
-    // Border handles slide along their side; corners stay.
+    // Border handles slide along their side; corners stay. The frame stops the others: a
+    // target outside it is taken to the nearest point a margin inside.
     const unsigned s = sides_[v];
-    targets_[v] = {(s & 3u) ? rest_[v].x : t.x, (s & 12u) ? rest_[v].y : t.y};
+    const double m = kFrameMargin;
+    framed_ |= (!(s & 3u) && (t.x < kFrameMargin || t.x > width_ - kFrameMargin)) ||
+               (!(s & 12u) && (t.y < kFrameMargin || t.y > height_ - kFrameMargin));
+    targets_[v] = {(s & 3u) ? rest_[v].x : std::clamp(t.x, std::min(m, rest_[v].x), std::max(width_ - m, rest_[v].x)),
+                   (s & 12u) ? rest_[v].y : std::clamp(t.y, std::min(m, rest_[v].y), std::max(height_ - m, rest_[v].y))};
   }
   if (!(handles.region >= 0) || !std::isfinite(handles.region)) {
     invalid("the region " + num(handles.region) + " is not a number >= 0");
@@ -166,17 +172,14 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
   similarity_.resize(rest_.size());
   deformer.solve(targets_, result, similarity_);
   scale_fraction_ = 1;
+  reached_ = 1;
   if (first_flip(result) >= 0) {
     // Repair: apply the scale adjustment only partly, v = s1 + lambda (s2 - s1), with the largest
     // lambda (bisection, to 1/1024) that flips nothing. Refused when the similarity step flips.
-    const int f = first_flip(similarity_);
-    if (f >= 0) {
-      const Tri& t = triangles_[f];
-      const Vec2 r = rest_[t[0]];
-      invalid("the edit would flip control triangle " + std::to_string(f) + " (vertices " +
-              std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
-              " near (" + num(r.x) + ", " + num(r.y) +
-              ")); refused: try a smaller displacement, a larger sigma or several smaller steps");
+    if (first_flip(similarity_) >= 0) {
+      fold_free(deformer, result);
+      out = std::move(result);
+      return;
     }
     std::vector<Vec2> blend(rest_.size());
     // A result that is not finite (a numerically singular scale step) counts as flipped, and
@@ -211,6 +214,185 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
     }
   }
   out = std::move(result);
+}
+
+namespace {
+
+// The largest t in (0, 1] (or 1) such that moving every vertex from `from` by t (to - from) keeps
+// each triangle's signed area above its floor all the way: the signed area along the path is a
+// quadratic in t, and the bound is its first crossing of the floor. Returns 1 when no triangle
+// reaches its floor before t = 1.
+double area_bound(const std::vector<Vec2>& from, const std::vector<Vec2>& to,
+                  const std::vector<Tri>& triangles, const std::vector<double>& floor2) {
+  double bound = std::numeric_limits<double>::infinity();
+  for (size_t f = 0; f < triangles.size(); ++f) {
+    const Tri& t = triangles[f];
+    const Vec2 a = from[t[0]], b = from[t[1]], c = from[t[2]];
+    const Vec2 da = {to[t[0]].x - a.x, to[t[0]].y - a.y};
+    const Vec2 e1 = {b.x - a.x, b.y - a.y}, e2 = {c.x - a.x, c.y - a.y};
+    const Vec2 d1 = {to[t[1]].x - b.x - da.x, to[t[1]].y - b.y - da.y};
+    const Vec2 d2 = {to[t[2]].x - c.x - da.x, to[t[2]].y - c.y - da.y};
+    const auto cross = [](Vec2 u, Vec2 v) { return u.x * v.y - u.y * v.x; };
+    // 2 area(t) - floor = c0 + c1 t + c2 t^2, with c0 > 0.
+    const double c0 = cross(e1, e2) - floor2[f];
+    const double c1 = cross(e1, d2) + cross(d1, e2);
+    const double c2 = cross(d1, d2);
+    double root = std::numeric_limits<double>::infinity();
+    if (!(c0 > 0)) {
+      root = 0;
+    } else if (c2 == 0) {
+      if (c1 < 0) root = -c0 / c1;
+    } else {
+      const double disc = c1 * c1 - 4 * c2 * c0;
+      if (disc >= 0) {
+        // The roots q / c2 and c0 / q (numerically stable); the first positive one counts.
+        const double q = -0.5 * (c1 + std::copysign(std::sqrt(disc), c1));
+        for (const double r : {q / c2, q != 0 ? c0 / q : std::numeric_limits<double>::infinity()}) {
+          if (r > 0) root = std::min(root, r);
+        }
+      }
+    }
+    bound = std::min(bound, root);
+  }
+  return bound;
+}
+
+}  // namespace
+
+// The symmetric Dirichlet energy of a deformation, sum over triangles of A_f (|J|^2 + |J^-1|^2)
+// (J the map from the rest triangle to the deformed one, A_f its rest area): 4 times the area for
+// a rigid motion, and infinite as a triangle degenerates, so a descent on it never folds and
+// pushes the neighbours of a squeezed triangle away. Returns infinity when a triangle is at or
+// below its floor; with `gradient`, adds the energy's gradient to it.
+double ShapeEditor::distortion(const std::vector<Vec2>& x, std::vector<Vec2>* gradient) const {
+  double energy = 0;
+  for (size_t f = 0; f < triangles_.size(); ++f) {
+    const Tri& t = triangles_[f];
+    const Vec2 q0 = x[t[0]];
+    const double a = x[t[1]].x - q0.x, c = x[t[2]].x - q0.x;  // Q = [a c; b d]
+    const double b = x[t[1]].y - q0.y, d = x[t[2]].y - q0.y;
+    const double cross = a * d - b * c;
+    if (!(cross > floor2_[f])) return std::numeric_limits<double>::infinity();
+    const Inverse& p = inverse_[f];
+    // J = Q P^-1
+    const double j00 = a * p.m00 + c * p.m10, j01 = a * p.m01 + c * p.m11;
+    const double j10 = b * p.m00 + d * p.m10, j11 = b * p.m01 + d * p.m11;
+    const double s = j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11;
+    const double det = j00 * j11 - j01 * j10;
+    energy += p.area * s * (1 + 1 / (det * det));
+    if (gradient) {
+      // dE/dJ = A (2 J (1 + 1/det^2) - 2 s / det^3 cof(J)), then dE/dQ = dE/dJ P^-T.
+      const double k1 = 2 * p.area * (1 + 1 / (det * det)), k2 = -2 * p.area * s / (det * det * det);
+      const double g00 = k1 * j00 + k2 * j11, g01 = k1 * j01 - k2 * j10;
+      const double g10 = k1 * j10 - k2 * j01, g11 = k1 * j11 + k2 * j00;
+      const double m00 = g00 * p.m00 + g01 * p.m01, m01 = g00 * p.m10 + g01 * p.m11;
+      const double m10 = g10 * p.m00 + g11 * p.m01, m11 = g10 * p.m10 + g11 * p.m11;
+      std::vector<Vec2>& g = *gradient;
+      g[t[1]].x += m00, g[t[1]].y += m10;
+      g[t[2]].x += m01, g[t[2]].y += m11;
+      g[t[0]].x -= m00 + m01, g[t[0]].y -= m10 + m11;
+    }
+  }
+  return energy;
+}
+
+// One preconditioned descent step on the distortion with the fixed coordinates held (the
+// Laplacian as the quadratic proxy, Kovalsky et al. 2016), as long as the floor and an Armijo
+// decrease allow. Returns the relative decrease of the energy (0 when no step was taken).
+double ShapeEditor::relax_step(const ArapDeformer& deformer, std::vector<Vec2>& x) {
+  const size_t n = rest_.size();
+  gradient_.assign(n, {0, 0});
+  const double energy = distortion(x, &gradient_);
+  direction_.assign(n, {0, 0});
+  deformer.precondition(gradient_, direction_);
+  double slope = 0;
+  for (size_t v = 0; v < n; ++v) slope += gradient_[v].x * direction_[v].x + gradient_[v].y * direction_[v].y;
+  if (!(slope < 0)) return 0;
+  trial_.resize(n);
+  for (size_t v = 0; v < n; ++v) trial_[v] = {x[v].x + direction_[v].x, x[v].y + direction_[v].y};
+  const double bound = area_bound(x, trial_, triangles_, floor2_);
+  for (double t = std::min(1.0, kStepShare * bound); t > 1e-12; t /= 2) {
+    for (size_t v = 0; v < n; ++v) trial_[v] = {x[v].x + t * direction_[v].x, x[v].y + t * direction_[v].y};
+    const double e = distortion(trial_, nullptr);
+    if (e <= energy + 1e-4 * t * slope) {
+      x.swap(trial_);
+      return (energy - e) / energy;
+    }
+  }
+  return 0;
+}
+
+void ShapeEditor::fold_free(const ArapDeformer& deformer, std::vector<Vec2>& x) {
+  const size_t n = rest_.size();
+  if (floor2_.size() != triangles_.size()) {
+    floor2_.resize(triangles_.size());
+    inverse_.resize(triangles_.size());
+    for (size_t f = 0; f < triangles_.size(); ++f) {
+      const Tri& t = triangles_[f];
+      const Vec2 a = rest_[t[0]], b = rest_[t[1]], c = rest_[t[2]];
+      const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - a.x, vy = c.y - a.y;  // P = [u v]
+      const double cross = ux * vy - uy * vx;
+      floor2_[f] = kAreaFloor * cross;
+      inverse_[f] = {vy / cross, -vx / cross, -uy / cross, ux / cross, cross / 2};
+    }
+  }
+  // Rounds: push the handles towards their targets along the ARAP step (the similarity step
+  // first), as far as no triangle reaches its floor, then let the distortion's descent, handles
+  // held, make room around them. It stops when the handles arrive, or when the rounds stop
+  // gaining ground: the last fold-free position on the way.
+  x = rest_;
+  std::vector<Vec2> proposal = similarity_;
+  trial_.resize(n);
+  double left = 1;  // the fraction of the handles' way still to go
+  int slow = 0;
+  for (int round = 0; round < kFoldFreeRounds && left > 0; ++round) {
+    double bound;
+    if (round == 0) {
+      bound = area_bound(x, proposal, triangles_, floor2_);
+    } else {
+      // Two ways towards the targets, the one that goes farther: the ARAP step, and the
+      // distortion's preconditioned step with the handles moved the rest of their way (the
+      // barrier in its gradient steers the free vertices around squeezed triangles).
+      deformer.rigid_step(targets_, x, proposal);
+      bound = area_bound(x, proposal, triangles_, floor2_);
+      if (bound <= 1) {
+        gradient_.assign(n, {0, 0});
+        distortion(x, &gradient_);
+        for (size_t v = 0; v < n; ++v) trial_[v] = {targets_[v].x - x[v].x, targets_[v].y - x[v].y};
+        deformer.precondition(gradient_, trial_);
+        for (size_t v = 0; v < n; ++v) trial_[v] = {x[v].x + trial_[v].x, x[v].y + trial_[v].y};
+        const double other = area_bound(x, trial_, triangles_, floor2_);
+        if (other > bound) proposal.swap(trial_), bound = other;
+      }
+    }
+    const double t = bound > 1 ? 1 : kStepShare * bound;
+    if (t == 1) {
+      x.swap(proposal);
+      left = 0;
+      break;
+    }
+    for (size_t v = 0; v < n; ++v) {
+      x[v] = {x[v].x + t * (proposal[v].x - x[v].x), x[v].y + t * (proposal[v].y - x[v].y)};
+    }
+    left *= 1 - t;
+    slow = t < 1e-3 ? slow + 1 : 0;
+    if (slow >= 8) break;
+    for (int k = 0; k < (t < 0.1 ? 5 : 1) * kRelaxSteps; ++k) relax_step(deformer, x);
+  }
+  // Handles within a rounding error of their targets are put on them, if nothing reaches its
+  // floor then.
+  if (left > 0 && left < 1e-6) {
+    proposal = x;
+    for (size_t v = 0; v < n; ++v) {
+      if (targets_[v].x != rest_[v].x || targets_[v].y != rest_[v].y) proposal[v] = targets_[v];
+    }
+    if (distortion(proposal, nullptr) < std::numeric_limits<double>::infinity()) x.swap(proposal), left = 0;
+  }
+  // Then the distortion's descent with the handles where they are, until it settles.
+  for (int k = 0; k < kSettleSteps; ++k) {
+    if (relax_step(deformer, x) < 1e-6) break;
+  }
+  reached_ = 1 - left;
 }
 
 int ShapeEditor::first_flip(const std::vector<Vec2>& p) const {

@@ -246,6 +246,29 @@ def test_direct_handles_move_and_recolor_control_points():
         image.move_vertices([10**6], (1, 1))
 
 
+def _smallest_area(image):
+    mesh = image.mesh()
+    p = mesh["positions"][mesh["triangles"]]
+    return ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) -
+            (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])).min()
+
+
+def test_deform_never_folds_and_says_how_far_it_went():
+    image = subvec.load(BUTTERFLY)
+    positions = image.mesh()["positions"]
+    v = int(np.argmin(np.hypot(positions[:, 0] - 200, positions[:, 1] - 180)))
+    assert image.deform([v], [positions[v] + (3, 2)], region=60) == 1.0
+    assert np.array_equal(image.mesh()["positions"][v], positions[v] + (3, 2))
+    # Far past the right border: the frame stops it, a margin inside, and nothing folds.
+    reached = image.deform([v], [positions[v] + (5000, 0)])
+    assert 0 < reached < 1
+    assert image.mesh()["positions"][v][0] <= image.width - 0.25
+    assert _smallest_area(image) > 0
+    # A feature drag the plain ARAP solve would flip: it goes all the way now, or stops and says so.
+    line = image.drag((200, 180), (230, 150), select="feature", sigma=25, region=75)
+    assert "dragged by" in line and _smallest_area(image) > 0
+
+
 def test_color_selection_blend_and_transform():
     image = subvec.load(BUTTERFLY)
     sel = image.select_colors((160, 175), radius=40)

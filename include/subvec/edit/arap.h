@@ -69,6 +69,23 @@ class ArapDeformer {
   // Step 1 alone (the similarity solve), for tests and analysis.
   void solve_similarity(std::span<const Vec2> targets, std::span<Vec2> out) const;
 
+  // One iteration of local-global ARAP (Sorkine and Alexa 2007; Liu et al. 2008 in the plane)
+  // from `current` (#V): each triangle's rest shape is rotated to fit its `current` shape best,
+  // then `out` (#V) receives the positions whose edges best match those rotated rest edges, with
+  // step 2's weighted edge Laplacian (factored already) and the fixed coordinates from `targets`.
+  // Returns the rigidity energy of `current` in that weighting, sum over triangles of
+  // w_f * sum over edges |(v_b - v_a) - R_f (p_b - p_a)|^2: one iteration never increases it
+  // along the straight path from `current` to `out` (the global step minimises a convex
+  // quadratic). Used by ShapeEditor's fold-free path (edit/shape.h).
+  double rigid_step(std::span<const Vec2> targets, std::span<const Vec2> current,
+                    std::span<Vec2> out) const;
+
+  // Solves L d = -g for the free coordinates of `direction` (#V), whose fixed coordinates are
+  // given (0: a descent step; the handles' remaining way: a step that also moves them), L step
+  // 2's weighted edge Laplacian (factored already), both axes: the quadratic proxy that
+  // preconditions a descent on another energy whose gradient is `gradient` (#V).
+  void precondition(std::span<const Vec2> gradient, std::span<Vec2> direction) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,6 +1,6 @@
 // Edit operations as a mouse does them, in image coordinates: the `subvec edit --ops` file
 // (docs/editing.md has the format). Parsing checks the file's structure; applying checks what
-// needs the image (points inside it, something to select, no flipped triangle).
+// needs the image (points inside it, something to select).
 #pragma once
 
 #include <span>
@@ -49,8 +49,9 @@ std::vector<EditOp> parse_edit_ops(std::string_view json);
 
 // Applies the operations in order; returns one line per operation saying what it selected and did.
 // Throws Error(kInvalidArgument) naming the operation ("ops[1] (move-feature): ...") when a level
-// is out of range, a point lies outside the image, there is nothing to select, a shape edit would
-// flip a triangle or a color transform is impossible; `image` then holds the operations before the
+// is out of range, a point lies outside the image, there is nothing to select or a color transform
+// is impossible (a shape edit never folds the mesh: one that cannot go all the way stops at its
+// last fold-free position and its line says so, edit/shape.h); `image` then holds the operations before the
 // failing one.
 std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const EditOp> ops);
 

@@ -8,15 +8,24 @@
 // creases and tears are kept and every feature curve stays a C^2 cubic B-spline by construction
 // (paper §3.2).
 //
-// Flips are repaired when the ARAP solve allows it, refused otherwise. In practice it is the
-// scale-adjustment step (edit/arap.h) that flips, near thin triangles squeezed against the border
-// or a feature, while the similarity step s1 does not. A deformed mesh with a triangle of zero or
-// negative signed area is then replaced by s1 + lambda (s2 - s1), with the largest lambda in
-// [0, 1) that flips nothing (bisection to 1/1024): the handles still meet their targets exactly,
-// and the result is as rigid as a flip-free blend allows. When s1 itself flips, deform throws
-// Error(kInvalidArgument) naming the triangle and changes nothing; the edit can be retried with a
-// smaller displacement, a larger sigma, a region, or in several steps (each step starts from the
-// last result as its rest shape).
+// No edit folds the mesh (issue 25). The ARAP solve (edit/arap.h) is the result whenever it
+// flips nothing. When its scale-adjustment step s2 flips (near thin triangles squeezed against
+// the border or a feature) but the similarity step s1 does not, the result is
+// s1 + lambda (s2 - s1) with the largest lambda in [0, 1) that flips nothing (bisection to
+// 1/1024). When s1 itself flips, the fold-free path takes over: starting from the rest shape, it
+// pushes the handles towards their targets along the ARAP step (or along the preconditioned step
+// of the symmetric Dirichlet energy, whichever goes farther), each push stopping before any
+// triangle falls to 1/1000 of its rest area (the signed area along a straight path is a quadratic,
+// so the bound is exact), and between pushes descends the symmetric Dirichlet energy with the
+// handles held (Laplacian-preconditioned, after Kovalsky et al.'s accelerated quadratic proxy):
+// the energy is infinite at a degenerate triangle, so the descent moves the free vertices away
+// from squeezed triangles and makes room. Then it descends the energy with the handles at their
+// targets until it settles. The handles meet their targets exactly, unless the pushes stop
+// gaining ground: then the result is the last fold-free position on the way and reached() says
+// how far it went. That happens where no fold-free position exists or is within reach: a feature
+// chain that would cross itself or another chain held in place, or the image frame, which stops
+// handles a margin (kFrameMargin) inside it and can squeeze a triangle of handles flat (framed()).
+// The result is deterministic: the same ops give the same bits.
 #pragma once
 
 #include <cstdint>
@@ -93,13 +102,19 @@ class ShapeEditor {
   const std::vector<Vec2>& rest() const { return rest_; }
   // The lambda of the last deform: 1 when the scale adjustment was applied in full.
   double scale_fraction() const { return scale_fraction_; }
+  // The fraction of the way the handles went in the last deform: 1 when they met their targets,
+  // less when the fold-free path stopped (see above).
+  double reached() const { return reached_; }
+  // Whether the frame held a handle in the last deform: a target outside the image (less the
+  // margin) was moved to its nearest point inside.
+  bool framed() const { return framed_; }
 
   // Deformed positions (#V) with the handles at their targets (projected as described above).
   // The factorization depends only on the set of handle vertices and the region, and is cached
   // (the last few sets), so repeated calls with the same vertices and new targets, a drag, only
-  // back-substitute. Throws Error(kInvalidArgument) for an out-of-range or repeated handle vertex,
-  // a non-finite target or region, or a result that would flip a triangle (nothing is changed
-  // then).
+  // back-substitute. Never flips or degenerates a triangle (see above; reached() < 1 when the
+  // handles stopped short). Throws Error(kInvalidArgument) for an out-of-range or repeated
+  // handle vertex, or a non-finite target or region.
   std::vector<Vec2> deform(const Handles& handles);
   void deform(const Handles& handles, std::vector<Vec2>& out);
 
@@ -113,9 +128,25 @@ class ShapeEditor {
 
   std::vector<Vec2> rest_;
   std::vector<Tri> triangles_;
+  int width_, height_;
+  static constexpr double kFrameMargin = 0.25;  // pixels: how close the frame lets a handle come
   std::vector<uint8_t> sides_;  // per vertex: bit 0 left, 1 right, 2 top, 3 bottom
   std::list<Cached> cache_;     // most recently used first
   int first_flip(const std::vector<Vec2>& positions) const;
+  void fold_free(const ArapDeformer& deformer, std::vector<Vec2>& out);
+  double distortion(const std::vector<Vec2>& x, std::vector<Vec2>* gradient) const;
+  double relax_step(const ArapDeformer& deformer, std::vector<Vec2>& x);
+  static constexpr double kAreaFloor = 1e-3;  // of each triangle's rest area
+  static constexpr double kStepShare = 0.9;   // of the way to the first triangle at its floor
+  static constexpr int kFoldFreeRounds = 200, kRelaxSteps = 4, kSettleSteps = 100;
+  struct Inverse {
+    double m00, m01, m10, m11, area;  // the rest edge matrix's inverse, and the rest area
+  };
+  std::vector<double> floor2_;  // per triangle, twice its smallest allowed area
+  std::vector<Inverse> inverse_;
+  std::vector<Vec2> gradient_, direction_, trial_;  // scratch
+  double reached_ = 1;
+  bool framed_ = false;
 
   std::vector<Vec2> targets_, similarity_;  // scratch
   double scale_fraction_ = 1;

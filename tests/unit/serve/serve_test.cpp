@@ -285,9 +285,9 @@ TEST(ServeEditor, CoarseTrianglesAreTheViewOneLevelCoarser) {
   EXPECT_TRUE(editor.view(editor.new_session(), {0, 0}).coarse_triangles.empty());
 }
 
-// A release the mesh cannot take commits the last position the preview took, and says so; a
-// drag refused from its first move changes nothing.
-TEST(ServeEditor, RefusedReleaseCommitsTheLastPreview) {
+// A drag that would fold the mesh (issue 25) stops at the last fold-free position, in the preview
+// and in the commit, which is `subvec edit`'s result and says it stopped.
+TEST(ServeEditor, ADragThatWouldFoldStopsAndSaysSo) {
   const VectorImage original = disk();
   Editor editor(original);
   const std::string s = editor.new_session();
@@ -296,19 +296,25 @@ TEST(ServeEditor, RefusedReleaseCommitsTheLastPreview) {
   start.sigma = 30;
   editor.drag_start(s, 1, start);
   editor.drag_move(s, {80, 48}, 0);
-  // Through the disk and out of its other side: the ring of triangles inside folds.
+  // Through the disk and out of its other side: the outline would cross itself.
   const Vec2 far{4, 48};
-  EXPECT_EQ(status_of([&] { editor.drag_move(s, far, 0); }), kUnprocessable);
+  editor.drag_move(s, far, 0);
   std::string log;
   editor.drag_end(s, 1, far, 0, log);
-  EXPECT_EQ(log.rfind("stopped at the last position the mesh could take: ", 0), 0u) << log;
+  EXPECT_EQ(log.rfind("stopped at the last position the mesh could take: dragged by (-72, 0) px", 0), 0u) << log;
   EXPECT_EQ(editor.version(), 2);
-  const VectorImage expected = dragged(original, 80);
+  subvec::EditOp op;
+  op.kind = subvec::EditOp::Kind::kDrag;
+  op.select = subvec::EditSelect::kFeature;
+  op.from = start.at;
+  op.to = far;
+  op.sigma = 30;
+  VectorImage expected = original;
+  const std::vector<std::string> lines = subvec::apply_edit_ops(expected, std::span(&op, 1));
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("% of the way"), std::string::npos) << lines[0];
   EXPECT_EQ(editor.snapshot().first.levels[0].positions, expected.levels[0].positions);
-
-  editor.drag_start(s, 2, start);
-  EXPECT_EQ(status_of([&] { editor.drag_end(s, 2, far, 0, log); }), kUnprocessable);
-  EXPECT_EQ(editor.version(), 2);
+  EXPECT_NE(expected.levels[0].positions, original.levels[0].positions);
 }
 
 // The move tool: translate and rotate a whole feature, committed as `subvec edit`'s move-feature.
