@@ -11,14 +11,13 @@
 import { Decompress } from 'fzstd';
 import { SvecError, SvecImage } from './image';
 import { escape, fail, validate } from './validate';
-import { checksum, readJson, readPayload } from './wasm';
+import { checksum, container, readJson, readPayload } from './wasm';
 
 const GIB = 2 ** 30; // largest file, and largest payload
 const MAGIC = [0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a]; // "SUBVEC" NUL ^Z
 const HEADER = 32;
 
 const latin1 = (b: Uint8Array) => String.fromCharCode(...b);
-const hex = (b: ArrayLike<number>) => Array.from(b, (x) => x.toString(16).padStart(2, '0')).join(' ');
 
 // ---------------------------------------------------------------------------------------------
 // Bytes.
@@ -27,36 +26,7 @@ const hex = (b: ArrayLike<number>) => Array.from(b, (x) => x.toString(16).padSta
 // zstd: one frame that must decompress to exactly `expected` bytes (fzstd, plus the checks
 // libzstd makes that fzstd does not: window limit, dictionary, block sizes, checksum).
 
-function unzstd(f: Uint8Array, expected: number): Uint8Array {
-  const le = (at: number, n: number) => {
-    let v = 0;
-    for (let i = n; i--; ) v = v * 256 + f[at + i];
-    return v;
-  };
-  const d = f[4], single = (d >> 5) & 1, dict = [0, 1, 2, 4][d & 3], sizeBytes = [single, 2, 4, 8][d >> 6];
-  let end = 6 - single + dict + sizeBytes;
-  if (f.length < end || le(0, 4) !== 0xfd2fb528 || d & 8) fail('corrupt zstd frame: bad frame header');
-  const content = sizeBytes ? le(end - sizeBytes, sizeBytes) + (sizeBytes === 2 ? 256 : 0) : -1;
-  if (content >= 0 && content !== expected) fail(`zstd frame holds ${content} bytes but the header declares ${expected}`);
-  // fzstd allocates the window up front: libzstd's default limit (2^27) bounds it.
-  const window = single ? content : 2 ** (10 + (f[5] >> 3)) * (1 + (f[5] & 7) / 8);
-  if (window > 2 ** 27 + 1) fail('corrupt zstd frame: Frame requires too much memory for decoding');
-  if (le(end - sizeBytes - dict, dict)) fail('corrupt zstd frame: Dictionary mismatch');
-  // The blocks, to find the frame's end (trailing bytes, truncation). libzstd passes a raw block
-  // through as far as it goes: `partial` is what a truncated one gives.
-  let partial = 0;
-  for (let last = 0; !last; ) {
-    if (end + 3 > f.length) {
-      end = Infinity;
-      break;
-    }
-    const h = le(end, 3), type = (h >> 1) & 3, size = h >>> 3;
-    if (type === 3 || size > Math.min(2 ** 17, window)) fail('corrupt zstd frame: Data corruption detected');
-    last = h & 1;
-    partial = type === 0 && f.length - end - 3 < size ? Math.max(0, f.length - end - 3) : 0;
-    end += 3 + (type === 1 ? 1 : size);
-  }
-  if (d & 4) end += 4; // checksum
+function unzstd(f: Uint8Array, expected: number, end: number, partial: number, d: number): Uint8Array {
   const out = new Uint8Array(expected);
   let produced = 0;
   try {
@@ -70,7 +40,7 @@ function unzstd(f: Uint8Array, expected: number): Uint8Array {
     if (end <= f.length || (e as { code?: number }).code !== 5) fail(`corrupt zstd frame: ${(e as Error).message}`);
   }
   if (end > f.length) fail(`truncated zstd frame: it ends after ${produced + partial} of ${expected} payload bytes`);
-  if (d & 4 && le(end - 4, 4) !== checksum(out.subarray(0, produced))) fail("corrupt zstd frame: Restored data doesn't match checksum");
+  if (d & 4 && new DataView(f.buffer, f.byteOffset + end - 4).getUint32(0, true) !== checksum(out.subarray(0, produced))) fail("corrupt zstd frame: Restored data doesn't match checksum");
   if (produced !== expected) fail(`zstd frame decompresses to ${produced} bytes but the header declares ${expected}`);
   if (end < f.length) fail(`${f.length - end} unexpected bytes after the zstd frame`);
   return out;
@@ -80,19 +50,8 @@ function unzstd(f: Uint8Array, expected: number): Uint8Array {
 // The binary form: header, payload version 1 (lossless), trailer, pyramid records.
 
 function binary(b: Uint8Array): SvecImage {
-  if (b.subarray(0, 8).some((x, i) => x !== MAGIC[i]))
-    fail(`not a .svec file: wrong magic bytes (${hex(b.subarray(0, 8))}, expected ${hex(MAGIC)})`);
-  if (b.length < HEADER) fail(`truncated .svec header: ${b.length} bytes, the header needs ${HEADER}`);
-  const h = new DataView(b.buffer, b.byteOffset, HEADER);
-  const version = h.getUint32(8, true), flags = h.getUint32(12, true);
-  const size = h.getBigUint64(16, true), frame = h.getBigUint64(24, true), available = BigInt(b.length - HEADER);
-  if (version < 1 || version > 3) fail(`unsupported .svec version ${version} (this build reads 1, 2 and 3)`);
-  if (flags) fail(`unsupported .svec flags ${flags} (this build knows none)`);
-  if (size > GIB) fail(`declared payload of ${size} bytes is over the limit of ${GIB}`);
-  if (frame > available) fail(`truncated .svec file: the header declares a ${frame}-byte zstd frame but only ${available} bytes follow`);
-  if (frame < available) fail(`${available - frame} unexpected bytes after the zstd frame`);
-
-  const [image, records, topologies] = readPayload(unzstd(b.subarray(HEADER), Number(size)), version);
+  const [size, end, partial, d, version] = container(b);
+  const [image, records, topologies] = readPayload(unzstd(b.subarray(HEADER), size, end, partial, d), version);
   validate(image, records, topologies);
   return image;
 }

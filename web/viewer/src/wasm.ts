@@ -29,6 +29,7 @@ interface Exports {
   xxh64(bytes: number, length: number): number;
   json(bytes: number, length: number): number;
   payload(bytes: number, length: number, version: number): number;
+  container(bytes: number, length: number): number;
 }
 
 let instance: Exports | null = null;
@@ -321,3 +322,7 @@ export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.len
 /** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
 export const readPayload = (b: Uint8Array, version: number) =>
   call((put, m) => m.payload(put(b), b.length, version), (at, get, i32) => image(at, get, i32, true));
+
+/** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
+ * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version. */
+export const container = (b: Uint8Array) => call((put, m) => m.container(put(b), b.length), (at, get) => get(Float64Array, at, 5));

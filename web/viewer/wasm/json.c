@@ -692,3 +692,73 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
   if (left()) say_start(), say_number(AS_INTEGER, left()), say(" unexpected bytes after the payload's pyramid records"), say_fail();
   return image;
 }
+
+// ---------------------------------------------------------------------------------------------
+// The binary form's header and its zstd frame's header and blocks: the checks libzstd makes that
+// fzstd does not (window limit, dictionary, block sizes), and where the frame ends. Returns the
+// payload's size, the frame's end (after its checksum; infinite when the blocks run out), what a
+// raw block cut short gives, the frame descriptor and the version.
+
+static void say_u64(uint64_t v) {
+  char digits[20];
+  int32_t d = 20;
+  do digits[--d] = (char)('0' + v % 10), v /= 10;
+  while (v);
+  say_bytes((const uint8_t *)digits + d, 20 - d);
+}
+static double le(const uint8_t *f, int32_t at, int32_t n) {
+  double v = 0;
+  for (int32_t k = n; k--;) v = v * 256 + f[at + k];
+  return v;
+}
+
+EXPORT(container) double *container(const uint8_t *file, int32_t n) {
+  static const uint8_t MAGIC[8] = {0x53, 0x55, 0x42, 0x56, 0x45, 0x43, 0x00, 0x1a};
+  for (int32_t k = 0; k < 8 && k < n; ++k)
+    if (file[k] != MAGIC[k]) {
+      say_start(), say("not a .svec file: wrong magic bytes (");
+      for (int32_t q = 0; q < 8 && q < n; ++q) {
+        char h[4] = {"0123456789abcdef"[file[q] >> 4], "0123456789abcdef"[file[q] & 15], ' ', 0};
+        if (q + 1 == 8 || q + 1 == n) h[2] = 0;
+        say(h);
+      }
+      say(", expected 53 55 42 56 45 43 00 1a)"), say_fail();
+    }
+  if (n < 32) say_start(), say("truncated .svec header: "), say_number(AS_INTEGER, n), say(" bytes, the header needs 32"), say_fail();
+  uint32_t version, flags;
+  uint64_t size, frame, available = (uint64_t)(n - 32);
+  __builtin_memcpy(&version, file + 8, 4), __builtin_memcpy(&flags, file + 12, 4), __builtin_memcpy(&size, file + 16, 8), __builtin_memcpy(&frame, file + 24, 8);
+  if (version < 1 || version > 3) say_start(), say("unsupported .svec version "), say_number(AS_INTEGER, version), say(" (this build reads 1, 2 and 3)"), say_fail();
+  if (flags) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows none)"), say_fail();
+  if (size > 1073741824) say_start(), say("declared payload of "), say_u64(size), say(" bytes is over the limit of 1073741824"), say_fail();
+  if (frame > available)
+    say_start(), say("truncated .svec file: the header declares a "), say_u64(frame), say("-byte zstd frame but only "), say_u64(available), say(" bytes follow"), say_fail();
+  if (frame < available) say_start(), say_u64(available - frame), say(" unexpected bytes after the zstd frame"), say_fail();
+
+  const uint8_t *f = file + 32;
+  int32_t fn = n - 32, d = fn > 4 ? f[4] : 0, single = d >> 5 & 1, dict = (int32_t[]){0, 1, 2, 4}[d & 3], size_bytes = (int32_t[]){single, 2, 4, 8}[d >> 6];
+  double end = 6 - single + dict + size_bytes, expected = (double)size;
+  if (fn < end || le(f, 0, 4) != 4247762216.0 || d & 8) say_start(), say("corrupt zstd frame: bad frame header"), say_fail();
+  double content = size_bytes ? le(f, (int32_t)end - size_bytes, size_bytes) + (size_bytes == 2 ? 256 : 0) : -1;
+  if (content >= 0 && content != expected)
+    say_start(), say("zstd frame holds "), say_number(AS_INTEGER, content), say(" bytes but the header declares "), say_number(AS_INTEGER, expected), say_fail();
+  double window = single ? content : (double)(1ull << (10 + (f[5] >> 3))) * (1 + (f[5] & 7) / 8.0);
+  if (window > 134217729.0) say_start(), say("corrupt zstd frame: Frame requires too much memory for decoding"), say_fail();
+  if (le(f, (int32_t)end - size_bytes - dict, dict) != 0) say_start(), say("corrupt zstd frame: Dictionary mismatch"), say_fail();
+  double partial = 0;
+  for (int last = 0; !last;) {
+    if (end + 3 > fn) {
+      end = __builtin_inf();
+      break;
+    }
+    int32_t h = (int32_t)le(f, (int32_t)end, 3), type = h >> 1 & 3, bytes = (int32_t)((uint32_t)h >> 3);
+    if (type == 3 || bytes > (window < 131072 ? window : 131072)) say_start(), say("corrupt zstd frame: Data corruption detected"), say_fail();
+    last = h & 1;
+    partial = type == 0 && fn - end - 3 < bytes ? (fn - end - 3 > 0 ? fn - end - 3 : 0) : 0;
+    end += 3 + (type == 1 ? 1 : bytes);
+  }
+  if (d & 4) end += 4;
+  double *out = (double *)need_memory(alloc(5 * sizeof(double)));
+  out[0] = expected, out[1] = end, out[2] = partial, out[3] = d, out[4] = version;
+  return out;
+}

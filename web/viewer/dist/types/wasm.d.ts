@@ -25,3 +25,6 @@ export declare function checkLevel(level: Level, width: number, height: number, 
 export declare const readJson: (b: Uint8Array) => [SvecImage, PyramidRecord[], Edges[]];
 /** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
 export declare const readPayload: (b: Uint8Array, version: number) => [SvecImage, PyramidRecord[], Edges[]];
+/** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
+ * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version. */
+export declare const container: (b: Uint8Array) => Float64Array<ArrayBuffer>;
