@@ -182,7 +182,8 @@ export function checksum(b: Uint8Array): number {
 // ---------------------------------------------------------------------------------------------
 // Compact levels (wasm/decode.c).
 
-const utf8 = new TextDecoder('utf-8', { ignoreBOM: true });
+// strict: the module's messages are UTF-8 (keys the JSON reader decoded), and so must a file's strings be
+const utf8 = new TextDecoder('utf-8', { fatal: true, ignoreBOM: true });
 
 // A number as nlohmann's dump() writes it: 4.0, 0.5, 4e+38, 1e-05.
 function dump(v: number): string {
@@ -257,10 +258,9 @@ export function checkLevel(level: Level, width: number, height: number, l: numbe
 // refuses it, the bytes are not UTF-8 or it holds a lone surrogate).
 const bytes = (at: number, n: number) => new Uint8Array(instance!.memory.buffer, at, n);
 const number = (at: number, n: number) => Number(utf8.decode(bytes(at, n)));
-const strict = new TextDecoder('utf-8', { fatal: true, ignoreBOM: true });
 function string(at: number, n: number, out: number): number {
   try {
-    const s: string = JSON.parse(strict.decode(bytes(at, n)));
+    const s: string = JSON.parse(utf8.decode(bytes(at, n)));
     if (!/[\ud800-\udfff]/u.test(s)) return new TextEncoder().encodeInto(s, bytes(out, n)).written;
   } catch {}
   return -1;
@@ -269,39 +269,26 @@ function string(at: number, n: number, out: number): number {
 type Get = <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T;
 
 // wasm/json.c's JsonImage, JsonLevel, JsonStroke, JsonEntry (32-bit fields; an Array is n, then
-// a pointer), and a compact level in decode.c's Level: positions, colors, triangles,
-// triangleColors, creases, numFeatures, featureIds, featureOffsets, featureVertices,
-// featureSaliency, then Edges: numEdges, a, b, f, g (decode.c asserts the layout).
+// a pointer).
 function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): [SvecImage, PyramidRecord[], Edges[]] {
   const f = (p: number, k: number) => i32(p + 4 * k);
   const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
   const text = (p: number, k: number) => {
     try {
-      return strict.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
+      return utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
     } catch {
       return '\ud800'; // invalid UTF-8, which validate() reports in its place in the order
     }
   };
   const records: PyramidRecord[] = [], topologies: Edges[] = [];
   const levels = Array.from({ length: f(at, 2) }, (_, l): Level => {
-    const p = f(at, 3) + 76 * l, nf = f(p, 14), c = f(p, 18);
+    const p = f(at, 3) + 92 * l, nf = f(p, 14), edge = (k: number) => get(Int32Array, f(p, k), f(p, 19));
     records[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
-    if (c) {
-      const field = (k: number) => f(c, k), nt = f(p, 4);
-      const offsets = get(Int32Array, field(7), nf + 1), ids = get(Int32Array, field(6), nf);
-      const saliency = get(Float64Array, field(9), nf), vertices = get(Int32Array, field(8), offsets[nf]);
-      const ne = field(10), edge = (k: number) => get(Int32Array, field(11 + k), ne);
-      topologies[l] = { a: edge(0), b: edge(1), g: edge(3) };
-      return {
-        positions: get(Float64Array, field(0), f(p, 0)), colors: get(Float32Array, field(1), f(p, 2)), triangles: get(Int32Array, field(2), nt),
-        triangleColors: get(Int32Array, field(3), nt), creases: get(Int32Array, field(4), f(p, 8)),
-        features: Array.from({ length: nf }, (_, i) => ({ id: ids[i], saliency: saliency[i], vertices: vertices.subarray(offsets[i], offsets[i + 1]) })),
-      };
-    }
-    const triangles = ints(p, 4), saliency = get(Float64Array, f(p, 16), nf);
+    if (f(p, 18)) topologies[l] = { a: edge(20), b: edge(21), g: edge(22) };
+    const saliency = get(Float64Array, f(p, 16), nf);
     return {
-      positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles,
-      triangleColors: f(p, 7) ? ints(p, 6) : triangles.slice(), creases: ints(p, 8),
+      positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles: ints(p, 4),
+      triangleColors: ints(p, 6), creases: ints(p, 8),
       features: Array.from({ length: nf }, (_, k): Feature => {
         const id = f(f(p, 15), k), vertices = ints(f(p, 17) + 8 * k, 0);
         return binary ? { id, saliency: saliency[k], vertices } : { id, vertices, saliency: saliency[k] };

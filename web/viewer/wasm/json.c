@@ -344,7 +344,8 @@ typedef struct {
   int32_t *feature_ids;
   double *saliency;
   Array *feature_vertices;
-  void *compact; // a compact level (decode.c's Level, which wasm.ts reads), its counts above
+  int32_t compact, num_edges; // a compact level: its edges (decode.c's), for validate()
+  int32_t *a, *b, *g;
 } JsonLevel;
 typedef struct { int32_t level; float width, color[3], taper; Array points; } JsonStroke;
 typedef struct { const uint8_t *key; int32_t keyn; const uint8_t *value; int32_t valuen; } JsonEntry;
@@ -422,7 +423,7 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
     } else if (level->colors.n / 3 != level->positions.n / 2) {
       bad_start(&p), say("\"triangle_colors\" is absent, so color i belongs to vertex i, but there are "), say_number(AS_INTEGER, level->positions.n / 2),
         say(" vertices and "), say_number(AS_INTEGER, level->colors.n / 3), say(" colors"), say_fail();
-    }
+    } else level->triangle_colors = level->triangles; // a copy (wasm.ts copies each array out)
     const Node *o;
     field(m, &p, "creases", I32, 2, "[a, b] (two vertex indices)", 0, &level->creases);
     AT_KEY(pfe, &p, "features");
@@ -623,8 +624,18 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
           say_start(), say("level "), say_number(AS_INTEGER, l), say(" connectivity: "), say_number(AS_INTEGER, m), say(" bytes for "), say_number(AS_INTEGER, c[0]),
             say(" vertices (expected "), say_number(AS_INTEGER, expected), say(")"), say_fail();
       }
-      level->compact = compact(version, sections, ops, c[0], c[1], c[2], c[3], c[4], pb, cb, width, height, l);
-      level->positions.n = 2 * c[0], level->colors.n = 3 * c[1], level->triangles.n = 3 * c[2], level->creases.n = 2 * c[3], level->num_features = c[4];
+      // decode.c's Level, field by field (32-bit): positions, colors, triangles, triangleColors,
+      // creases, numFeatures, featureIds, featureOffsets, featureVertices, featureSaliency, then
+      // Edges: numEdges, a, b, f, g (decode.c asserts the layout)
+      const int32_t *L = (const int32_t *)compact(version, sections, ops, c[0], c[1], c[2], c[3], c[4], pb, cb, width, height, l);
+#define FIELD(k) ((void *)(uintptr_t)L[k])
+      level->positions = (Array){2 * c[0], FIELD(0)}, level->colors = (Array){3 * c[1], FIELD(1)}, level->triangles = (Array){3 * c[2], FIELD(2)};
+      level->triangle_colors = (Array){3 * c[2], FIELD(3)}, level->creases = (Array){2 * c[3], FIELD(4)};
+      level->num_features = c[4], level->feature_ids = FIELD(6), level->saliency = FIELD(9);
+      level->feature_vertices = (Array *)need_memory(NEW(Array, c[4] + 1));
+      const int32_t *offsets = FIELD(7), *vertices = FIELD(8);
+      for (int32_t k = 0; k < c[4]; ++k) level->feature_vertices[k] = (Array){offsets[k + 1] - offsets[k], (void *)(vertices + offsets[k])};
+      level->compact = 1, level->num_edges = L[10], level->a = FIELD(11), level->b = FIELD(12), level->g = FIELD(14);
       continue;
     }
     static const double MIN[] = {16, 12, 24, 8, 16};
