@@ -1,8 +1,15 @@
-// The .svec.json form (docs/format.md): a port of the JSON reader that decode.ts had, itself the
-// C++ reader's (src/io/svec_json.cpp) checks and messages: an exact tokenizer (duplicate keys,
-// integers vs numbers, depth 32, UTF-8, JSON.parse's escapes), then a walk that names the path of
-// each problem ("levels[0].triangles[12][1]: ..."). Numbers are parsed by JavaScript (Number()),
-// and written by it (message.h); the image-wide rules stay in JavaScript (validate.ts).
+// Reading files (docs/format.md), ports of what decode.ts had, itself the C++ reader's checks and
+// messages (src/io/svec_json.cpp, svec.cpp, svec_binary.cpp):
+// - the .svec.json form: an exact tokenizer (duplicate keys, integers vs numbers, depth 32,
+//   byte, line and column of a syntax error), then a walk that names the path of each problem
+//   ("levels[0].triangles[12][1]: ..."); numerals and string literals are JavaScript's to read
+//   (Number(), JSON.parse on strict UTF-8);
+// - the binary form: the header and the zstd frame's header and blocks (fzstd, in JavaScript,
+//   decompresses), then the payload: a cursor that names what it was reading, the version-1
+//   levels, the compact levels' counts and sections (decode.c decodes them), strokes, metadata
+//   and pyramid records.
+// Numbers in messages are written by JavaScript (message.h); the image-wide rules stay there
+// (validate.ts). wasm.ts reads the JsonImage back.
 #include "message.h"
 
 IMPORT(number) double js_number(const uint8_t *text, int32_t n);
