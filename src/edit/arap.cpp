@@ -122,6 +122,21 @@ struct ArapDeformer::Impl {
     }
   }
 
+  // Step 2's solve, per axis: the positions whose edges best match the right-hand sides `b`, with
+  // the fixed coordinates from `targets` (copied to `out` bit for bit).
+  void solve_edges(const Eigen::VectorXd (&b)[2], std::span<const Vec2> targets, std::span<Vec2> out) const {
+    const size_t n = rest.size();
+    for (int axis = 0; axis < 2; ++axis) {
+      Eigen::VectorXd x(static_cast<Eigen::Index>(n));
+      for (size_t v = 0; v < n; ++v) x[Eigen::Index(v)] = axis ? targets[v].y : targets[v].x;
+      scale[axis].solve(b[axis], x);
+      for (size_t v = 0; v < n; ++v) {
+        double& o = axis ? out[v].y : out[v].x;
+        o = has(fixed[v], axis) ? (axis ? targets[v].y : targets[v].x) : x[Eigen::Index(v)];
+      }
+    }
+  }
+
   Eigen::VectorXd step1(std::span<const Vec2> targets) const {
     const size_t n = rest.size();
     Eigen::VectorXd x(2 * n);
@@ -330,15 +345,7 @@ void ArapDeformer::solve(std::span<const Vec2> targets, std::span<Vec2> out,
       for (int axis = 0; axis < 2; ++axis) b[axis][a] -= e[axis], b[axis][c] += e[axis];
     }
   }
-  for (int axis = 0; axis < 2; ++axis) {
-    Eigen::VectorXd x(static_cast<Eigen::Index>(n));
-    for (size_t v = 0; v < n; ++v) x[Eigen::Index(v)] = axis ? targets[v].y : targets[v].x;
-    m.scale[axis].solve(b[axis], x);
-    for (size_t v = 0; v < n; ++v) {
-      double& o = axis ? out[v].y : out[v].x;
-      o = has(m.fixed[v], axis) ? (axis ? targets[v].y : targets[v].x) : x[Eigen::Index(v)];
-    }
-  }
+  m.solve_edges(b, targets, out);
 }
 
 double ArapDeformer::rigid_step(std::span<const Vec2> targets, std::span<const Vec2> current,
@@ -373,15 +380,7 @@ double ArapDeformer::rigid_step(std::span<const Vec2> targets, std::span<const V
       }
     }
   }
-  for (int axis = 0; axis < 2; ++axis) {
-    Eigen::VectorXd x(static_cast<Eigen::Index>(n));
-    for (size_t v = 0; v < n; ++v) x[Eigen::Index(v)] = axis ? targets[v].y : targets[v].x;
-    m.scale[axis].solve(b[axis], x);
-    for (size_t v = 0; v < n; ++v) {
-      double& o = axis ? out[v].y : out[v].x;
-      o = has(m.fixed[v], axis) ? (axis ? targets[v].y : targets[v].x) : x[Eigen::Index(v)];
-    }
-  }
+  m.solve_edges(b, targets, out);
   return energy;
 }
 

@@ -363,6 +363,14 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
                           num(w) + "] x [0, " + num(h) + "]");
       }
     };
+    // A move farther than the image is wide or high takes nothing anywhere (the frame holds every
+    // control point): it is a mistake, not an edit.
+    auto within_reach = [&](Vec2 t) {
+      if (!(std::abs(t.x) <= w && std::abs(t.y) <= h)) {
+        refuse(where, "\"translate\" " + point(t) + " is larger than the image (" + num(w) + " x " +
+                          num(h) + ")");
+      }
+    };
     ControlMesh mesh = image.levels[op.level];
     const MeshTopology topology = validate_level(mesh, image.width, image.height, op.level);
     auto pick_feature = [&](Vec2 p) {
@@ -383,6 +391,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           }
           Handles handles;
           if (op.kind == EditOp::Kind::kMoveVertices) {
+            within_reach(op.translate);
             handles = move_vertices(mesh, op.vertices, op.translate);
             done = std::to_string(op.vertices.size()) +
                    (op.vertices.size() == 1 ? " control point" : " control points") +
@@ -408,6 +417,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
             }
           } else {
             inside("at", op.at);
+            within_reach(op.translate);
             const FeaturePick pick = pick_feature(op.at);
             handles = move_feature(mesh, mesh.features[pick.feature], op.translate, op.rotate);
             done = feature_name(mesh, pick.feature) + " (" + num(pick.distance) +
