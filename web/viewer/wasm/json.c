@@ -413,7 +413,7 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
   image->width = (int32_t)field(top, 0, "width", I32, 0, 0, REQUIRED, 0), image->height = (int32_t)field(top, 0, "height", I32, 0, 0, REQUIRED, 0);
   const Node *items = list(need(top, 0, "levels"), &pl);
   if (items->n > MAX_LEVELS) bad_start(&pl), say_number(AS_INTEGER, items->n), say(" levels is over the limit of 64"), say_fail();
-  image->num_levels = items->n, image->levels = NEW(JsonLevel, items->n + 1);
+  image->num_levels = items->n, image->levels = (JsonLevel *)need_memory(NEW(JsonLevel, items->n + 1));
   int32_t l = 0;
   for (const Node *j = items->first; j; j = j->next, ++l) {
     AT_INDEX(p, &pl, l);
@@ -451,7 +451,6 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
     field(m, &p, "parent_vertices", I32, 0, 0, 0, &level->parents);
     field(m, &p, "collapses", I32, 2, "[removed, kept] (two vertex indices)", 0, &level->collapses);
   }
-  need_memory(image->levels);
   const Node *o;
   AT_KEY(ps, 0, "strokes");
   if ((o = find(top, "strokes"))) {
