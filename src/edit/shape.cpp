@@ -175,7 +175,8 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
   reached_ = 1;
   if (first_flip(result) >= 0) {
     // Repair: apply the scale adjustment only partly, v = s1 + lambda (s2 - s1), with the largest
-    // lambda (bisection, to 1/1024) that flips nothing. Refused when the similarity step flips.
+    // lambda (bisection, to 1/1024) that flips nothing. When the similarity step flips too, the
+    // fold-free path (below) takes over.
     if (first_flip(similarity_) >= 0) {
       fold_free(deformer, result);
       out = std::move(result);
