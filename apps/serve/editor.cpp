@@ -121,6 +121,8 @@ std::string edit_label(const EditOp& op) {
     case EditOp::Kind::kColor:
       return op.name() + (op.select == EditSelect::kVertices ? points(op.vertices.size()) : at(op.at));
     case EditOp::Kind::kMoveVertices: return "move" + points(op.vertices.size());
+    case EditOp::Kind::kAddFeature: return "new feature" + at(op.points.front());
+    case EditOp::Kind::kDeleteFeature: return "feature deleted" + at(op.at);
   }
   return op.name();
 }

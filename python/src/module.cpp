@@ -501,6 +501,41 @@ void def_edits(PyVectorImage& vi) {
           },
           "vertices"_a, "translate"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0)
       .def(
+          "add_feature",
+          [](VectorImage& v, const py::object& points, const std::string& kind, int level) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kAddFeature;
+            for (const py::handle p : points) {
+              std::array<double, 2> xy;
+              try {
+                xy = p.cast<std::array<double, 2>>();
+              } catch (const py::cast_error&) {
+                invalid("points must be a sequence of [x, y] pairs");
+              }
+              op.points.push_back(point(xy, "points"));
+            }
+            if (kind == "tear") {
+              op.feature_kind = subvec::FeatureKind::kTear;
+            } else if (kind == "crease") {
+              op.feature_kind = subvec::FeatureKind::kCrease;
+            } else {
+              invalid("kind must be 'tear' or 'crease', got '" + kind + "'");
+            }
+            op.level = level;
+            return apply_op(v, op);
+          },
+          "points"_a, py::kw_only(), "kind"_a = "tear", "level"_a = 0)
+      .def(
+          "delete_feature",
+          [](VectorImage& v, std::array<double, 2> at, int level) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kDeleteFeature;
+            op.at = point(at, "at");
+            op.level = level;
+            return apply_op(v, op);
+          },
+          "at"_a, py::kw_only(), "level"_a = 0)
+      .def(
           "recolor",
           [](VectorImage& v, std::optional<std::array<double, 2>> at, std::array<double, 3> color,
              const std::string& mode, const std::string& select, std::optional<double> radius,

@@ -116,6 +116,11 @@ class VectorImage:
                 amount: float = 0.5, level: int = 0) -> str: ...
     def move_vertices(self, vertices: npt.ArrayLike, translate: _Point, *, region: float = 0.0,
                       level: int = 0) -> str: ...
+    def add_feature(self, points: npt.ArrayLike, *, kind: Literal["tear", "crease"] = "tear",
+                    level: int = 0) -> str:
+        """A new tear (or crease) along the drawn polyline's C^2 fit; returns the log line."""
+    def delete_feature(self, at: _Point, *, level: int = 0) -> str:
+        """Deletes the feature nearest to `at`, joining its colors by a ramp; returns the log line."""
     def select_colors(self, at: _Point, *, select: Literal["vertex", "feature", "region"] = "vertex",
                       radius: float | None = None, tolerance: float | None = None,
                       level: int = 0) -> Selection: ...

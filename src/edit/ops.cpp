@@ -27,6 +27,7 @@ using detail::num;
 using Json = nlohmann::json;
 
 constexpr int kMaxDepth = 16;
+constexpr size_t kMaxDrawnPoints = 100000;  // add-feature's polyline
 
 std::string point(Vec2 p) { return "[" + num(p.x) + ", " + num(p.y) + "]"; }
 
@@ -145,8 +146,13 @@ EditOp parse_op(const Json& j, Place& at) {
     op.kind = EditOp::Kind::kColor;
   } else if (kind == "move-vertices") {
     op.kind = EditOp::Kind::kMoveVertices;
+  } else if (kind == "add-feature") {
+    op.kind = EditOp::Kind::kAddFeature;
+  } else if (kind == "delete-feature") {
+    op.kind = EditOp::Kind::kDeleteFeature;
   } else {
-    at.fail("unknown op \"" + printable(kind) + "\" (expected drag, move-feature, color or move-vertices)");
+    at.fail("unknown op \"" + printable(kind) +
+            "\" (expected drag, move-feature, color, move-vertices, add-feature or delete-feature)");
   }
   at.op = kind;
 
@@ -195,6 +201,33 @@ EditOp parse_op(const Json& j, Place& at) {
     }
   };
   switch (op.kind) {
+    case EditOp::Kind::kAddFeature: {
+      const Json& list = fields.required("points");
+      if (!list.is_array() || list.size() < 2) {
+        at.fail("points", std::string("expected an array of at least 2 points [x, y], got ") +
+                              (list.is_array() ? "an array of " + std::to_string(list.size()) + " elements"
+                                               : type_name(list)));
+      }
+      if (list.size() > kMaxDrawnPoints) {
+        at.fail("points", "more than " + std::to_string(kMaxDrawnPoints) + " points");
+      }
+      for (const Json& p : list) op.points.push_back(vec2(p, at, "points"));
+      if (const Json* k = fields.optional("kind")) {
+        const std::string v = string_value(*k, at, "kind");
+        if (v == "tear") {
+          op.feature_kind = FeatureKind::kTear;
+        } else if (v == "crease") {
+          op.feature_kind = FeatureKind::kCrease;
+        } else {
+          at.fail("kind", "expected \"tear\" or \"crease\", got \"" + printable(v) + "\"");
+        }
+      }
+      break;
+    }
+    case EditOp::Kind::kDeleteFeature:
+      op.select = EditSelect::kFeature;
+      op.at = vec2(fields.required("at"), at, "at");
+      break;
     case EditOp::Kind::kMoveVertices:
       region();
       vertex_list();
@@ -315,6 +348,10 @@ std::string EditOp::name() const {
       return mode == ColorMode::kBlend ? "color blend" : "color transform";
     case Kind::kMoveVertices:
       return "move-vertices";
+    case Kind::kAddFeature:
+      return "add-feature";
+    case Kind::kDeleteFeature:
+      return "delete-feature";
   }
   return "?";
 }
@@ -444,6 +481,27 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           }
           break;
         }
+        case EditOp::Kind::kAddFeature: {
+          for (const Vec2& p : op.points) inside("points", p);
+          const FeatureEditResult r = add_feature(mesh, image.width, image.height, op.points, op.feature_kind);
+          const int n = static_cast<int>(r.curve.points.size());
+          done = std::string(r.curve.closed ? "closed " : "") +
+                 (op.feature_kind == FeatureKind::kTear ? "tear " + feature_name(mesh, r.feature) : "crease") +
+                 " added: " + std::to_string(n) + " control points (fit within " + num(r.curve.deviation, 2) +
+                 " px of the " + std::to_string(op.points.size()) + " drawn), " +
+                 std::to_string(r.vertices_added) + " vertices added, " + std::to_string(r.flips) +
+                 " edges flipped, " + std::to_string(r.colors_refit) + " color values refitted";
+          break;
+        }
+        case EditOp::Kind::kDeleteFeature: {
+          inside("at", op.at);
+          const FeaturePick pick = pick_feature(op.at);
+          const std::string name = feature_name(mesh, pick.feature);
+          const FeatureEditResult r = delete_feature(mesh, image.width, image.height, pick.feature);
+          done = name + " (" + num(pick.distance) + " px away) deleted, " + std::to_string(r.colors_refit) +
+                 " color values refitted";
+          break;
+        }
         case EditOp::Kind::kColor: {
           if (op.select != EditSelect::kVertices) inside("at", op.at);
           const ColorSelection s = select_colors(mesh, topology, op.select, op.at, op.radius,
@@ -469,7 +527,13 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
     }
     // Strokes on the level follow a shape edit (issue 29): each point keeps its place in its
     // control triangle. All of the level's points go through one call (one point-location grid).
-    if (op.kind != EditOp::Kind::kColor) {
+    const bool topology_edit = op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature;
+    if (topology_edit && op.level + 1 < num_levels) {
+      // The next level's link to this one (its parents' numbering) no longer holds.
+      image.levels[op.level + 1].parent_vertices.clear();
+      image.levels[op.level + 1].collapses.clear();
+    }
+    if (op.kind != EditOp::Kind::kColor && !topology_edit) {
       int carried = 0;
       std::vector<Vec2> points;
       for (const Stroke& stroke : image.strokes) {

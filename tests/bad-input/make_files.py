@@ -372,6 +372,11 @@ def ops_files():
                                          "radius": 3, "color": [0, 0], "amount": 0.5}])
     ops("ops-infinity.json", '[{"op": "drag", "select": "vertex", "from": [48, 48], "to": [Infinity, 1]}]\n')
     ops("ops-number-overflow.json", '[{"op": "drag", "select": "vertex", "from": [48, 48], "to": [1e400, 1]}]\n')
+    ops("ops-add-feature-one-point.json", [{"op": "add-feature", "points": [[10, 10]]}])
+    ops("ops-add-feature-kind.json", [{"op": "add-feature", "points": [[10, 10], [20, 30]], "kind": "fold"}])
+    ops("ops-add-feature-crossing.json", [{"op": "add-feature", "points": [[5, 47.3], [91, 47.3]]}])
+    ops("ops-add-feature-outside.json", [{"op": "add-feature", "points": [[10, 10], [10, 1e9]]}])
+    ops("ops-delete-feature-outside.json", [{"op": "delete-feature", "at": [-3, 10]}])
     ops("ops-deep-nesting.json", "[" * 5000 + "]" * 5000 + "\n")
     ops("ops-duplicate-key.json", '[{"op": "drag", "op": "drag", "select": "vertex", "from": [1, 1], "to": [2, 2]}]\n')
 

@@ -269,6 +269,26 @@ def test_deform_never_folds_and_says_how_far_it_went():
     assert "dragged by" in line and _smallest_area(image) > 0
 
 
+def test_add_and_delete_features():
+    image = subvec.load(BUTTERFLY)
+    before = image.render()
+    count = len(image.mesh()["features"])
+    # A closed tear in the blurred green top-left corner: the picture barely changes.
+    t = np.linspace(0, 2 * np.pi, 60)
+    line = image.add_feature(np.stack([40 + 12 * np.cos(t), 60 + 12 * np.sin(t)], axis=1).tolist())
+    assert "closed tear feature" in line
+    features = image.mesh()["features"]
+    assert len(features) == count + 1 and features[-1]["closed"]
+    assert np.abs(image.render().astype(int) - before.astype(int)).mean() < 0.5
+    # Deleted again: the feature is gone.
+    assert "deleted" in image.delete_feature((52, 60))
+    assert len(image.mesh()["features"]) == count
+    with pytest.raises(ValueError, match="kind must be"):
+        image.add_feature([[10, 10], [20, 20]], kind="fold")
+    with pytest.raises(ValueError, match=r"\[x, y\] pairs"):
+        image.add_feature([[10, 10], "x"])
+
+
 def test_color_selection_blend_and_transform():
     image = subvec.load(BUTTERFLY)
     sel = image.select_colors((160, 175), radius=40)

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "subvec/edit/feature_edit.h"
 #include "subvec/edit/selection.h"
 #include "subvec/mesh/vector_image.h"
 
@@ -21,6 +22,8 @@ struct EditOp {
     kMoveFeature,  // at; translate, rotate (degrees)
     kColor,        // at; mode, select, radius, tolerance (region), color, amount (blend)
     kMoveVertices, // vertices, translate (the editor's direct handles)
+    kAddFeature,   // points, feature_kind (edit/feature_edit.h)
+    kDeleteFeature,// at: the nearest feature
   };
   Kind kind = Kind::kDrag;
   int level = 0;
@@ -37,9 +40,11 @@ struct EditOp {
   Color color;            // color: the new color, 0-255
   double amount = 0.5;    // color blend: 0 keeps the old color, 1 paints the new one
   std::vector<int32_t> vertices;  // move-vertices; color with select "vertices"
+  std::vector<Vec2> points;       // add-feature: the drawn polyline
+  FeatureKind feature_kind = FeatureKind::kTear;  // add-feature
 
   // "drag vertex", "drag feature", "move-feature", "color blend", "color transform",
-  // "move-vertices".
+  // "move-vertices", "add-feature", "delete-feature".
   std::string name() const;
 };
 
