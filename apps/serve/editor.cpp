@@ -31,6 +31,7 @@ struct Editor::View {
   int64_t version = 0;     // the document version it shows
   bool preview = false;    // it holds a drag preview's positions, not the document's
   double scale = 1;        // canvas pixels per image pixel (ViewRequest::scale)
+  uint64_t topology = 0;   // topology_key() of the level it refines
 };
 
 struct Editor::Session {
@@ -105,8 +106,23 @@ bool encode_moves(const std::vector<uint32_t>& indices, const std::vector<float>
   throw RequestError(status, e.what());
 }
 
-// apply_edit_ops names the operation of its ops file ("ops[0] (drag): ..."); the page applies one
-// operation at a time, so the prefix says nothing there.
+// A hash of what a view's refinement depends on besides positions and colors: the triangles,
+// their color corners, the creases and the feature chains. An edit that changes it (a feature
+// added or deleted, or the undo of one) makes the page fetch a new view.
+uint64_t topology_key(const ControlMesh& mesh) {
+  uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](int64_t v) { h = (h ^ static_cast<uint64_t>(v)) * 1099511628211ull; };
+  mix(mesh.num_vertices());
+  for (const subvec::Tri& t : mesh.triangles) mix(t[0]), mix(t[1]), mix(t[2]);
+  for (const subvec::Tri& t : mesh.triangle_colors) mix(t[0]), mix(t[1]), mix(t[2]);
+  for (const subvec::EdgeVerts& e : mesh.creases) mix(e[0]), mix(e[1]);
+  for (const subvec::Feature& f : mesh.features) {
+    mix(-1);
+    for (const int32_t v : f.vertices) mix(v);
+  }
+  return h;
+}
+
 // What an edit was, for the undo and redo messages: "color blend at (223, 262)".
 std::string edit_label(const EditOp& op) {
   const auto at = [](Vec2 p) {
@@ -127,6 +143,8 @@ std::string edit_label(const EditOp& op) {
   return op.name();
 }
 
+// apply_edit_ops names the operation of its ops file ("ops[0] (drag): ..."); the page applies one
+// operation at a time, so the prefix says nothing there.
 std::string without_op_prefix(const std::string& line) {
   if (line.rfind("ops[0] (", 0) != 0) return line;
   const size_t end = line.find("): ");
@@ -301,6 +319,7 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
       return same;
     }
     v->limit = subvec::view_mesh(image_, options);
+    v->topology = topology_key(image_.levels[request.level]);
   } catch (const Error& e) {
     const ErrorCode code = e.code();
     throw RequestError(code == ErrorCode::kInvalidArgument ? kBadRequest
@@ -389,6 +408,13 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
   if (!session.view) return delta;
   View& v = *session.view;
   const ControlMesh& mesh = image_.levels[v.mesh.level];
+  if (v.topology != topology_key(mesh)) {
+    // The view refines another mesh: the page fetches a new view and the control mesh.
+    delta.view_id = v.mesh.id;
+    delta.reload = true;
+    session.view.reset();
+    return delta;
+  }
   const std::vector<Vec2>& positions = preview ? *preview : mesh.positions;
   delta.view_id = v.mesh.id;
   v.version = version_;
@@ -767,14 +793,22 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(op.level);
-  if (op.kind != EditOp::Kind::kColor && op.kind != EditOp::Kind::kMoveVertices) {
-    throw RequestError(kBadRequest, "not a color edit or a move of control points");
+  if (op.kind != EditOp::Kind::kColor && op.kind != EditOp::Kind::kMoveVertices &&
+      op.kind != EditOp::Kind::kAddFeature && op.kind != EditOp::Kind::kDeleteFeature) {
+    throw RequestError(kBadRequest, "not a color edit, a move of control points or a feature edit");
   }
   VectorImage edited = image_;
+  std::vector<std::string> lines;
   try {
-    subvec::apply_edit_ops(edited, std::span(&op, 1));
+    lines = subvec::apply_edit_ops(edited, std::span(&op, 1));
   } catch (const Error& e) {
     refuse_edit(Error(e.code(), without_op_prefix(e.what())));
+  }
+  if (op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature) {
+    log = lines.empty() ? edit_label(op) : without_op_prefix(lines.front());
+    session.drag.reset();
+    commit_locked(std::move(edited), edit_label(op), session);
+    return delta_locked(session, nullptr, false);
   }
   if (op.kind == EditOp::Kind::kMoveVertices) {  // an arrow-key nudge
     const auto px = [](double v) { return std::to_string(std::lround(v)); };

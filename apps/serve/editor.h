@@ -101,6 +101,9 @@ struct Delta {
   std::vector<uint8_t> colors;
   std::vector<float> control_positions;  // #V x 2 of the view's level (for the overlay)
   bool strokes_changed = false;
+  // The level's topology changed (a feature added or deleted, or the undo of one): the view is
+  // gone, and the page fetches a new one and the control mesh. Nothing else is set.
+  bool reload = false;
   // A drag preview sends moves instead (a third of the bytes): `moved` has a bit per GL vertex
   // (bit g % 8 of byte g / 8), and `offsets` an (x, y) int16 pair per set bit, in steps of
   // 2^-offset_shift image pixels, to add to the position the page holds. The sum is exact in
@@ -218,7 +221,8 @@ class Editor {
                  std::string& log);
   void drag_cancel(const std::string& session);
 
-  // A color edit (op.kind == kColor) or a nudge of control points (kMoveVertices) through
+  // A color edit (op.kind == kColor), a nudge of control points (kMoveVertices) or a feature
+  // added or deleted (kAddFeature, kDeleteFeature: the delta then says reload) through
   // apply_edit_ops; the delta for the session's view, and `log`, the page's line: "color blend at
   // (50, 46): 34 control colors moved toward (0, 255, 0)", "moved 3 control points by (1, 0) px".
   Delta apply(const std::string& session, int64_t version, const subvec::EditOp& op,

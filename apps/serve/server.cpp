@@ -95,6 +95,7 @@ std::string delta_frame(const Delta& d, json header) {
   header["dense_positions"] = d.dense_positions;
   header["dense_colors"] = d.dense_colors;
   header["strokes_changed"] = d.strokes_changed;
+  header["reload"] = d.reload;
   return f.finish(std::move(header));
 }
 
@@ -729,6 +730,44 @@ void EditorServer::Impl::edit_routes() {
     }
     op.color = {c[0].get<float>(), c[1].get<float>(), c[2].get<float>()};
     op.amount = number(j, "amount", 0.5);
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+
+  // The pen tool: a new feature along the drawn points; and a feature deleted (issue 25).
+  server.Post("/api/feature/add", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kAddFeature;
+    op.level = small_int(j, "level", 0);
+    const json& points = field(j, "points");
+    if (!points.is_array() || points.size() < 2 || points.size() > 100000) {
+      throw RequestError(kBadRequest, "\"points\" must be an array of 2 to 100000 points [x, y]");
+    }
+    for (const json& p : points) {
+      if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+        throw RequestError(kBadRequest, "\"points\" must hold points [x, y]");
+      }
+      op.points.push_back({p[0].get<double>(), p[1].get<double>()});
+    }
+    const std::string kind = j.contains("kind") ? text(j, "kind") : "tear";
+    if (kind != "tear" && kind != "crease") throw RequestError(kBadRequest, "\"kind\" must be \"tear\" or \"crease\"");
+    op.feature_kind = kind == "tear" ? subvec::FeatureKind::kTear : subvec::FeatureKind::kCrease;
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
+                    "application/octet-stream");
+  });
+  server.Post("/api/feature/delete", [this](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kDeleteFeature;
+    op.level = small_int(j, "level", 0);
+    op.at = point(j, "at");
     std::shared_ptr<Editor> doc = ready_editor();
     std::string log;
     const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);

@@ -11,7 +11,7 @@
 import { ApiError, Frame, decodeMoves, getJson, postFrame, postJson } from './api';
 import { Renderer, Transform, softwareWebGL } from './gl';
 
-type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points';
+type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points' | 'pen';
 
 const TOOL_HELP: Record<Tool, string> = {
   pan: 'Pan: drag to move the view. The wheel zooms at the cursor with every tool; the image is re-refined for the new zoom when you stop.',
@@ -19,6 +19,7 @@ const TOOL_HELP: Record<Tool, string> = {
   drag: 'Drag (as-rigid-as-possible): press on a feature (or a vertex, with "vertex" picked) and drag. The part near where you grabbed follows the mouse (σ sets how far along the feature), and the whole mesh deforms as rigidly as possible around it; the image border stays in place.',
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
   points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Alt: draw a lasso; Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
+  pen: 'Pen: press and drag to draw a new feature; on release it becomes a tear along the smooth curve (a C² B-spline) through what you drew, and the image does not change until you edit one side (Shift held on release: a crease, continuous color with a corner in it). End near where you started to close it. Features cannot cross yet: stop at the other one. Delete removes the feature the Select tool picked.',
   color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
@@ -59,6 +60,9 @@ const state = {
   selection: [] as number[],     // the points tool's selected control vertices
   // A box (or, with Alt, a lasso: the pointer's path) being drawn with the points tool.
   box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean; lasso: [number, number][] | null },
+  pen: null as null | { pointer: number; points: [number, number][] },  // a pen stroke (canvas pixels)
+  picked: null as null | [number, number],  // where the Select tool last picked a feature
+  reload: false,  // an edit changed the level's topology: fetch the view and control mesh again
 };
 
 // A drag or move, from press to release. Its task (runDrag) holds the queue from the press
@@ -271,6 +275,11 @@ async function loadStrokes() {
 function applyDelta(frame: Frame) {
   const h = frame.header;
   if (typeof h.version === 'number') state.version = h.version;
+  if (h.reload) {
+    // The topology changed (a feature added or deleted, or its undo): runEdit fetches it all.
+    state.reload = true;
+    return;
+  }
   if (typeof h.offset_shift === 'number') {
     // A drag preview's moves, from the positions the page holds.
     if (h.view === state.view.id) {
@@ -364,6 +373,12 @@ async function runEdit(run: () => Promise<void | boolean>) {
   let drawn = false;
   try {
     drawn = (await run()) === true;
+    if (state.reload) {
+      state.reload = false;
+      drawn = false;
+      await loadDocument();
+      await Promise.all([fetchView(), loadControl(), loadStrokes()]);
+    }
     await refreshCounts();
   } catch (e) {
     drawn = false;
@@ -525,9 +540,11 @@ async function doSelect(at: [number, number]) {
     const r = await postJson('/api/select', { level: state.level, at, ...colorPick() });
     if (seq !== selectSeq) return;
     renderer.setHighlight(r.chain, r.region);
+    state.picked = r.feature >= 0 ? at : null;
     const what = r.feature >= 0 ? `the nearest feature, ${r.distance.toFixed(1)} px away (pink)`
       : r.vertex >= 0 ? `the nearest control point, ${r.distance.toFixed(1)} px away` : 'the region around the click';
-    status(`${what}; a color edit here changes the ${r.colors} control colors shown white`);
+    status(`${what}; a color edit here changes the ${r.colors} control colors shown white` +
+      (r.feature >= 0 ? '; Delete deletes the feature' : ''));
   } catch (e) {
     if (seq === selectSeq) status(e instanceof Error ? e.message : String(e), true);
   }
@@ -928,6 +945,67 @@ function dragEnd(e: PointerEvent | null, cancel = false) {
   drag.release(!cancel);
 }
 
+// The pen: the pointer's path, drawn over the canvas while it moves; on release, one edit that
+// adds the feature (the server fits the curve). A press released without moving draws nothing.
+function penDown(e: PointerEvent) {
+  state.pen = { pointer: e.pointerId, points: [canvasPoint(e)] };
+  canvas.setPointerCapture(e.pointerId);
+  drawPen();
+}
+function penMove(e: PointerEvent) {
+  const pen = state.pen;
+  if (!pen || e.pointerId !== pen.pointer) return;
+  const p = canvasPoint(e), last = pen.points[pen.points.length - 1];
+  const dpr = window.devicePixelRatio || 1;
+  if (Math.hypot(p[0] - last[0], p[1] - last[1]) < 2 * dpr) return;
+  pen.points.push(p);
+  drawPen();
+}
+function drawPen() {
+  const svg = $('pen-path'), pen = state.pen;
+  svg.style.display = pen ? 'block' : 'none';
+  if (!pen) return;
+  const dpr = window.devicePixelRatio || 1;
+  svg.querySelector('polyline')!.setAttribute('points', pen.points.map(([x, y]) => `${x / dpr},${y / dpr}`).join(' '));
+}
+function penEnd(e: PointerEvent | null, cancel = false) {
+  const pen = state.pen;
+  if (!pen || (e && e.pointerId !== pen.pointer)) return;
+  if (e && !cancel) penMove(e);
+  state.pen = null;
+  drawPen();
+  if (cancel) { status('pen stroke cancelled'); return; }
+  if (!state.doc) return;
+  const { width, height } = state.doc;
+  const points = pen.points.map((p) => {
+    const [x, y] = toImage(p);
+    return [Math.min(Math.max(x, 0), width), Math.min(Math.max(y, 0), height)];
+  });
+  let length = 0;
+  for (let i = 1; i < points.length; i++) length += Math.hypot(points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]);
+  if (points.length < 2 || length < 2) { status('a click: press and drag to draw a feature'); return; }
+  const kind = e?.shiftKey ? 'crease' : 'tear';
+  void edit(async () => {
+    const f = await postFrame('/api/feature/add', {
+      session: state.session, version: state.version, level: state.level, points, kind,
+    });
+    applyDelta(f);
+    state.picked = null;
+    status(f.header.log);
+  });
+}
+async function deletePicked() {
+  const at = state.picked;
+  if (!at) { status('pick a feature with the Select tool first (V), then press Delete'); return; }
+  state.picked = null;
+  await edit(async () => {
+    const f = await postFrame('/api/feature/delete', { session: state.session, version: state.version, level: state.level, at });
+    applyDelta(f);
+    renderer.setHighlight([], []);
+    status(f.header.log);
+  });
+}
+
 // ---- input ---------------------------------------------------------------------------------
 
 canvas.addEventListener('pointerdown', (e) => {
@@ -949,6 +1027,7 @@ canvas.addEventListener('pointerdown', (e) => {
   if (state.tool === 'select') void doSelect(at);
   else if (state.tool === 'color') void doColor(at, e.timeStamp || performance.now());
   else if (state.tool === 'points') pointsDown(e);
+  else if (state.tool === 'pen') penDown(e);
   else void dragStart(e);
 });
 canvas.addEventListener('pointermove', (e) => {
@@ -964,6 +1043,10 @@ canvas.addEventListener('pointermove', (e) => {
     state.fitted = false;
     redraw();
     scheduleView();
+    return;
+  }
+  if (state.pen) {
+    penMove(e);
     return;
   }
   if (state.box && e.pointerId === state.box.pointer) {
@@ -983,15 +1066,20 @@ const release = (e: PointerEvent) => {
     boxEnd(e);
     return;
   }
+  if (state.pen) {
+    penEnd(e);
+    return;
+  }
   dragEnd(e);
 };
 canvas.addEventListener('pointerup', release);
-canvas.addEventListener('pointercancel', (e) => { state.pan = null; boxEnd(e, true); dragEnd(e, true); });
+canvas.addEventListener('pointercancel', (e) => { state.pan = null; boxEnd(e, true); penEnd(e, true); dragEnd(e, true); });
 // A capture lost without a pointerup (the browser took it away): the drag ends there, so that its
 // task, which holds the queue, cannot wait for a release that never comes.
 canvas.addEventListener('lostpointercapture', (e) => {
   if (state.drag && e.pointerId === state.drag.pointer) dragEnd(e);
   if (state.box && e.pointerId === state.box.pointer) boxEnd(e);
+  if (state.pen && e.pointerId === state.pen.pointer) penEnd(e);
 });
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
 canvas.addEventListener('wheel', (e) => {
@@ -1029,7 +1117,7 @@ window.addEventListener('keydown', (e) => {
   }
   if (key === 'r') { recolorPoints(); return; }
   if (key === 'escape' && state.tool === 'points' && !state.drag && state.selection.length) { setSelection([]); status('selection cleared'); return; }
-  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points' };
+  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points', n: 'pen' };
   if (tools[key]) { setTool(tools[key]); return; }
   if (key === 'f') { toggleRadio('pick'); return; }
   if (key === 'b') { toggleRadio('mode'); return; }
@@ -1040,6 +1128,8 @@ window.addEventListener('keydown', (e) => {
   if (key === '2') { toggleCheck('show-features'); return; }
   if (key === '[') { void setLevel(state.level - 1); return; }
   if (key === ']') { void setLevel(state.level + 1); return; }
+  if ((key === 'delete' || key === 'backspace') && state.tool === 'select') { e.preventDefault(); void deletePicked(); return; }
+  if (key === 'escape' && state.pen) { penEnd(null, true); return; }
   if (key === 'escape' && state.drag) dragEnd(null, true);
 });
 window.addEventListener('keyup', (e) => {

@@ -380,6 +380,62 @@ TEST(ServeEditor, ViewIsUnweldedAtTearsAndColorDeltasAreSparse) {
   }
 }
 
+// The pen tool's edits (issue 25): a feature added and deleted through the editor equals `subvec
+// edit`'s, each changes the topology, so the delta tells the page to fetch a new view, and undo
+// and redo across them do the same.
+TEST(ServeEditor, FeatureEditsReloadTheViewAndUndo) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  editor.view(s, {0, 2});
+  subvec::EditOp add;
+  add.kind = subvec::EditOp::Kind::kAddFeature;
+  for (int i = 0; i <= 30; ++i) add.points.push_back({8 + 0.2 * i, 20 + 2.0 * i});  // left of the disk
+  std::string log;
+  Delta d = editor.apply(s, 1, add, log);
+  EXPECT_TRUE(d.reload);
+  EXPECT_NE(log.find("tear feature 1 (id 1) added"), std::string::npos) << log;
+  VectorImage reference = original;
+  subvec::apply_edit_ops(reference, std::span(&add, 1));
+  const VectorImage added = editor.snapshot().first;
+  EXPECT_EQ(added.levels[0].triangles, reference.levels[0].triangles);
+  EXPECT_EQ(added.levels[0].colors, reference.levels[0].colors);
+  ASSERT_EQ(added.levels[0].features.size(), 2u);
+  // A color edit on the fresh view is a plain delta again.
+  editor.view(s, {0, 2});
+  d = editor.apply(s, 2, color_op({48, 48}, {0, 255, 0}), log);
+  EXPECT_FALSE(d.reload);
+  EXPECT_GT(d.color_indices.size(), 0u);
+  subvec::EditOp del;
+  del.kind = subvec::EditOp::Kind::kDeleteFeature;
+  del.at = {10, 50};
+  d = editor.apply(s, 3, del, log);
+  EXPECT_TRUE(d.reload);
+  EXPECT_NE(log.find("feature 1 (id 1)"), std::string::npos) << log;
+  EXPECT_EQ(editor.snapshot().first.levels[0].features.size(), 1u);
+  std::string label;
+  editor.view(s, {0, 2});
+  d = editor.undo(s, 4, label);
+  EXPECT_TRUE(d.reload);
+  EXPECT_EQ(label, "feature deleted at (10, 50)");
+  EXPECT_EQ(editor.snapshot().first.levels[0].features.size(), 2u);
+  editor.undo(s, 5, label);  // the color edit: same topology, but the view went with the reload
+  editor.view(s, {0, 2});
+  d = editor.undo(s, 6, label);
+  EXPECT_TRUE(d.reload);
+  EXPECT_EQ(label, "new feature at (8, 20)");
+  EXPECT_EQ(editor.snapshot().first.levels[0].triangles, original.levels[0].triangles);
+  editor.view(s, {0, 2});
+  d = editor.redo(s, 7, label);
+  EXPECT_TRUE(d.reload);
+  EXPECT_EQ(editor.snapshot().first.levels[0].triangles, reference.levels[0].triangles);
+  // A curve across the disk's tear is refused, and nothing changes.
+  subvec::EditOp across = add;
+  across.points = {{10, 48}, {90, 48}};
+  EXPECT_EQ(status_of([&] { editor.apply(s, 8, across, log); }), kUnprocessable);
+  EXPECT_EQ(editor.version(), 8);
+}
+
 TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
   Editor editor(disk());
   const std::string s = editor.new_session();
