@@ -28,7 +28,10 @@ Handles drag_vertex(const ControlMesh& mesh, int vertex, Vec2 displacement) {
     invalid("vertex " + std::to_string(vertex) + " is out of range");
   }
   const Vec2 p = mesh.positions[vertex];
-  return {{vertex}, {{p.x + displacement.x, p.y + displacement.y}}};
+  Handles h;
+  h.vertices = {vertex};
+  h.targets = {{p.x + displacement.x, p.y + displacement.y}};
+  return h;
 }
 
 Handles move_vertices(const ControlMesh& mesh, std::span<const int32_t> vertices, Vec2 translate) {
@@ -64,6 +67,7 @@ Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 cente
   if (!(sigma > 0) || !std::isfinite(sigma)) invalid("sigma " + num(sigma) + " is not a positive number");
   Handles h;
   h.vertices = unique_vertices(feature);
+  h.center = center;
   for (int32_t v : h.vertices) {
     const Vec2 p = mesh.positions[v];
     const double d2 = (p.x - center.x) * (p.x - center.x) + (p.y - center.y) * (p.y - center.y);
@@ -98,10 +102,11 @@ ShapeEditor::ShapeEditor(const ControlMesh& mesh, int width, int height)
   }
 }
 
-const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, double region) {
+const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, double region,
+                                              std::optional<Vec2> center) {
   std::sort(handles.begin(), handles.end());
   for (auto it = cache_.begin(); it != cache_.end(); ++it) {
-    if (it->handles == handles && it->region == region) {
+    if (it->handles == handles && it->region == region && it->center == center) {
       cache_.splice(cache_.begin(), cache_, it);
       return *cache_.front().deformer;
     }
@@ -115,7 +120,12 @@ const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, doub
     const double r2 = region * region;
     for (size_t v = 0; v < rest_.size(); ++v) {
       bool near = false;
+      if (center) {
+        const double dx = rest_[v].x - center->x, dy = rest_[v].y - center->y;
+        near = dx * dx + dy * dy <= r2;
+      }
       for (int32_t h : handles) {
+        if (center) break;
         const double dx = rest_[v].x - rest_[h].x, dy = rest_[v].y - rest_[h].y;
         if (dx * dx + dy * dy <= r2) {
           near = true;
@@ -127,7 +137,7 @@ const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, doub
   }
   for (int32_t v : handles) fixed[v] = FixedAxes::kXY;
   auto deformer = std::make_shared<const ArapDeformer>(rest_, triangles_, fixed);
-  cache_.push_front({std::move(handles), region, std::move(deformer)});
+  cache_.push_front({std::move(handles), region, center, std::move(deformer)});
   if (cache_.size() > kCachedSets) cache_.pop_back();
   return *cache_.front().deformer;
 }
@@ -167,7 +177,10 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
   if (!(handles.region >= 0) || !std::isfinite(handles.region)) {
     invalid("the region " + num(handles.region) + " is not a number >= 0");
   }
-  const ArapDeformer& deformer = deformer_for(handles.vertices, handles.region);
+  if (handles.center && !(std::isfinite(handles.center->x) && std::isfinite(handles.center->y))) {
+    invalid("the region's centre is not finite");
+  }
+  const ArapDeformer& deformer = deformer_for(handles.vertices, handles.region, handles.center);
   std::vector<Vec2> result(rest_.size());
   similarity_.resize(rest_.size());
   deformer.solve(targets_, result, similarity_);

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <list>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -47,6 +48,11 @@ struct Handles {
   // > 0: only the part of the mesh within this Euclidean distance (pixels, rest positions) of a
   // handle deforms; farther vertices are pinned. 0: the whole mesh, held by the image frame.
   double region = 0;
+  // When set, the region is the disk of radius `region` around this point instead of around every
+  // handle. A feature drag sets it to the grab point: the far vertices of a long feature are
+  // handles that barely move (the Gaussian falloff), and the region around them would let the
+  // mesh near them deform beyond 3 sigma of the drag.
+  std::optional<Vec2> center;
 };
 
 // One vertex moved by `displacement`.
@@ -55,7 +61,8 @@ Handles drag_vertex(const ControlMesh& mesh, int vertex, Vec2 displacement);
 // Part of a feature dragged from `center` by `displacement` (paper §6.1): every vertex of the
 // feature moves by g * displacement with g = exp(-d^2 / (2 sigma^2)), d the Euclidean distance from
 // its rest position to `center`. All the feature's vertices are handles (far ones barely move, so
-// the rest of the feature holds its place). sigma > 0, pixels.
+// the rest of the feature holds its place); a region given later is centred on `center`
+// (Handles::center). sigma > 0, pixels.
 Handles drag_feature(const ControlMesh& mesh, const Feature& feature, Vec2 center,
                      Vec2 displacement, double sigma);
 
@@ -122,9 +129,10 @@ class ShapeEditor {
   struct Cached {
     std::vector<int32_t> handles;  // sorted
     double region = 0;
+    std::optional<Vec2> center;
     std::shared_ptr<const ArapDeformer> deformer;
   };
-  const ArapDeformer& deformer_for(std::vector<int32_t> handles, double region);
+  const ArapDeformer& deformer_for(std::vector<int32_t> handles, double region, std::optional<Vec2> center);
 
   std::vector<Vec2> rest_;
   std::vector<Tri> triangles_;
