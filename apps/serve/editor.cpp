@@ -42,6 +42,7 @@ struct Editor::Session {
     DragStart start;
     int64_t version = 0;
     int vertex = -1, feature = -1;
+    subvec::Feature chain;  // the feature or crease chain grabbed (edit/selection.h)
     std::unique_ptr<subvec::ShapeEditor> shape;
     std::vector<Vec2> preview;
     // The control positions the page holds (the drag's start, then each preview's moves).
@@ -546,14 +547,15 @@ SelectResult Editor::select(const SelectRequest& request) const {
       const Vec2 p = mesh.positions[result.vertex];
       result.distance = std::hypot(p.x - request.at.x, p.y - request.at.y);
     } else if (request.select == EditSelect::kFeature) {
-      const subvec::FeaturePick pick = subvec::nearest_feature(mesh, topology, request.at);
+      const std::vector<subvec::Feature> chains = subvec::editable_chains(mesh, topology);
+      const subvec::FeaturePick pick = subvec::nearest_feature(chains, mesh, topology, request.at);
       if (pick.feature < 0) {
         throw RequestError(kUnprocessable, "nothing to select: level " +
                                                std::to_string(request.level) + " has no features");
       }
       result.feature = pick.feature;
       result.distance = pick.distance;
-      result.chain = mesh.features[pick.feature].vertices;
+      result.chain = chains[pick.feature].vertices;
     }
     const subvec::ColorSelection colors = subvec::select_colors(
         mesh, topology, request.select, request.at, request.radius, request.tolerance);
@@ -604,20 +606,23 @@ SelectResult Editor::drag_start(const std::string& session_id, int64_t version,
     result.vertex = drag->vertex;
   } else {
     const MeshTopology topology = MeshTopology::build(mesh, image_.width, image_.height);
-    const subvec::FeaturePick pick = subvec::nearest_feature(mesh, topology, drag->start.at);
+    const std::vector<subvec::Feature> chains = subvec::editable_chains(mesh, topology);
+    const subvec::FeaturePick pick = subvec::nearest_feature(chains, mesh, topology, drag->start.at);
     if (pick.feature < 0) {
       throw RequestError(kUnprocessable, "nothing to select: level " +
                                              std::to_string(start.level) + " has no features");
     }
     drag->feature = pick.feature;
+    drag->chain = chains[pick.feature];
     result.feature = pick.feature;
     result.distance = pick.distance;
-    result.chain = mesh.features[pick.feature].vertices;
+    result.chain = drag->chain.vertices;
   }
   // What the user left to the editor: an extent local to what was grabbed.
   if (start.auto_sigma || start.auto_region) {
-    const subvec::DragExtent e = points ? subvec::suggested_drag_extent(mesh, start.vertices)
-                                        : subvec::suggested_drag_extent(mesh, drag->feature, drag->vertex);
+    const subvec::DragExtent e = points              ? subvec::suggested_drag_extent(mesh, start.vertices)
+                                 : drag->vertex >= 0 ? subvec::suggested_drag_extent(mesh, -1, drag->vertex)
+                                                     : subvec::suggested_drag_extent(mesh, drag->chain);
     if (start.auto_sigma) drag->start.sigma = e.sigma;
     if (start.auto_region) drag->start.region = e.region;
   }
@@ -668,12 +673,11 @@ Delta Editor::drag_move_locked(Session& session, Vec2 to, double rotate) {
   if (!drag.start.vertices.empty()) {
     handles = subvec::move_vertices(mesh, drag.start.vertices, d);
   } else if (drag.start.move_feature) {
-    handles = subvec::move_feature(mesh, mesh.features[drag.feature], d, rotate);
+    handles = subvec::move_feature(mesh, drag.chain, d, rotate);
   } else if (drag.vertex >= 0) {
     handles = subvec::drag_vertex(mesh, drag.vertex, d);
   } else {
-    handles = subvec::drag_feature(mesh, mesh.features[drag.feature], drag.start.at, d,
-                                   drag.start.sigma);
+    handles = subvec::drag_feature(mesh, drag.chain, drag.start.at, d, drag.start.sigma);
   }
   handles.region = drag.start.region;
   try {

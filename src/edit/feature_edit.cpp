@@ -174,7 +174,7 @@ double deviation(const Resampled& r, const std::vector<Vec2>& p, bool closed) {
 
 }  // namespace
 
-CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolerance) {
+CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolerance, bool may_close) {
   detail::check_positive("spacing", spacing);
   detail::check_positive("tolerance", tolerance);
   std::vector<Vec2> poly;
@@ -189,7 +189,7 @@ CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolera
   if (r.length < kMinLength) {
     invalid("the drawn curve is " + num(r.length, 3) + " px long, shorter than " + num(kMinLength) + " px");
   }
-  fit.closed = poly.size() > 3 && gap <= kCloseDistance && r.length > 4 * kCloseDistance;
+  fit.closed = may_close && poly.size() > 3 && gap <= kCloseDistance && r.length > 4 * kCloseDistance;
   if (fit.closed) {
     poly.back() = poly.front();
     r = resample(poly);
@@ -284,28 +284,38 @@ class Editable {
     return nv;
   }
 
-  // Splits the smooth or border edge (a, b) at p = a + s (b - a); returns the new vertex.
+  // Splits the edge (a, b) at p = a + s (b - a); returns the new vertex. Each side of an interior
+  // edge gets its own new color value, interpolated on that side: equal values across a smooth
+  // edge or a crease (the caller merges them with face_varying_indices), different across a tear.
+  // A sharp edge's two halves stay sharp.
   int split_edge(int a, int b, double s) {
     int t1 = triangle_of(a, b), t2 = triangle_of(b, a);
     if (t1 < 0) std::swap(a, b), std::swap(t1, t2), s = 1 - s;
     const Vec2 pa = m_.positions[a], pb = m_.positions[b];
     const int nv = add_vertex({pa.x + s * (pb.x - pa.x), pa.y + s * (pb.y - pa.y)});
     const int n = m_.num_triangles();
-    {
-      const int k = corner(t1, a);
-      const Tri v = m_.triangles[t1], c = m_.triangle_colors[t1];
-      const int ca = c[k], cb = c[(k + 1) % 3], cc = c[(k + 2) % 3], vc = v[(k + 2) % 3];
-      const int nc = add_color(mix({ca, cb, 0}, {1 - s, s, 0}));
-      set(t1, {a, nv, vc}, {ca, nc, cc});
-      set(n, {nv, b, vc}, {nc, cb, cc});
-      if (t2 >= 0) {
-        const int j = corner(t2, b);
-        const Tri w = m_.triangles[t2], e = m_.triangle_colors[t2];
-        const int vd = w[(j + 2) % 3], cd = e[(j + 2) % 3];
-        // A smooth edge: the corners of a and b are the same values on both sides.
-        set(t2, {b, nv, vd}, {cb, nc, cd});
-        set(n + 1, {nv, a, vd}, {nc, ca, cd});
-      }
+    const int k = corner(t1, a);
+    const Tri v = m_.triangles[t1], c = m_.triangle_colors[t1];
+    const int ca = c[k], cb = c[(k + 1) % 3], cc = c[(k + 2) % 3], vc = v[(k + 2) % 3];
+    const int nc = add_color(mix({ca, cb, 0}, {1 - s, s, 0}));
+    int j = -1, vd = -1, cd = -1, ca2 = -1, cb2 = -1, nc2 = -1;
+    if (t2 >= 0) {
+      j = corner(t2, b);
+      vd = m_.triangles[t2][(j + 2) % 3];
+      cb2 = m_.triangle_colors[t2][j], ca2 = m_.triangle_colors[t2][(j + 1) % 3], cd = m_.triangle_colors[t2][(j + 2) % 3];
+      nc2 = add_color(mix({ca2, cb2, 0}, {1 - s, s, 0}));
+    }
+    set(t1, {a, nv, vc}, {ca, nc, cc});
+    set(n, {nv, b, vc}, {nc, cb, cc});
+    if (t2 >= 0) {
+      set(t2, {b, nv, vd}, {cb2, nc2, cd});
+      set(n + 1, {nv, a, vd}, {nc2, ca2, cd});
+    }
+    auto it = sharp_.find(undirected(a, b));
+    if (it != sharp_.end()) {
+      const int value = it->second;
+      sharp_.erase(it);
+      sharp_[undirected(a, nv)] = sharp_[undirected(nv, b)] = value;
     }
     return nv;
   }
@@ -390,7 +400,11 @@ class Editable {
   std::unordered_map<uint64_t, int> sharp_;
 };
 
+// The sharp value of the new curve's own edges.
+constexpr int kDrawn = 1 << 30;
+
 std::string sharp_name(const ControlMesh& mesh, int value) {
+  if (value == kDrawn) return "itself";
   if (value == 0) return "a crease";
   return "feature " + std::to_string(value - 1) + " (id " + std::to_string(mesh.features[value - 1].id) + ")";
 }
@@ -452,7 +466,7 @@ void recover_edge(Editable& e, int a, int b) {
       const int s = e.sharp_at(v);
       invalid("the curve " + (s >= 0 ? "crosses " + sharp_name(m, s) + " at" : std::string("passes through")) +
               " control vertex " + std::to_string(v) + " " + point(m.positions[v]) +
-              (s >= 0 ? "; features cannot cross yet, so draw it up to the other one" : ""));
+              (s >= 0 ? " (draw it across between two control points)" : ""));
     }
   }
   std::vector<EdgeVerts> crossing;
@@ -468,7 +482,7 @@ void recover_edge(Editable& e, int a, int b) {
         const double x = orient(pa, pb, pu) / den;
         invalid("the curve crosses " + (s >= 0 ? sharp_name(m, s) : std::string("the image border")) + " near " +
                 point({pu.x + x * (pv.x - pu.x), pu.y + x * (pv.y - pu.y)}) +
-                "; features cannot cross yet, so draw it up to the other one");
+                (s >= 0 && s != kDrawn ? " between two of its control points (draw it more steeply across)" : ""));
       }
       crossing.push_back({u, v});
     }
@@ -679,20 +693,118 @@ double mean_edge_near(const ControlMesh& mesh, std::span<const Vec2> points) {
 
 }  // namespace
 
-FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::span<const Vec2> polyline,
-                              FeatureKind kind) {
-  const MeshTopology before = validate_level(mesh_in, width, height);
-  FeatureEditResult result;
-  for (const Vec2& p : polyline)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) invalid("the drawn curve has a point that is not finite");
-  const double spacing = std::clamp(mean_edge_near(mesh_in, polyline), 3.0, 30.0);
-  result.curve = fit_curve(polyline, spacing);
-  std::vector<Vec2> points = result.curve.points;
-  // The frame: ends within 1 px of the border go onto it; every other point stays inside.
+namespace {
+
+// Where a drawn polyline meets an existing feature or crease: its arc length along the polyline,
+// the point, and the sharp edge (a, b) it lies on.
+struct Junction {
+  double s = 0;
+  Vec2 at;
+  int32_t a = -1, b = -1;
+};
+
+// The sharp interior edges of the mesh (feature chains, creases).
+std::vector<EdgeVerts> sharp_edges(const ControlMesh& mesh) {
+  std::vector<EdgeVerts> out = mesh.creases;
+  for (const Feature& f : mesh.features)
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i) out.push_back({f.vertices[i], f.vertices[i + 1]});
+  return out;
+}
+
+// The junctions of `poly` with the mesh's sharp edges: every crossing, and an open end within
+// kJoinDistance of a sharp edge (the end then moves onto it). Sorted along the polyline; one per
+// kJoinDistance of arc length.
+std::vector<Junction> find_junctions(const ControlMesh& mesh, std::vector<Vec2>& poly, bool closed) {
+  const std::vector<EdgeVerts> sharp = sharp_edges(mesh);
+  std::vector<Junction> out;
+  std::vector<double> arc{0};
+  for (size_t i = 1; i < poly.size(); ++i)
+    arc.push_back(arc.back() + std::hypot(poly[i].x - poly[i - 1].x, poly[i].y - poly[i - 1].y));
+  for (size_t i = 0; i + 1 < poly.size(); ++i) {
+    const Vec2 p = poly[i], q = poly[i + 1];
+    for (const EdgeVerts& e : sharp) {
+      const Vec2 a = mesh.positions[e[0]], b = mesh.positions[e[1]];
+      if (std::max(a.x, b.x) < std::min(p.x, q.x) || std::min(a.x, b.x) > std::max(p.x, q.x) ||
+          std::max(a.y, b.y) < std::min(p.y, q.y) || std::min(a.y, b.y) > std::max(p.y, q.y) || !crosses(p, q, a, b)) {
+        continue;
+      }
+      const double t = orient(a, b, p) / (orient(a, b, p) - orient(a, b, q));
+      out.push_back({arc[i] + t * (arc[i + 1] - arc[i]), {p.x + t * (q.x - p.x), p.y + t * (q.y - p.y)}, e[0], e[1]});
+    }
+  }
+  // A segment through a vertex of a chain meets it there.
+  std::vector<int32_t> chain_vertices;
+  for (const EdgeVerts& e : sharp) chain_vertices.push_back(e[0]), chain_vertices.push_back(e[1]);
+  std::sort(chain_vertices.begin(), chain_vertices.end());
+  chain_vertices.erase(std::unique(chain_vertices.begin(), chain_vertices.end()), chain_vertices.end());
+  for (size_t i = 0; i + 1 < poly.size(); ++i) {
+    const Vec2 p = poly[i], q = poly[i + 1];
+    const double len = std::hypot(q.x - p.x, q.y - p.y);
+    for (const int32_t w : chain_vertices) {
+      const Vec2 c = mesh.positions[w];
+      Vec2 foot;
+      if (detail::segment_distance(c, p, q, &foot) >= 1e-6 * std::max(1.0, len)) continue;
+      const double t = len > 0 ? std::hypot(foot.x - p.x, foot.y - p.y) / len : 0;
+      out.push_back({arc[i] + t * (arc[i + 1] - arc[i]), c, w, w});
+    }
+  }
+  // Ends near a feature or crease join it.
+  auto join_end = [&](bool last) {
+    const Vec2 p = last ? poly.back() : poly.front();
+    double best = kJoinDistance;
+    Junction j;
+    for (const EdgeVerts& e : sharp) {
+      Vec2 q;
+      const double d = detail::segment_distance(p, mesh.positions[e[0]], mesh.positions[e[1]], &q);
+      if (d < best) best = d, j = {last ? arc.back() : 0.0, q, e[0], e[1]};
+    }
+    if (j.a < 0) return;
+    for (const Junction& k : out)
+      if (std::abs(k.s - j.s) < kJoinDistance) return;  // it crosses there already
+    (last ? poly.back() : poly.front()) = j.at;
+    out.push_back(j);
+  };
+  if (!closed) join_end(false), join_end(true);
+  std::sort(out.begin(), out.end(), [](const Junction& x, const Junction& y) { return x.s < y.s; });
+  std::vector<Junction> kept;
+  for (const Junction& j : out)
+    if (kept.empty() || j.s - kept.back().s >= kJoinDistance) kept.push_back(j);
+  return kept;
+}
+
+// The part of `poly` between arc lengths s0 and s1, its ends interpolated.
+std::vector<Vec2> sub_polyline(const std::vector<Vec2>& poly, double s0, double s1) {
+  std::vector<Vec2> out;
+  double arc = 0;
+  auto at = [&](size_t i, double s) {
+    const double len = std::hypot(poly[i + 1].x - poly[i].x, poly[i + 1].y - poly[i].y);
+    const double t = len > 0 ? std::clamp((s - arc) / len, 0.0, 1.0) : 0;
+    return Vec2{poly[i].x + t * (poly[i + 1].x - poly[i].x), poly[i].y + t * (poly[i + 1].y - poly[i].y)};
+  };
+  for (size_t i = 0; i + 1 < poly.size(); ++i) {
+    const double len = std::hypot(poly[i + 1].x - poly[i].x, poly[i + 1].y - poly[i].y);
+    if (arc + len >= s0 && arc <= s1) {
+      if (out.empty()) out.push_back(at(i, s0));
+      if (arc + len <= s1) {
+        out.push_back(poly[i + 1]);
+      } else {
+        out.push_back(at(i, s1));
+        break;
+      }
+    }
+    arc += len;
+  }
+  return out;
+}
+
+// Puts control points in the frame: an open curve's end within 1 px of the border goes onto it
+// (unless it is a junction); every other point stays kMargin inside.
+void frame_points(std::vector<Vec2>& points, bool closed, bool first_fixed, bool last_fixed, int width, int height) {
   constexpr double kMargin = 0.25;
   for (size_t i = 0; i < points.size(); ++i) {
     Vec2& p = points[i];
-    const bool end = !result.curve.closed && (i == 0 || i + 1 == points.size());
+    if ((i == 0 && first_fixed) || (i + 1 == points.size() && last_fixed)) continue;
+    const bool end = !closed && (i == 0 || i + 1 == points.size());
     if (end) {
       const double dx = std::min(p.x, width - p.x), dy = std::min(p.y, height - p.y);
       if (std::min(dx, dy) <= 1.0) {
@@ -704,57 +816,185 @@ FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::
     }
     p.x = std::clamp(p.x, kMargin, width - kMargin), p.y = std::clamp(p.y, kMargin, height - kMargin);
   }
-  // The control polygon must not cross itself.
-  const size_t spans = result.curve.closed ? points.size() : points.size() - 1;
+  const size_t spans = closed ? points.size() : points.size() - 1;
   for (size_t i = 0; i < spans; ++i)
     for (size_t j = i + 2; j < spans; ++j) {
-      if (result.curve.closed && i == 0 && j == spans - 1) continue;
+      if (closed && i == 0 && j == spans - 1) continue;
       if (crosses(points[i], points[(i + 1) % points.size()], points[j], points[(j + 1) % points.size()])) {
         invalid("the drawn curve crosses itself near " + point(points[j]));
       }
     }
+}
+
+// Splits the sharp edge of the junction in the mesh and in the chain (feature or creases) that
+// holds it; returns the new vertex, a corner where the new curve meets the old one.
+int insert_junction(Editable& e, const Junction& j) {
+  ControlMesh& m = e.mesh();
+  // The edge may have been split by an earlier junction: the piece of it that holds the point.
+  int a = -1, b = -1;
+  double best = std::numeric_limits<double>::infinity();
+  for (const EdgeVerts& edge : sharp_edges(m)) {
+    const double d = detail::segment_distance(j.at, m.positions[edge[0]], m.positions[edge[1]]);
+    if (d < best) best = d, a = edge[0], b = edge[1];
+  }
+  const Vec2 pa = m.positions[a], pb = m.positions[b];
+  for (const int v : {a, b})
+    if (std::hypot(m.positions[v].x - j.at.x, m.positions[v].y - j.at.y) < 1e-3) return v;  // on a vertex
+  const double len2 = (pb.x - pa.x) * (pb.x - pa.x) + (pb.y - pa.y) * (pb.y - pa.y);
+  const double t = std::clamp(((j.at.x - pa.x) * (pb.x - pa.x) + (j.at.y - pa.y) * (pb.y - pa.y)) / len2, 1e-3, 1 - 1e-3);
+  const int nv = e.split_edge(a, b, t);
+  for (Feature& f : m.features)
+    for (size_t i = 0; i + 1 < f.vertices.size(); ++i)
+      if ((f.vertices[i] == a && f.vertices[i + 1] == b) || (f.vertices[i] == b && f.vertices[i + 1] == a)) {
+        f.vertices.insert(f.vertices.begin() + long(i) + 1, nv);
+        return nv;
+      }
+  for (size_t i = 0; i < m.creases.size(); ++i) {
+    const EdgeVerts c = m.creases[i];
+    if ((c[0] == a && c[1] == b) || (c[0] == b && c[1] == a)) {
+      m.creases[i] = {c[0], nv};
+      m.creases.push_back({nv, c[1]});
+      return nv;
+    }
+  }
+  return nv;
+}
+
+}  // namespace
+
+FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::span<const Vec2> polyline,
+                              FeatureKind kind) {
+  const MeshTopology before = validate_level(mesh_in, width, height);
+  FeatureEditResult result;
+  for (const Vec2& p : polyline)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) invalid("the drawn curve has a point that is not finite");
+  const double spacing = std::clamp(mean_edge_near(mesh_in, polyline), 3.0, 30.0);
+  result.curve = fit_curve(polyline, spacing);
+
+  // The pieces between junctions with existing features: each its own fit, ending on them.
+  std::vector<Vec2> poly;
+  for (const Vec2& q : polyline)
+    if (poly.empty() || std::hypot(q.x - poly.back().x, q.y - poly.back().y) > 1e-9) poly.push_back(q);
+  if (result.curve.closed) poly.back() = poly.front();
+  std::vector<Junction> junctions = find_junctions(mesh_in, poly, result.curve.closed);
+  // A closed drawing that meets features starts and ends at its first junction.
+  const bool loop = result.curve.closed && !junctions.empty();
+  if (loop) {
+    const Junction start = junctions.front();
+    double total = 0;
+    for (size_t i = 1; i < poly.size(); ++i) total += std::hypot(poly[i].x - poly[i - 1].x, poly[i].y - poly[i - 1].y);
+    std::vector<Vec2> turned = sub_polyline(poly, start.s, total);
+    const std::vector<Vec2> rest = sub_polyline(poly, 0, start.s);
+    turned.insert(turned.end(), rest.begin() + 1, rest.end());
+    turned.front() = turned.back() = start.at;
+    poly = std::move(turned);
+    junctions = find_junctions(mesh_in, poly, true);
+    double length = 0;
+    for (size_t i = 1; i < poly.size(); ++i) length += std::hypot(poly[i].x - poly[i - 1].x, poly[i].y - poly[i - 1].y);
+    std::erase_if(junctions, [&](const Junction& j) { return j.s < kJoinDistance || j.s > length - kJoinDistance; });
+    junctions.insert(junctions.begin(), Junction{0.0, start.at, start.a, start.b});
+  }
+  struct Piece {
+    CurveFit fit;
+    int first = -1, last = -1;  // junction indices at its ends, -1: free
+  };
+  std::vector<Piece> pieces;
+  if (junctions.empty()) {
+    pieces.push_back({result.curve, -1, -1});
+  } else {
+    double length = 0;
+    for (size_t i = 1; i < poly.size(); ++i) length += std::hypot(poly[i].x - poly[i - 1].x, poly[i].y - poly[i - 1].y);
+    std::vector<double> cuts{0};
+    for (size_t k = loop ? 1 : 0; k < junctions.size(); ++k) cuts.push_back(junctions[k].s);
+    cuts.push_back(length);
+    for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+      const double s0 = cuts[k], s1 = cuts[k + 1];
+      if (s1 - s0 < kMinLength) continue;
+      // Piece k runs from cut k to cut k + 1: junction k - 1 to junction k (an end of the
+      // polyline at either end of the list; a junction at an end leaves an empty piece there).
+      std::vector<Vec2> part = sub_polyline(poly, s0, s1);
+      // (A loop's junction 0 is both ends: piece k then runs from junction k to k + 1, or 0.)
+      const int n = static_cast<int>(junctions.size());
+      const int first = loop ? int(k) : k == 0 ? -1 : int(k) - 1;
+      const int last = loop ? (int(k) + 1) % n : int(k) < n ? int(k) : -1;
+      if (first >= 0) part.front() = junctions[first].at;
+      if (last >= 0) part.back() = junctions[last].at;
+      Piece piece;
+      piece.fit = fit_curve(part, spacing, 0.5, false);
+      piece.first = first, piece.last = last;
+      pieces.push_back(std::move(piece));
+    }
+    if (pieces.empty()) invalid("the drawn curve is too short between the features it meets");
+    result.curve = pieces.front().fit;
+  }
 
   ControlMesh mesh = mesh_in;
   mesh.parent_vertices.clear(), mesh.collapses.clear();
   const int old_vertices = mesh.num_vertices();
   Editable e(mesh, width, height);
-  std::vector<int32_t> chain;
-  for (const Vec2& p : points) {
-    const int v = insert_point(e, p);
-    if (v < old_vertices) {
-      const Vec2 q = mesh.positions[v];
-      const bool corner = (q.x == 0 || q.x == width) && (q.y == 0 || q.y == height);
-      if (!corner) invalid("the curve's control point " + point(p) + " falls on control vertex " + std::to_string(v));
+  std::vector<int> junction_vertex(junctions.size(), -1);
+  auto junction_at = [&](int j) {
+    if (junction_vertex[j] < 0) junction_vertex[j] = insert_junction(e, junctions[j]);
+    return junction_vertex[j];
+  };
+  std::vector<std::vector<int32_t>> chains;
+  for (Piece& piece : pieces) {
+    std::vector<Vec2>& points = piece.fit.points;
+    frame_points(points, piece.fit.closed, piece.first >= 0, piece.last >= 0, width, height);
+    std::vector<int32_t> chain;
+    for (size_t i = 0; i < points.size(); ++i) {
+      int v;
+      if (i == 0 && piece.first >= 0) {
+        v = junction_at(piece.first);
+      } else if (i + 1 == points.size() && piece.last >= 0) {
+        v = junction_at(piece.last);
+      } else {
+        // A control point on an existing vertex (to 1e-6 px) takes it, unless a feature or a
+        // crease holds it already (the drawing would touch that one without a junction).
+        v = insert_point(e, points[i]);
+        if (v < old_vertices && e.sharp_at(v) >= 0) {
+          invalid("the curve's control point " + point(points[i]) + " falls on control vertex " + std::to_string(v) +
+                  " of " + sharp_name(mesh, e.sharp_at(v)));
+        }
+      }
+      const bool closes = i + 1 == points.size() && i > 1 && v == chain.front();  // a loop on one junction
+      if (!closes && std::find(chain.begin(), chain.end(), v) != chain.end()) {
+        invalid("the curve's control points " + point(points[i]) + " repeat a vertex");
+      }
+      chain.push_back(v);
     }
-    if (std::find(chain.begin(), chain.end(), v) != chain.end()) {
-      invalid("the curve's control points " + point(p) + " repeat a vertex");
-    }
-    chain.push_back(v);
+    if (piece.fit.closed) chain.push_back(chain.front());
+    chains.push_back(std::move(chain));
   }
-  if (result.curve.closed) chain.push_back(chain.front());
-  for (size_t i = 0; i + 1 < chain.size(); ++i) {
-    recover_edge(e, chain[i], chain[i + 1]);
-    if (e.triangle_of(chain[i + 1], chain[i]) < 0 || e.triangle_of(chain[i], chain[i + 1]) < 0) {
-      invalid("the curve runs along the image border near " + point(mesh.positions[chain[i]]));
+  for (const std::vector<int32_t>& chain : chains) {
+    for (size_t i = 0; i + 1 < chain.size(); ++i) {
+      recover_edge(e, chain[i], chain[i + 1]);
+      if (e.triangle_of(chain[i + 1], chain[i]) < 0 || e.triangle_of(chain[i], chain[i + 1]) < 0) {
+        invalid("the curve runs along the image border near " + point(mesh.positions[chain[i]]));
+      }
+      e.mark(chain[i], chain[i + 1], kDrawn);  // kept by the flips that follow
     }
-    e.mark(chain[i], chain[i + 1], 0);  // kept by the flips that follow
   }
   make_delaunay(e);
   result.flips = e.flips;
   result.vertices_added = mesh.num_vertices() - old_vertices;
+  result.pieces = static_cast<int>(chains.size());
+  result.junctions = static_cast<int>(std::count_if(junction_vertex.begin(), junction_vertex.end(), [](int v) { return v >= 0; }));
 
   int32_t id = 0;
   for (const Feature& f : mesh.features) id = std::max(id, f.id + 1);
-  if (kind == FeatureKind::kTear) {
-    Feature f;
-    f.id = id;
-    f.vertices = chain;
-    mesh.features.push_back(std::move(f));
-    result.feature = static_cast<int>(mesh.features.size()) - 1;
-    result.id = id;
-  } else {
-    for (size_t i = 0; i + 1 < chain.size(); ++i) mesh.creases.push_back({chain[i], chain[i + 1]});
+  for (const std::vector<int32_t>& chain : chains) {
+    if (kind == FeatureKind::kTear) {
+      Feature f;
+      f.id = id++;
+      f.vertices = chain;
+      mesh.features.push_back(std::move(f));
+      if (result.feature < 0) result.feature = static_cast<int>(mesh.features.size()) - 1;
+    } else {
+      for (size_t i = 0; i + 1 < chain.size(); ++i) mesh.creases.push_back({chain[i], chain[i + 1]});
+    }
   }
+  if (kind == FeatureKind::kTear) result.id = mesh.features[result.feature].id;
   const MeshTopology topology = MeshTopology::build(mesh, width, height);
   split_colors_at_tears(mesh, topology);
 
@@ -774,19 +1014,24 @@ FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::
   return result;
 }
 
-FeatureEditResult delete_feature(ControlMesh& mesh_in, int width, int height, int feature) {
-  const MeshTopology before = validate_level(mesh_in, width, height);
-  if (feature < 0 || feature >= static_cast<int>(mesh_in.features.size())) {
-    invalid("feature " + std::to_string(feature) + " is out of range (the level has " +
-            std::to_string(mesh_in.features.size()) + " features)");
-  }
+namespace {
+
+// Deletes the chain `gone` (a tear feature, or a chain of creases when `crease`): see
+// delete_feature.
+FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, const MeshTopology& before,
+                               int feature, const Feature& gone, bool crease) {
   FeatureEditResult result;
   result.feature = feature;
-  const Feature gone = mesh_in.features[feature];
   result.id = gone.id;
   ControlMesh mesh = mesh_in;
   mesh.parent_vertices.clear(), mesh.collapses.clear();
-  mesh.features.erase(mesh.features.begin() + feature);
+  if (crease) {
+    std::set<uint64_t> edges;
+    for (size_t i = 0; i + 1 < gone.vertices.size(); ++i) edges.insert(undirected(gone.vertices[i], gone.vertices[i + 1]));
+    std::erase_if(mesh.creases, [&](const EdgeVerts& e) { return edges.count(undirected(e[0], e[1])) > 0; });
+  } else {
+    mesh.features.erase(mesh.features.begin() + feature);
+  }
   const MeshTopology topology = MeshTopology::build(mesh, width, height);
   split_colors_at_tears(mesh, topology);  // merges the two sides' values (their mean)
 
@@ -873,6 +1118,32 @@ FeatureEditResult delete_feature(ControlMesh& mesh_in, int width, int height, in
   validate_level(mesh, width, height);
   mesh_in = std::move(mesh);
   return result;
+}
+
+}  // namespace
+
+FeatureEditResult delete_feature(ControlMesh& mesh, int width, int height, int feature) {
+  const MeshTopology before = validate_level(mesh, width, height);
+  if (feature < 0 || feature >= static_cast<int>(mesh.features.size())) {
+    invalid("feature " + std::to_string(feature) + " is out of range (the level has " +
+            std::to_string(mesh.features.size()) + " features)");
+  }
+  const Feature gone = mesh.features[feature];
+  return delete_chain(mesh, width, height, before, feature, gone, false);
+}
+
+FeatureEditResult delete_crease(ControlMesh& mesh, int width, int height, const Feature& chain) {
+  const MeshTopology before = validate_level(mesh, width, height);
+  std::set<uint64_t> creases;
+  for (const EdgeVerts& e : mesh.creases) creases.insert(undirected(e[0], e[1]));
+  for (size_t i = 0; i + 1 < chain.vertices.size(); ++i) {
+    const int32_t a = chain.vertices[i], b = chain.vertices[i + 1];
+    if (a < 0 || b < 0 || a >= mesh.num_vertices() || b >= mesh.num_vertices() || !creases.count(undirected(a, b))) {
+      invalid("the chain's edge " + std::to_string(i) + " is not a crease of the level");
+    }
+  }
+  if (chain.vertices.size() < 2) invalid("the chain has fewer than 2 vertices");
+  return delete_chain(mesh, width, height, before, -1, chain, true);
 }
 
 }  // namespace subvec

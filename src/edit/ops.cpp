@@ -410,12 +410,20 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
     };
     ControlMesh mesh = image.levels[op.level];
     const MeshTopology topology = validate_level(mesh, image.width, image.height, op.level);
+    // Shape edits and deletions pick among the tear features and the crease chains.
+    const std::vector<Feature> chains = editable_chains(mesh, topology);
     auto pick_feature = [&](Vec2 p) {
-      const FeaturePick pick = nearest_feature(mesh, topology, p);
+      const FeaturePick pick = nearest_feature(chains, mesh, topology, p);
       if (pick.feature < 0) {
         refuse(where, "nothing to select: level " + std::to_string(op.level) + " has no features");
       }
       return pick;
+    };
+    // "feature 3 (id 12)", or "crease 2" for the third crease chain.
+    auto chain_name = [&](int f) {
+      return f < static_cast<int>(mesh.features.size())
+                 ? feature_name(mesh, f)
+                 : "crease " + std::to_string(f - static_cast<int>(mesh.features.size()));
     };
     std::string done;
     try {
@@ -448,16 +456,16 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
               done = vertex_name(mesh, v) + " moved by " + point(d);
             } else {
               const FeaturePick pick = pick_feature(op.from);
-              handles = drag_feature(mesh, mesh.features[pick.feature], op.from, d, op.sigma);
-              done = feature_name(mesh, pick.feature) + " (" + num(pick.distance) +
+              handles = drag_feature(mesh, chains[pick.feature], op.from, d, op.sigma);
+              done = chain_name(pick.feature) + " (" + num(pick.distance) +
                      " px away) dragged by " + point(d) + ", sigma " + num(op.sigma);
             }
           } else {
             inside("at", op.at);
             within_reach(op.translate);
             const FeaturePick pick = pick_feature(op.at);
-            handles = move_feature(mesh, mesh.features[pick.feature], op.translate, op.rotate);
-            done = feature_name(mesh, pick.feature) + " (" + num(pick.distance) +
+            handles = move_feature(mesh, chains[pick.feature], op.translate, op.rotate);
+            done = chain_name(pick.feature) + " (" + num(pick.distance) +
                    " px away) rotated by " + num(op.rotate) + " degrees and moved by " +
                    point(op.translate);
           }
@@ -485,19 +493,29 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           for (const Vec2& p : op.points) inside("points", p);
           const FeatureEditResult r = add_feature(mesh, image.width, image.height, op.points, op.feature_kind);
           const int n = static_cast<int>(r.curve.points.size());
-          done = std::string(r.curve.closed ? "closed " : "") +
-                 (op.feature_kind == FeatureKind::kTear ? "tear " + feature_name(mesh, r.feature) : "crease") +
+          const bool tear = op.feature_kind == FeatureKind::kTear;
+          done = std::string(r.curve.closed ? "closed " : "") + (tear ? "tear " + feature_name(mesh, r.feature) : "crease") +
                  " added: " + std::to_string(n) + " control points (fit within " + num(r.curve.deviation, 2) +
-                 " px of the " + std::to_string(op.points.size()) + " drawn), " +
-                 std::to_string(r.vertices_added) + " vertices added, " + std::to_string(r.flips) +
-                 " edges flipped, " + std::to_string(r.colors_refit) + " color values refitted";
+                 " px of the " + std::to_string(op.points.size()) + " drawn), ";
+          if (r.pieces > 1 || r.junctions > 0) {
+            done += std::to_string(r.pieces) + (r.pieces == 1 ? " piece" : " pieces") + " (" +
+                    (!tear ? "" : r.pieces == 1 ? "feature " + std::to_string(r.feature) + ", "
+                                                : "features " + std::to_string(r.feature) + " to " +
+                                                      std::to_string(r.feature + r.pieces - 1) + ", ") +
+                    std::to_string(r.junctions) + (r.junctions == 1 ? " junction" : " junctions") +
+                    " with existing features), ";
+          }
+          done += std::to_string(r.vertices_added) + " vertices added, " + std::to_string(r.flips) +
+                  " edges flipped, " + std::to_string(r.colors_refit) + " color values refitted";
           break;
         }
         case EditOp::Kind::kDeleteFeature: {
           inside("at", op.at);
           const FeaturePick pick = pick_feature(op.at);
-          const std::string name = feature_name(mesh, pick.feature);
-          const FeatureEditResult r = delete_feature(mesh, image.width, image.height, pick.feature);
+          const std::string name = chain_name(pick.feature);
+          const bool crease = pick.feature >= static_cast<int>(mesh.features.size());
+          const FeatureEditResult r = crease ? delete_crease(mesh, image.width, image.height, chains[pick.feature])
+                                             : delete_feature(mesh, image.width, image.height, pick.feature);
           done = name + " (" + num(pick.distance) + " px away) deleted, " + std::to_string(r.colors_refit) +
                  " color values refitted";
           break;

@@ -145,11 +145,16 @@ int nearest_vertex(const ControlMesh& mesh, Vec2 p) {
 }
 
 FeaturePick nearest_feature(const ControlMesh& mesh, const MeshTopology& topology, Vec2 p) {
+  return nearest_feature(mesh.features, mesh, topology, p);
+}
+
+FeaturePick nearest_feature(std::span<const Feature> chains, const ControlMesh& mesh,
+                            const MeshTopology& topology, Vec2 p) {
   FeaturePick pick;
   pick.distance = std::numeric_limits<double>::infinity();
   constexpr int kSamplesPerSpan = 16;
-  for (size_t f = 0; f < mesh.features.size(); ++f) {
-    for (const CurvePiece& piece : feature_pieces(topology, mesh.features[f])) {
+  for (size_t f = 0; f < chains.size(); ++f) {
+    for (const CurvePiece& piece : feature_pieces(topology, chains[f])) {
       const std::vector<Vec2> points = piece_points(mesh, piece);
       const std::vector<Vec2> curve = sample_bspline(points, piece.closed, kSamplesPerSpan);
       for (size_t i = 0; i + 1 < curve.size(); ++i) {
@@ -168,6 +173,56 @@ FeaturePick nearest_feature(const ControlMesh& mesh, const MeshTopology& topolog
   }
   if (pick.feature < 0) pick.distance = 0;
   return pick;
+}
+
+std::vector<Feature> crease_chains(const ControlMesh& mesh, const MeshTopology& topology) {
+  const int nv = mesh.num_vertices();
+  std::vector<std::vector<int32_t>> around(nv);  // crease edges at each vertex
+  for (size_t e = 0; e < mesh.creases.size(); ++e)
+    for (const int32_t v : mesh.creases[e]) around[v].push_back(static_cast<int32_t>(e));
+  const auto stops = [&](int32_t v) { return around[v].size() != 2 || topology.vertex_tags[v] == VertexTag::kCorner; };
+  std::vector<uint8_t> used(mesh.creases.size(), 0);
+  // From vertex v along crease edge e: the chain's vertices until a stop or back at the start.
+  const auto walk = [&](int32_t v, int32_t e, std::vector<int32_t>& out, bool mark) {
+    const int32_t start = v;
+    for (;;) {
+      if (mark) used[e] = 1;
+      const EdgeVerts& edge = mesh.creases[e];
+      v = edge[0] == v ? edge[1] : edge[0];
+      out.push_back(v);
+      if (v == start || stops(v)) return;
+      e = around[v][0] == e ? around[v][1] : around[v][0];
+    }
+  };
+  std::vector<Feature> chains;
+  for (size_t e0 = 0; e0 < mesh.creases.size(); ++e0) {
+    if (used[e0]) continue;
+    // Back from the edge's first vertex to the chain's end (or round a loop), then forward.
+    const int32_t a = mesh.creases[e0][0];
+    std::vector<int32_t> back{a};
+    if (!stops(a)) walk(a, around[a][0] == int32_t(e0) ? around[a][1] : around[a][0], back, false);
+    const bool loop = back.size() > 1 && back.back() == a;
+    int32_t first = loop ? a : back.back();
+    int32_t first_edge = int32_t(e0);
+    if (!loop && first != a) {
+      // The edge leaving `first` towards a: the last one the walk back crossed.
+      const int32_t prev = back[back.size() - 2];
+      for (const int32_t e : around[first])
+        if (mesh.creases[e][0] == prev || mesh.creases[e][1] == prev) first_edge = e;
+    }
+    Feature f;
+    f.id = -1 - static_cast<int32_t>(chains.size());
+    f.vertices = {first};
+    walk(first, first_edge, f.vertices, true);
+    chains.push_back(std::move(f));
+  }
+  return chains;
+}
+
+std::vector<Feature> editable_chains(const ControlMesh& mesh, const MeshTopology& topology) {
+  std::vector<Feature> chains = mesh.features;
+  for (Feature& f : crease_chains(mesh, topology)) chains.push_back(std::move(f));
+  return chains;
 }
 
 ColorSelection select_vertex_colors(const ControlMesh& mesh, const MeshTopology& topology, Vec2 at,

@@ -433,13 +433,11 @@ double outside(const std::array<double, 3>& l) { return -std::min({l[0], l[1], l
 
 }  // namespace
 
-DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex) {
+DragExtent suggested_drag_extent(const ControlMesh& mesh, const Feature& f) {
   DragExtent e;
-  if (feature >= 0) {
-    if (feature >= static_cast<int>(mesh.features.size())) {
-      invalid("feature " + std::to_string(feature) + " is out of range");
-    }
-    const Feature& f = mesh.features[feature];
+  for (const int32_t v : f.vertices)
+    if (v < 0 || v >= mesh.num_vertices()) invalid("vertex " + std::to_string(v) + " is out of range");
+  {
     double length = 0;
     double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
     for (size_t i = 0; i < f.vertices.size(); ++i) {
@@ -454,6 +452,16 @@ DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int verte
     e.sigma = f.closed() && diagonal <= 60 ? std::max(2 * diagonal, 8.0) : std::clamp(length / 4, 8.0, 60.0);
     e.region = std::max(3 * e.sigma, 30.0);
     return e;
+  }
+}
+
+DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex) {
+  DragExtent e;
+  if (feature >= 0) {
+    if (feature >= static_cast<int>(mesh.features.size())) {
+      invalid("feature " + std::to_string(feature) + " is out of range");
+    }
+    return suggested_drag_extent(mesh, mesh.features[feature]);
   }
   if (vertex < 0 || vertex >= mesh.num_vertices()) invalid("vertex " + std::to_string(vertex) + " is out of range");
   double longest = 0;

@@ -19,6 +19,9 @@
 // ramp instead of a step. The band widens with the jump across the feature so that the ramp stays
 // gentle; the mesh keeps its vertices, and so its budget.
 //
+// Creases drawn with kind kCrease, and those of a file, are edited like tears: picked, dragged and
+// moved as chains (crease_chains(), edit/selection.h) and deleted with delete_crease().
+//
 // Both edits keep the mesh valid (mesh/validate.h) and are deterministic. Topology changes break
 // the pyramid's link between this level and its neighbours (ControlMesh::parent_vertices,
 // collapses): the caller clears it (apply_edit_ops does).
@@ -49,7 +52,9 @@ struct CurveFit {
 inline constexpr double kCloseDistance = 2.0;
 inline constexpr double kMinSpacing = 1.5;
 inline constexpr double kMinLength = 2.0;
-CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolerance = 0.5);
+inline constexpr double kJoinDistance = 2.0;  // add_feature: an open end this close joins a feature
+// With `may_close` false the curve is open whatever its ends.
+CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolerance = 0.5, bool may_close = true);
 
 struct FeatureEditResult {
   int feature = -1;          // add: index of the new feature in mesh.features; delete: the index it had
@@ -57,20 +62,29 @@ struct FeatureEditResult {
   int vertices_added = 0;    // add: control vertices inserted
   int flips = 0;             // add: edge flips (recovery and Delaunay)
   int colors_refit = 0;      // color values refitted
-  CurveFit curve;            // add: the fit whose control points the chain is
+  CurveFit curve;            // add: the fit whose control points the (first) chain is
+  int pieces = 1;            // add: new features (the drawn curve split at its junctions)
+  int junctions = 0;         // add: points where it meets existing features or creases
 };
 
 // Adds a feature along `polyline` (image pixels) to `mesh` (a valid level of a width x height
 // image). A point within 1 pixel of the image border is put on it; the rest are kept kFrameMargin
-// inside. Throws Error(kInvalidArgument) naming the problem, with `mesh` unchanged, when the
-// polyline is unusable (fit_curve), when the curve would cross or touch an existing feature or
-// crease ("crosses feature 3 (id 12) near (40.5, 20)"), or when its control polygon crosses
-// itself.
+// inside. Where the polyline crosses an existing feature or crease, or an open end comes within
+// kJoinDistance of one, the two meet at a junction: a corner vertex inserted on the existing chain
+// (whose curve then passes through it), and the polyline is split there into pieces, each fitted
+// on its own with its ends on the junctions and added as its own feature. Throws
+// Error(kInvalidArgument) naming the problem, with `mesh` unchanged, when the polyline is unusable
+// (fit_curve), when a fitted piece would still cross a feature or crease ("crosses feature 3
+// (id 12) near (40.5, 20)"), or when its control polygon crosses itself.
 FeatureEditResult add_feature(ControlMesh& mesh, int width, int height, std::span<const Vec2> polyline,
                               FeatureKind kind = FeatureKind::kTear);
 
 // Deletes mesh.features[feature] (see above). Throws Error(kInvalidArgument) for an index out of
 // range.
 FeatureEditResult delete_feature(ControlMesh& mesh, int width, int height, int feature);
+// Deletes a chain of creases (one of crease_chains(), edit/selection.h): its edges become smooth and
+// the colors near it are refitted as above (there is no jump, so the band is the narrowest).
+// Throws Error(kInvalidArgument) when an edge of the chain is not a crease.
+FeatureEditResult delete_crease(ControlMesh& mesh, int width, int height, const Feature& chain);
 
 }  // namespace subvec

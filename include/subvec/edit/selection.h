@@ -80,6 +80,18 @@ struct FeaturePick {
 
 // The feature whose limit curve passes nearest to `p` (ties: the lowest index).
 FeaturePick nearest_feature(const ControlMesh& mesh, const MeshTopology& topology, Vec2 p);
+// The same among `chains` (chains of tear or crease edges of `mesh`; pick.feature indexes them).
+FeaturePick nearest_feature(std::span<const Feature> chains, const ControlMesh& mesh,
+                            const MeshTopology& topology, Vec2 p);
+
+// The interior creases as chains, so that they are picked, dragged, moved and deleted like the
+// tear features (issue 25): mesh.creases split at every vertex where they do not simply continue
+// (a corner of the topology, or a crease vertex with other than two crease edges), each chain in
+// the order of its first edge in mesh.creases, closed loops repeating their first vertex. Ids are
+// -1, -2, ... (a tear feature's id is >= 0).
+std::vector<Feature> crease_chains(const ControlMesh& mesh, const MeshTopology& topology);
+// What a shape edit or a deletion picks from: the tear features, then the crease chains.
+std::vector<Feature> editable_chains(const ControlMesh& mesh, const MeshTopology& topology);
 
 // A selection of color values of one level, with the seed the region grew from.
 struct ColorSelection {

@@ -88,6 +88,8 @@ struct DragExtent {
   double region = 0;
 };
 DragExtent suggested_drag_extent(const ControlMesh& mesh, int feature, int vertex);
+// For a chain of the mesh (a feature, or a crease chain: edit/selection.h), as for a feature.
+DragExtent suggested_drag_extent(const ControlMesh& mesh, const Feature& chain);
 // For a selection of vertices: the largest of their regions (sigma is unused).
 DragExtent suggested_drag_extent(const ControlMesh& mesh, std::span<const int32_t> vertices);
 

@@ -263,6 +263,54 @@ TEST(FeatureEdit, ACreaseAndAClosedTear) {
   EXPECT_LE(mae_where(rendered, after, [](int, int) { return true; }), 0.5);
 }
 
+// A crease is picked, dragged, moved and deleted like a tear: as a chain of crease_chains().
+TEST(FeatureEdit, ACreaseIsEditedLikeATear) {
+  VectorImage image = smooth_image();
+  EditOp add;
+  add.kind = EditOp::Kind::kAddFeature;
+  add.points = wave({20, 70}, {140, 60}, 8, 80);
+  add.feature_kind = FeatureKind::kCrease;
+  apply_edit_ops(image, std::span(&add, 1));
+  const ControlMesh added = image.levels[0];
+  const MeshTopology topology = validate_level(added, image.width, image.height);
+  const std::vector<Feature> chains = crease_chains(added, topology);
+  ASSERT_EQ(chains.size(), 1u);
+  EXPECT_EQ(chains[0].id, -1);
+  EXPECT_EQ(chains[0].vertices.size(), added.creases.size() + 1);
+  // The chain runs along the creases in order, end to end.
+  for (size_t i = 0; i + 1 < chains[0].vertices.size(); ++i) {
+    const int a = chains[0].vertices[i], b = chains[0].vertices[i + 1];
+    EXPECT_TRUE(std::any_of(added.creases.begin(), added.creases.end(), [&](const EdgeVerts& e) {
+      return (e[0] == a && e[1] == b) || (e[0] == b && e[1] == a);
+    })) << i;
+  }
+  // Drag it by its middle: its vertices there follow, and the creases stay.
+  const Vec2 grab = added.positions[chains[0].vertices[chains[0].vertices.size() / 2]];
+  EditOp drag;
+  drag.kind = EditOp::Kind::kDrag;
+  drag.select = EditSelect::kFeature;
+  drag.from = grab;
+  drag.to = {grab.x, grab.y + 6};
+  drag.sigma = 20;
+  drag.region = 60;
+  const std::vector<std::string> log = apply_edit_ops(image, std::span(&drag, 1));
+  EXPECT_NE(log[0].find("crease 0"), std::string::npos) << log[0];
+  const int middle = chains[0].vertices[chains[0].vertices.size() / 2];
+  EXPECT_NEAR(image.levels[0].positions[middle].y, grab.y + 6, 1e-9);
+  EXPECT_EQ(image.levels[0].creases, added.creases);
+  // Delete it: no crease left.
+  EditOp del;
+  del.kind = EditOp::Kind::kDeleteFeature;
+  del.at = {grab.x, grab.y + 6};
+  const std::vector<std::string> gone = apply_edit_ops(image, std::span(&del, 1));
+  EXPECT_NE(gone[0].find("crease 0"), std::string::npos) << gone[0];
+  EXPECT_TRUE(image.levels[0].creases.empty());
+  validate(image);
+  Feature bogus;
+  bogus.vertices = {0, 1};
+  EXPECT_THROW(delete_crease(image.levels[0], image.width, image.height, bogus), Error);
+}
+
 TEST(FeatureEdit, BadCurvesAreRefusedByName) {
   test::SyntheticOptions o;
   o.width = 160;
@@ -270,16 +318,8 @@ TEST(FeatureEdit, BadCurvesAreRefusedByName) {
   o.vertices = 900;
   VectorImage image = test::make_synthetic_image(o);
   const VectorImage original = image;
-  // Across the whole image: it meets the synthetic features.
   EditOp op;
   op.kind = EditOp::Kind::kAddFeature;
-  op.points = {{2, 63.3}, {158, 63.3}};
-  try {
-    apply_edit_ops(image, std::span(&op, 1));
-    FAIL() << "a curve across a feature was accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("ops[0] (add-feature): the curve crosses feature"), std::string::npos) << e.what();
-  }
   op.points = {{20, 20}, {60, 60}, {60, 20}, {20, 60}};
   try {
     apply_edit_ops(image, std::span(&op, 1));
@@ -291,6 +331,61 @@ TEST(FeatureEdit, BadCurvesAreRefusedByName) {
   EXPECT_THROW(apply_edit_ops(image, std::span(&op, 1)), Error);
   EXPECT_EQ(image.levels[0].triangles, original.levels[0].triangles);
   EXPECT_THROW(delete_feature(image.levels[0], 160, 128, 99), Error);
+}
+
+// A curve across features meets them at junctions: it is split into pieces that end on corner
+// vertices inserted on the features it crosses, whose chains now pass through them; an end drawn
+// near a feature joins it.
+TEST(FeatureEdit, ACurveAcrossFeaturesJoinsThem) {
+  test::SyntheticOptions o;
+  o.width = 160;
+  o.height = 128;
+  o.vertices = 900;
+  VectorImage image = test::make_synthetic_image(o);
+  const Image8 rendered = render(image, RenderOptions{});
+  const size_t before = image.levels[0].features.size();
+  EditOp op;
+  op.kind = EditOp::Kind::kAddFeature;
+  op.points = wave({3, 63.3}, {157, 60}, 4, 150);
+  const std::vector<std::string> log = apply_edit_ops(image, std::span(&op, 1));
+  EXPECT_NE(log[0].find("junctions with existing features"), std::string::npos) << log[0];
+  validate(image);
+  const ControlMesh& mesh = image.levels[0];
+  ASSERT_GT(mesh.features.size(), before + 1);
+  const MeshTopology topology = validate_level(mesh, image.width, image.height);
+  // Every new piece ends on an old feature (a junction) or at the drawing's own ends.
+  int junctions = 0;
+  for (size_t f = before; f < mesh.features.size(); ++f) {
+    for (const int v : {mesh.features[f].vertices.front(), mesh.features[f].vertices.back()}) {
+      int on_old = 0;
+      for (size_t g = 0; g < before; ++g) {
+        const auto& c = mesh.features[g].vertices;
+        on_old += std::find(c.begin(), c.end(), v) != c.end();
+      }
+      if (on_old > 0) {
+        ++junctions;
+        EXPECT_EQ(topology.vertex_tags[v], VertexTag::kCorner);
+      }
+    }
+  }
+  EXPECT_GE(junctions, 2);
+  // The picture away from the new curve (and the old curves' small shifts at the junctions) holds.
+  const Image8 after = render(image, RenderOptions{});
+  EXPECT_LE(mae_where(rendered, after, [&](int, int y) { return std::abs(y + 0.5 - 62) > 8; }), 0.5);
+  // An end drawn 1.5 px short of a feature joins it.
+  VectorImage disk = test::make_synthetic_image(o);
+  const ControlMesh& m = disk.levels[0];
+  const Vec2 a = m.positions[m.features[0].vertices[0]], b = m.positions[m.features[0].vertices[1]];
+  const Vec2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
+  const double len = std::hypot(b.x - a.x, b.y - a.y);
+  const Vec2 n{-(b.y - a.y) / len, (b.x - a.x) / len};
+  EditOp reach;
+  reach.kind = EditOp::Kind::kAddFeature;
+  for (int i = 0; i <= 20; ++i) reach.points.push_back({mid.x + (1.5 + i) * n.x, mid.y + (1.5 + i) * n.y});
+  std::reverse(reach.points.begin(), reach.points.end());
+  const std::vector<std::string> joined = apply_edit_ops(disk, std::span(&reach, 1));
+  EXPECT_NE(joined[0].find("1 junction with existing features"), std::string::npos) << joined[0];
+  validate(disk);
 }
 
 // Ends within a pixel of the border go onto it: a cut from side to side.

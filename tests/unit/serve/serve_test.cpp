@@ -429,11 +429,18 @@ TEST(ServeEditor, FeatureEditsReloadTheViewAndUndo) {
   d = editor.redo(s, 7, label);
   EXPECT_TRUE(d.reload);
   EXPECT_EQ(editor.snapshot().first.levels[0].triangles, reference.levels[0].triangles);
-  // A curve across the disk's tear is refused, and nothing changes.
+  // A curve that crosses itself is refused, and nothing changes.
+  subvec::EditOp twisted = add;
+  twisted.points = {{20, 20}, {40, 40}, {40, 20}, {20, 40}};
+  EXPECT_EQ(status_of([&] { editor.apply(s, 8, twisted, log); }), kUnprocessable);
+  EXPECT_EQ(editor.version(), 8);
+  // One across the disk, through two of its control vertices (y = 48), joins it there.
   subvec::EditOp across = add;
   across.points = {{10, 48}, {90, 48}};
-  EXPECT_EQ(status_of([&] { editor.apply(s, 8, across, log); }), kUnprocessable);
-  EXPECT_EQ(editor.version(), 8);
+  editor.view(s, {0, 2});
+  d = editor.apply(s, 8, across, log);
+  EXPECT_TRUE(d.reload);
+  EXPECT_NE(log.find("junctions with existing features"), std::string::npos) << log;
 }
 
 TEST(ServeEditor, WindowedViewRefinesFewerFaces) {
