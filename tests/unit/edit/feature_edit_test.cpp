@@ -132,14 +132,17 @@ std::vector<Vec2> refined_tear_points(const ControlMesh& mesh, int width, int he
   return out;
 }
 
-VectorImage smooth_image() {
+// 160 x 128, about 900 vertices; with the synthetic features (two circles, an arc, a segment) or
+// without.
+VectorImage small_image(bool features) {
   test::SyntheticOptions o;
   o.width = 160;
   o.height = 128;
   o.vertices = 900;
-  o.features = false;
+  o.features = features;
   return test::make_synthetic_image(o);
 }
+VectorImage smooth_image() { return small_image(false); }
 
 TEST(FeatureEdit, TheFitFollowsTheDrawnCurve) {
   const std::vector<Vec2> drawn = wave({10, 60}, {150, 70}, 12, 200);
@@ -312,11 +315,7 @@ TEST(FeatureEdit, ACreaseIsEditedLikeATear) {
 }
 
 TEST(FeatureEdit, BadCurvesAreRefusedByName) {
-  test::SyntheticOptions o;
-  o.width = 160;
-  o.height = 128;
-  o.vertices = 900;
-  VectorImage image = test::make_synthetic_image(o);
+  VectorImage image = small_image(true);
   const VectorImage original = image;
   EditOp op;
   op.kind = EditOp::Kind::kAddFeature;
@@ -337,11 +336,7 @@ TEST(FeatureEdit, BadCurvesAreRefusedByName) {
 // vertices inserted on the features it crosses, whose chains now pass through them; an end drawn
 // near a feature joins it.
 TEST(FeatureEdit, ACurveAcrossFeaturesJoinsThem) {
-  test::SyntheticOptions o;
-  o.width = 160;
-  o.height = 128;
-  o.vertices = 900;
-  VectorImage image = test::make_synthetic_image(o);
+  VectorImage image = small_image(true);
   const Image8 rendered = render(image, RenderOptions{});
   const size_t before = image.levels[0].features.size();
   EditOp op;
@@ -373,7 +368,7 @@ TEST(FeatureEdit, ACurveAcrossFeaturesJoinsThem) {
   const Image8 after = render(image, RenderOptions{});
   EXPECT_LE(mae_where(rendered, after, [&](int, int y) { return std::abs(y + 0.5 - 62) > 8; }), 0.5);
   // An end drawn 1.5 px short of a feature joins it.
-  VectorImage disk = test::make_synthetic_image(o);
+  VectorImage disk = small_image(true);
   const ControlMesh& m = disk.levels[0];
   const Vec2 a = m.positions[m.features[0].vertices[0]], b = m.positions[m.features[0].vertices[1]];
   const Vec2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
@@ -452,12 +447,8 @@ DeleteMeasure measure_delete(VectorImage& image, int feature) {
 }
 
 TEST(FeatureEdit, ADeletedFeatureLeavesNoStep) {
-  test::SyntheticOptions o;
-  o.width = 160;
-  o.height = 128;
-  o.vertices = 900;
   for (int f = 0; f < 4; ++f) {
-    VectorImage image = test::make_synthetic_image(o);
+    VectorImage image = small_image(true);
     ASSERT_EQ(image.levels[0].features.size(), 4u);
     const int32_t id = image.levels[0].features[f].id;
     const DeleteMeasure m = measure_delete(image, f);
