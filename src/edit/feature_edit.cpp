@@ -691,9 +691,7 @@ double mean_edge_near(const ControlMesh& mesh, std::span<const Vec2> points) {
   return count ? sum / count : 8.0;
 }
 
-}  // namespace
-
-namespace {
+// ---- junctions ---------------------------------------------------------------------------------
 
 // Where a drawn polyline meets an existing feature or crease: its arc length along the polyline,
 // the point, and the sharp edge (a, b) it lies on.
