@@ -10,25 +10,13 @@ import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { requireBrowser, launch, serve, stop, openEditor, idle, pixel, client } from './harness.mjs';
+import { requireBrowser, launch, serve, stop, openEditor, idle, pixel, client, check, finish, diff } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
 const binary = process.argv[2];
 const chromium = requireBrowser('e2e-features.mjs', binary);
 
-let passed = 0;
-let failed = 0;
-function check(name, ok, detail = '') {
-  if (ok) {
-    passed++;
-    console.log(`ok   ${name}`);
-  } else {
-    failed++;
-    console.log(`FAIL ${name} ${detail}`);
-  }
-}
-const diff = (a, b) => Math.max(...[0, 1, 2].map((i) => Math.abs(a[i] - b[i])));
 const yellow = (p) => p[0] > 200 && p[1] > 200 && p[2] < 80;
 
 const dir = mkdtempSync(join(tmpdir(), 'subvec-e2e-features-'));
@@ -133,5 +121,4 @@ try {
   await stop(server);
   rmSync(dir, { recursive: true, force: true });
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed === 0 ? 0 : 1);
+finish();

@@ -12,7 +12,7 @@ import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'no
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { client, idle, launch, openEditor, pixel, requireBrowser, serve, stop } from './harness.mjs';
+import { check, client, diff, finish, idle, launch, openEditor, pixel, requireBrowser, serve, stop } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
@@ -20,14 +20,6 @@ const binary = process.argv[2];
 
 const chromium = requireBrowser('e2e-input.mjs', binary);
 
-let passed = 0;
-let failed = 0;
-function check(name, ok, detail = '') {
-  if (ok) passed++;
-  else failed++;
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${ok ? '' : ` ${detail}`}`);
-}
-const diff = (a, b) => Math.max(...[0, 1, 2].map((i) => Math.abs(a[i] - b[i])));
 
 // The disk example: a closed tear of radius 28 around (48, 48) in a 96 x 96 image.
 const onTear = (degrees) => [48 + 28 * Math.cos((degrees * Math.PI) / 180), 48 + 28 * Math.sin((degrees * Math.PI) / 180)];
@@ -551,5 +543,4 @@ try {
   await stop(photoServer);
   rmSync(dir, { recursive: true, force: true });
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed ? 1 : 0);
+finish();

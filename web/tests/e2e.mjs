@@ -12,7 +12,7 @@ import { mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { requireBrowser, launch, serve, stop, openEditor, idle, pixel, client } from './harness.mjs';
+import { requireBrowser, launch, serve, stop, openEditor, idle, pixel, client, check, finish, diff } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
@@ -21,18 +21,6 @@ const screenshot = process.argv[3];
 
 const chromium = requireBrowser('e2e.mjs', binary);
 
-let passed = 0;
-let failed = 0;
-function check(name, ok, detail = '') {
-  if (ok) {
-    passed++;
-    console.log(`ok   ${name}`);
-  } else {
-    failed++;
-    console.log(`FAIL ${name} ${detail}`);
-  }
-}
-const diff = (a, b) => Math.max(...[0, 1, 2].map((i) => Math.abs(a[i] - b[i])));
 
 // A two-level copy of the disk example: level 1 is level 0 with its channels swapped (r, g, b) ->
 // (b, g, r), so switching levels changes the colors while the geometry stays.
@@ -316,5 +304,4 @@ try {
 } catch (e) {
   check('photograph: served', false, e && e.stack ? e.stack : String(e));
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed === 0 ? 0 : 1);
+finish();

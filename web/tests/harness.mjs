@@ -96,3 +96,20 @@ export function requireBrowser(script, binary) {
   }
   return chromium;
 }
+
+// The checks of a browser test: check(name, ok, detail) prints "ok   name" or "FAIL name detail";
+// finish() prints "N passed, M failed" and exits 0 when none failed, else 1.
+let passed = 0;
+let failed = 0;
+export function check(name, ok, detail = '') {
+  if (ok) passed++;
+  else failed++;
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${ok ? '' : ` ${detail}`}`);
+}
+export function finish() {
+  console.log(`${passed} passed, ${failed} failed`);
+  process.exit(failed === 0 ? 0 : 1);
+}
+
+// The largest channel difference of two RGB(A) pixels.
+export const diff = (a, b) => Math.max(...[0, 1, 2].map((i) => Math.abs(a[i] - b[i])));
