@@ -24,7 +24,8 @@
 //
 // Both edits keep the mesh valid (mesh/validate.h) and are deterministic. Topology changes break
 // the pyramid's link between this level and its neighbours (ControlMesh::parent_vertices,
-// collapses): the caller clears it (apply_edit_ops does).
+// collapses): add_feature and delete_feature clear the edited level's, and the caller the next
+// level's (apply_edit_ops does).
 #pragma once
 
 #include <cstdint>
