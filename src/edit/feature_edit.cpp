@@ -567,6 +567,11 @@ int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int
   using Triplet = Eigen::Triplet<double>;
   std::vector<Triplet> normal;
   Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(n, 3);
+  // The refined color values whose stencil reaches a free color: only pixels on them have a row
+  // (the others depend on fixed colors alone), so most of the image is skipped at once.
+  std::vector<uint8_t> reaches(size_t(s.rows()), 0);
+  for (int r = 0; r < s.rows(); ++r)
+    for (SparseMatrix::InnerIterator it(s, r); it; ++it) reaches[r] |= slot[it.col()] >= 0;
   std::map<int, double> row;  // control color -> weight, for one pixel
   for (int py = 0; py < height; ++py) {
     for (int px = 0; px < width; ++px) {
@@ -575,16 +580,11 @@ int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int
       if (loc.triangle < 0) continue;
       if (band[pixel] && band_faces[system.refined.triangle_parent[loc.triangle]]) continue;
       const Tri& rc = system.refined.triangle_colors[loc.triangle];
+      if (!reaches[rc[0]] && !reaches[rc[1]] && !reaches[rc[2]]) continue;
       const double w[3] = {1.0 - loc.b1 - loc.b2, loc.b1, loc.b2};
       row.clear();
-      bool any = false;
-      for (int k = 0; k < 3; ++k) {
-        for (SparseMatrix::InnerIterator it(s, rc[k]); it; ++it) {
-          row[static_cast<int>(it.col())] += w[k] * it.value();
-          any |= slot[it.col()] >= 0;
-        }
-      }
-      if (!any) continue;
+      for (int k = 0; k < 3; ++k)
+        for (SparseMatrix::InnerIterator it(s, rc[k]); it; ++it) row[static_cast<int>(it.col())] += w[k] * it.value();
       double target[3] = {targets[pixel][0], targets[pixel][1], targets[pixel][2]};
       for (const auto& [c, value] : row) {
         if (slot[c] >= 0) continue;
