@@ -35,6 +35,33 @@ using namespace svec_detail;
 void encode_trailer(ByteWriter& w, const VectorImage& image);
 void decode_trailer(Cursor& in, VectorImage& image);
 void encode_pyramid(ByteWriter& w, const VectorImage& image);
+void encode_objects(ByteWriter& w, const VectorImage& image);
+
+// One mesh, every value as stored in memory: the levels of version 1 and every version's objects.
+void encode_mesh_v1(ByteWriter& w, const ControlMesh& m) {
+  if (m.triangle_colors.size() != m.triangles.size()) {
+    fail("cannot write a level whose triangle_colors and triangles differ in length",
+         ErrorCode::kInvalidMesh);
+  }
+  w.count(m.positions.size(), "vertices");
+  w.count(m.colors.size(), "colors");
+  w.count(m.triangles.size(), "triangles");
+  w.count(m.creases.size(), "creases");
+  w.count(m.features.size(), "features");
+  for (const Vec2& p : m.positions) w.f64(p.x), w.f64(p.y);
+  for (const Color& c : m.colors) w.f32(c.r), w.f32(c.g), w.f32(c.b);
+  for (const Tri& t : m.triangles)
+    for (int32_t v : t) w.i32(v);
+  for (const Tri& t : m.triangle_colors)
+    for (int32_t c : t) w.i32(c);
+  for (const EdgeVerts& e : m.creases) w.i32(e[0]), w.i32(e[1]);
+  for (const Feature& f : m.features) {
+    w.i32(f.id);
+    w.f64(f.saliency);
+    w.count(f.vertices.size(), "feature vertices");
+    for (int32_t v : f.vertices) w.i32(v);
+  }
+}
 
 // Version 1: every value as stored in memory, in the image's own order.
 std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
@@ -42,30 +69,8 @@ std::vector<uint8_t> encode_payload_v1(const VectorImage& image) {
   w.i32(image.width);
   w.i32(image.height);
   w.count(image.levels.size(), "levels");
-  for (const ControlMesh& m : image.levels) {
-    if (m.triangle_colors.size() != m.triangles.size()) {
-      fail("cannot write a level whose triangle_colors and triangles differ in length",
-           ErrorCode::kInvalidMesh);
-    }
-    w.count(m.positions.size(), "vertices");
-    w.count(m.colors.size(), "colors");
-    w.count(m.triangles.size(), "triangles");
-    w.count(m.creases.size(), "creases");
-    w.count(m.features.size(), "features");
-    for (const Vec2& p : m.positions) w.f64(p.x), w.f64(p.y);
-    for (const Color& c : m.colors) w.f32(c.r), w.f32(c.g), w.f32(c.b);
-    for (const Tri& t : m.triangles)
-      for (int32_t v : t) w.i32(v);
-    for (const Tri& t : m.triangle_colors)
-      for (int32_t c : t) w.i32(c);
-    for (const EdgeVerts& e : m.creases) w.i32(e[0]), w.i32(e[1]);
-    for (const Feature& f : m.features) {
-      w.i32(f.id);
-      w.f64(f.saliency);
-      w.count(f.vertices.size(), "feature vertices");
-      for (int32_t v : f.vertices) w.i32(v);
-    }
-  }
+  for (const ControlMesh& m : image.levels) encode_mesh_v1(w, m);
+  encode_objects(w, image);
   encode_trailer(w, image);
   encode_pyramid(w, image);
   return std::move(w.bytes);
@@ -93,6 +98,7 @@ std::vector<uint8_t> encode_payload_compact(const VectorImage& image, uint32_t v
     encode_compact_level(m, image.width, image.height, bits[l][0], bits[l][1], int(version), w,
                          block_ends, &orders[l]);
   }
+  encode_objects(w, image);
   // The pyramid records name vertices: renumber them as the levels were.
   VectorImage records;
   records.levels.resize(image.levels.size());
@@ -127,7 +133,70 @@ void encode_trailer(ByteWriter& w, const VectorImage& image) {
   }
 }
 
-VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version) {
+// Reads what encode_mesh_v1 wrote; `level` names it in messages ("level 2 ", "object 0 ").
+void decode_mesh_v1(Cursor& in, ControlMesh& m, const std::string& level) {
+  in.set_context(level + "counts");
+  const size_t counts[5] = {in.count(level + "vertices", 16), in.count(level + "colors", 12),
+                            in.count(level + "triangles", 24), in.count(level + "creases", 8),
+                            in.count(level + "features", 16)};
+  in.set_context(level + "vertices");
+  m.positions.resize(counts[0]);
+  for (Vec2& p : m.positions) p.x = in.f64(), p.y = in.f64();
+  in.set_context(level + "colors");
+  m.colors.resize(counts[1]);
+  for (Color& c : m.colors) c.r = in.f32(), c.g = in.f32(), c.b = in.f32();
+  in.set_context(level + "triangles");
+  m.triangles.resize(counts[2]);
+  for (Tri& t : m.triangles)
+    for (int32_t& v : t) v = in.i32();
+  in.set_context(level + "triangle colors");
+  m.triangle_colors.resize(counts[2]);
+  for (Tri& t : m.triangle_colors)
+    for (int32_t& c : t) c = in.i32();
+  in.set_context(level + "creases");
+  m.creases.resize(counts[3]);
+  for (EdgeVerts& e : m.creases) e[0] = in.i32(), e[1] = in.i32();
+  m.features.resize(counts[4]);
+  for (size_t i = 0; i < counts[4]; ++i) {
+    Feature& f = m.features[i];
+    const std::string what = level + "feature " + str(i);
+    in.set_context(what);
+    f.id = in.i32();
+    f.saliency = in.f64();
+    f.vertices.resize(in.count(what + " vertices", 4));
+    for (int32_t& v : f.vertices) v = in.i32();
+  }
+}
+
+// The objects (flag kObjectsFlag): a count, then each object's level, visibility, name and mesh.
+void decode_objects(Cursor& in, VectorImage& image) {
+  in.set_context("objects");
+  image.objects.resize(in.count("objects", 25, Limits::kMaxObjects));
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    Object& object = image.objects[o];
+    const std::string what = "object " + str(o) + " ";
+    in.set_context(what + "header");
+    object.level = in.i32();
+    const uint32_t visible = in.u8();
+    if (visible > 1) fail(what + "visibility " + str(visible) + " is neither 0 nor 1");
+    object.visible = visible == 1;
+    object.name = in.string(what + "name");
+    decode_mesh_v1(in, object.mesh, what);
+  }
+}
+
+void encode_objects(ByteWriter& w, const VectorImage& image) {
+  if (image.objects.empty()) return;  // no flag, no section: the file is as before objects existed
+  w.count(image.objects.size(), "objects");
+  for (const Object& object : image.objects) {
+    w.i32(object.level);
+    w.bytes.push_back(object.visible ? 1 : 0);
+    w.string(object.name);
+    encode_mesh_v1(w, object.mesh);
+  }
+}
+
+VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version, uint32_t flags) {
   Cursor in(payload);
   VectorImage image;
   in.set_context("image size");
@@ -143,44 +212,12 @@ VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version) {
     }
     for (size_t l = 0; l < num_levels; ++l)
       image.levels[l] = decode_compact_level(in, int(l), image.width, image.height, int(version));
+    if (flags & kObjectsFlag) decode_objects(in, image);
     decode_trailer(in, image);
     return image;
   }
-  for (size_t l = 0; l < num_levels; ++l) {
-    ControlMesh& m = image.levels[l];
-    const std::string level = "level " + str(l) + " ";
-    in.set_context(level + "counts");
-    const size_t counts[5] = {in.count(level + "vertices", 16), in.count(level + "colors", 12),
-                              in.count(level + "triangles", 24), in.count(level + "creases", 8),
-                              in.count(level + "features", 16)};
-    in.set_context(level + "vertices");
-    m.positions.resize(counts[0]);
-    for (Vec2& p : m.positions) p.x = in.f64(), p.y = in.f64();
-    in.set_context(level + "colors");
-    m.colors.resize(counts[1]);
-    for (Color& c : m.colors) c.r = in.f32(), c.g = in.f32(), c.b = in.f32();
-    in.set_context(level + "triangles");
-    m.triangles.resize(counts[2]);
-    for (Tri& t : m.triangles)
-      for (int32_t& v : t) v = in.i32();
-    in.set_context(level + "triangle colors");
-    m.triangle_colors.resize(counts[2]);
-    for (Tri& t : m.triangle_colors)
-      for (int32_t& c : t) c = in.i32();
-    in.set_context(level + "creases");
-    m.creases.resize(counts[3]);
-    for (EdgeVerts& e : m.creases) e[0] = in.i32(), e[1] = in.i32();
-    m.features.resize(counts[4]);
-    for (size_t i = 0; i < counts[4]; ++i) {
-      Feature& f = m.features[i];
-      const std::string what = level + "feature " + str(i);
-      in.set_context(what);
-      f.id = in.i32();
-      f.saliency = in.f64();
-      f.vertices.resize(in.count(what + " vertices", 4));
-      for (int32_t& v : f.vertices) v = in.i32();
-    }
-  }
+  for (size_t l = 0; l < num_levels; ++l) decode_mesh_v1(in, image.levels[l], "level " + str(l) + " ");
+  if (flags & kObjectsFlag) decode_objects(in, image);
   decode_trailer(in, image);
   return image;
 }
@@ -390,7 +427,10 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
     fail("unsupported .svec version " + str(version) + " (this build reads " +
          str(kLosslessVersion) + ", " + str(kCompactVersion) + " and " + str(kCodedVersion) + ")");
   }
-  if (flags != 0) fail("unsupported .svec flags " + str(flags) + " (this build knows none)");
+  if ((flags & ~kObjectsFlag) != 0) {
+    fail("unsupported .svec flags " + str(flags) + " (this build knows " + str(kObjectsFlag) +
+         ": objects)");
+  }
   if (payload_size > kMaxPayloadBytes) {
     fail("declared payload of " + str(payload_size) + " bytes is over the limit of " +
              str(kMaxPayloadBytes),
@@ -405,7 +445,7 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
     fail(str(available - frame_size) + " unexpected bytes after the zstd frame");
   }
   const std::vector<uint8_t> payload = decompress(bytes.subspan(kHeaderBytes), payload_size);
-  VectorImage image = decode_payload(payload, version);
+  VectorImage image = decode_payload(payload, version, flags);
   validate(image);
   return image;
 }
@@ -436,6 +476,7 @@ std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOpt
     quantized.width = image.width;
     quantized.height = image.height;
     quantized.strokes = image.strokes;
+    quantized.objects = image.objects;
     quantized.metadata = image.metadata;
     for (size_t l = 0; l < image.levels.size() && version == compact; ++l) {
       version = kLosslessVersion;
@@ -466,7 +507,7 @@ std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOpt
   ByteWriter w;
   w.bytes.assign(kMagic.begin(), kMagic.end());
   w.u32(version);
-  w.u32(0);  // flags
+  w.u32(image.objects.empty() ? 0 : kObjectsFlag);  // flags
   w.u64(payload.size());
   w.u64(frame.size());
   w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());

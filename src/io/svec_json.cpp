@@ -31,6 +31,7 @@ namespace {
 // key order matters (metadata, kept in file order) records it while parsing.
 using Json = nlohmann::json;
 using svec_detail::kJsonVersion;
+using svec_detail::kJsonObjectsVersion;
 
 // ---------------------------------------------------------------------------------------------
 // Parsing: path tracking, duplicate keys and depth.
@@ -312,6 +313,23 @@ ControlMesh level_at(const Json& j, const Path& path) {
   return m;
 }
 
+Object object_at_path(const Json& j, const Path& path) {
+  object_at(j, path);
+  check_keys(j, path, {"level", "name", "visible", "mesh"});
+  Object o;
+  if (const Json* l = find(j, "level")) o.level = int_at(*l, path.member("level"));
+  if (const Json* n = find(j, "name")) {
+    if (!n->is_string()) fail(path.member("name"), std::string("expected a string, got ") + type_name(*n));
+    o.name = n->get<std::string>();
+  }
+  if (const Json* v = find(j, "visible")) {
+    if (!v->is_boolean()) fail(path.member("visible"), std::string("expected true or false, got ") + type_name(*v));
+    o.visible = v->get<bool>();
+  }
+  o.mesh = level_at(require(j, path, "mesh"), path.member("mesh"));
+  return o;
+}
+
 Stroke stroke_at(const Json& j, const Path& path) {
   object_at(j, path);
   check_keys(j, path, {"level", "points", "width", "color", "taper"});
@@ -333,11 +351,17 @@ VectorImage image_from(const Json& root, const std::vector<std::string>& metadat
          "expected \"subvec\", got " + format.dump(-1, ' ', true) + " (this is not a subvec file)");
   }
   const int version = int_at(require(root, top, "version"), top.member("version"));
-  if (version != kJsonVersion) {
+  if (version != kJsonVersion && version != kJsonObjectsVersion) {
     fail(top.member("version"), "unsupported .svec.json version " + std::to_string(version) +
-                                    " (this build reads " + std::to_string(kJsonVersion) + ")");
+                                    " (this build reads " + std::to_string(kJsonVersion) + " and " +
+                                    std::to_string(kJsonObjectsVersion) + ")");
   }
-  check_keys(root, top, {"format", "version", "width", "height", "levels", "strokes", "metadata"});
+  if (version == kJsonVersion) {
+    check_keys(root, top, {"format", "version", "width", "height", "levels", "strokes", "metadata"});
+  } else {
+    check_keys(root, top,
+               {"format", "version", "width", "height", "levels", "objects", "strokes", "metadata"});
+  }
 
   VectorImage image;
   image.width = int_at(require(root, top, "width"), top.member("width"));
@@ -352,6 +376,17 @@ VectorImage image_from(const Json& root, const std::vector<std::string>& metadat
   }
   for (size_t l = 0; l < levels.size(); ++l)
     image.levels.push_back(level_at(levels[l], levels_path[l]));
+  if (const Json* o = find(root, "objects")) {
+    const Path objects_path = top.member("objects");
+    const Json& objects = array_at(*o, objects_path);
+    if (static_cast<int64_t>(objects.size()) > Limits::kMaxObjects) {
+      fail(objects_path,
+           std::to_string(objects.size()) + " objects is over the limit of " +
+               std::to_string(Limits::kMaxObjects),
+           ErrorCode::kLimit);
+    }
+    for (size_t k = 0; k < objects.size(); ++k) image.objects.push_back(object_at_path(objects[k], objects_path[k]));
+  }
   if (const Json* s = find(root, "strokes")) {
     image.strokes = list_at<Stroke>(*s, top.member("strokes"), stroke_at);
   }
@@ -458,10 +493,11 @@ std::string string_text(const std::string& s) {
   }
 }
 
-void write_level(JsonWriter& w, const ControlMesh& m, bool last) {
+// One mesh as a JSON object, `base` levels deeper than a level of "levels".
+void write_level(JsonWriter& w, const ControlMesh& m, bool last, int base = 0, const std::string& key = "") {
   const bool implicit_colors =
       m.colors.size() == m.positions.size() && m.triangle_colors == m.triangles;
-  w.line(2, "{");
+  w.line(base + 2, key.empty() ? "{" : "\"" + key + "\": {");
   std::vector<const char*> keys = {"vertices", "colors", "triangles"};
   if (!implicit_colors) keys.push_back("triangle_colors");
   if (!m.creases.empty()) keys.push_back("creases");
@@ -471,16 +507,16 @@ void write_level(JsonWriter& w, const ControlMesh& m, bool last) {
   for (size_t k = 0; k < keys.size(); ++k) {
     const std::string key = keys[k];
     const bool comma = k + 1 < keys.size();
-    if (key == "vertices") w.list(3, key, texts(m.positions, vec2_text), comma);
-    if (key == "colors") w.list(3, key, texts(m.colors, color_text), comma);
-    if (key == "triangles") w.list(3, key, texts(m.triangles, ints_text<3>), comma);
-    if (key == "triangle_colors") w.list(3, key, texts(m.triangle_colors, ints_text<3>), comma);
-    if (key == "creases") w.list(3, key, texts(m.creases, ints_text<2>), comma);
+    if (key == "vertices") w.list(base + 3, key, texts(m.positions, vec2_text), comma);
+    if (key == "colors") w.list(base + 3, key, texts(m.colors, color_text), comma);
+    if (key == "triangles") w.list(base + 3, key, texts(m.triangles, ints_text<3>), comma);
+    if (key == "triangle_colors") w.list(base + 3, key, texts(m.triangle_colors, ints_text<3>), comma);
+    if (key == "creases") w.list(base + 3, key, texts(m.creases, ints_text<2>), comma);
     if (key == "parent_vertices")
-      w.list(3, key, texts(m.parent_vertices, [](int32_t v) { return std::to_string(v); }), comma);
-    if (key == "collapses") w.list(3, key, texts(m.collapses, ints_text<2>), comma);
+      w.list(base + 3, key, texts(m.parent_vertices, [](int32_t v) { return std::to_string(v); }), comma);
+    if (key == "collapses") w.list(base + 3, key, texts(m.collapses, ints_text<2>), comma);
     if (key == "features") {
-      w.line(3, "\"features\": [");
+      w.line(base + 3, "\"features\": [");
       for (size_t i = 0; i < m.features.size(); ++i) {
         const Feature& f = m.features[i];
         const auto vertices = texts(f.vertices, [](int32_t v) { return std::to_string(v); });
@@ -491,19 +527,19 @@ void write_level(JsonWriter& w, const ControlMesh& m, bool last) {
         for (size_t j = 0; j < vertices.size(); ++j) text += (j ? ", " : "") + vertices[j];
         text += "]" + end;
         if (8 + text.size() <= JsonWriter::kWidth) {
-          w.line(4, text);
+          w.line(base + 4, text);
         } else {
-          w.line(4, "{");
-          w.line(5, "\"id\": " + std::to_string(f.id) + ",");
-          w.line(5, "\"saliency\": " + format_double(f.saliency) + ",");
-          w.list(5, "vertices", vertices, false);
-          w.line(4, end);
+          w.line(base + 4, "{");
+          w.line(base + 5, "\"id\": " + std::to_string(f.id) + ",");
+          w.line(base + 5, "\"saliency\": " + format_double(f.saliency) + ",");
+          w.list(base + 5, "vertices", vertices, false);
+          w.line(base + 4, end);
         }
       }
-      w.line(3, comma ? "]," : "]");
+      w.line(base + 3, comma ? "]," : "]");
     }
   }
-  w.line(2, last ? "}" : "},");
+  w.line(base + 2, last ? "}" : "},");
 }
 
 }  // namespace
@@ -541,14 +577,30 @@ std::string to_svec_json(const VectorImage& image) {
   JsonWriter w;
   w.line(0, "{");
   w.line(1, "\"format\": \"subvec\",");
-  w.line(1, "\"version\": " + std::to_string(kJsonVersion) + ",");
+  // Version 1 unless there are objects, so that files without them are as they always were.
+  w.line(1, "\"version\": " +
+                std::to_string(image.objects.empty() ? kJsonVersion : kJsonObjectsVersion) + ",");
   w.line(1, "\"width\": " + std::to_string(image.width) + ",");
   w.line(1, "\"height\": " + std::to_string(image.height) + ",");
-  const bool more_after_levels = !image.strokes.empty() || !image.metadata.empty();
+  const bool more_after_objects = !image.strokes.empty() || !image.metadata.empty();
+  const bool more_after_levels = !image.objects.empty() || more_after_objects;
   w.line(1, "\"levels\": [");
   for (size_t l = 0; l < image.levels.size(); ++l)
     write_level(w, image.levels[l], l + 1 == image.levels.size());
   w.line(1, more_after_levels ? "]," : "]");
+  if (!image.objects.empty()) {
+    w.line(1, "\"objects\": [");
+    for (size_t k = 0; k < image.objects.size(); ++k) {
+      const Object& o = image.objects[k];
+      w.line(2, "{");
+      w.line(3, "\"level\": " + std::to_string(o.level) + ",");
+      w.line(3, "\"name\": " + string_text(o.name) + ",");
+      w.line(3, std::string("\"visible\": ") + (o.visible ? "true" : "false") + ",");
+      write_level(w, o.mesh, true, 1, "mesh");
+      w.line(2, k + 1 < image.objects.size() ? "}," : "}");
+    }
+    w.line(1, more_after_objects ? "]," : "]");
+  }
   if (!image.strokes.empty()) {
     w.line(1, "\"strokes\": [");
     for (size_t i = 0; i < image.strokes.size(); ++i) {

@@ -13,11 +13,16 @@ inline constexpr std::array<uint8_t, 8> kMagic = {'S', 'U', 'B', 'V', 'E', 'C', 
 inline constexpr uint32_t kLosslessVersion = 1;  // exact values, the image's own order
 inline constexpr uint32_t kCompactVersion = 2;   // quantized, predicted, traversal order
 inline constexpr uint32_t kCodedVersion = 3;     // version 2's content, range-coded
+// Header flag: the payload holds objects (mesh/vector_image.h) after its levels. Files without
+// objects have no flag and are byte for byte what builds before objects wrote.
+inline constexpr uint32_t kObjectsFlag = 1;
 inline constexpr size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8;
 inline constexpr uint64_t kMaxPayloadBytes = uint64_t{1} << 30;  // 1 GiB uncompressed
 inline constexpr int kZstdLevel = 9;
 
+// .svec.json: version 1, or 2 when the image has objects (the "objects" member).
 inline constexpr int kJsonVersion = 1;
+inline constexpr int kJsonObjectsVersion = 2;
 inline constexpr int kMaxJsonDepth = 32;
 
 // Largest file read_svec() accepts (either form).

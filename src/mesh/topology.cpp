@@ -161,7 +161,8 @@ MeshTopology MeshTopology::build(const ControlMesh& mesh, int width, int height)
   t.vertex_tags.assign(nv, VertexTag::kSmooth);
   for (int v = 0; v < nv; ++v) {
     const Vec2 p = mesh.positions[v];
-    const bool image_corner = (p.x == 0 || p.x == width) && (p.y == 0 || p.y == height);
+    const bool image_corner =
+        width >= 0 && (p.x == 0 || p.x == width) && (p.y == 0 || p.y == height);
     if (image_corner || is_endpoint[v]) {
       t.vertex_tags[v] = VertexTag::kCorner;
     } else if (creases[v] == 0 && tears[v] == 0) {

@@ -110,20 +110,29 @@ class LevelValidator {
  public:
   LevelValidator(const ControlMesh& mesh, int width, int height, int level)
       : mesh_(mesh), width_(width), height_(height), prefix_("level " + str(level) + ": ") {}
+  // An object's mesh (validate_object): no frame to tile.
+  LevelValidator(const ControlMesh& mesh, int width, int height, const std::string& prefix)
+      : mesh_(mesh), width_(width), height_(height), prefix_(prefix), object_(true) {}
 
   MeshTopology run() {
     check_sizes();
     check_values();
     check_features();
     try {
-      topo_ = MeshTopology::build(mesh_, width_, height_);
+      topo_ = object_ ? MeshTopology::build(mesh_, MeshTopology::kNoFrame, MeshTopology::kNoFrame)
+                      : MeshTopology::build(mesh_, width_, height_);
     } catch (const Error& e) {
       throw Error(e.code(), prefix_ + e.what());
     }
     check_triangle_areas();
     check_unused_vertices();
-    check_boundary();
-    check_tiling();
+    if (object_) {
+      check_object_boundary();
+      check_object_turns();
+    } else {
+      check_boundary();
+      check_tiling();
+    }
     check_colors();
     return std::move(topo_);
   }
@@ -163,7 +172,12 @@ class LevelValidator {
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
         fail("vertex " + str(v) + " position " + point(p) + " is not finite");
       }
-      if (p.x < 0 || p.x > width_ || p.y < 0 || p.y > height_) {
+      if (object_) {
+        constexpr double kFar = double(1 << 24);
+        if (std::abs(p.x) > kFar || std::abs(p.y) > kFar) {
+          fail("vertex " + str(v) + " position " + point(p) + " is more than 2^24 pixels away");
+        }
+      } else if (p.x < 0 || p.x > width_ || p.y < 0 || p.y > height_) {
         fail("vertex " + str(v) + " position " + point(p) + " is outside the image [0, " +
              str(width_) + "] x [0, " + str(height_) + "]");
       }
@@ -259,6 +273,45 @@ class LevelValidator {
     }
   }
 
+  // An object: its boundary edges make closed loops, two at each boundary vertex (no pinch).
+  void check_object_boundary() {
+    if (mesh_.triangles.empty()) fail("has no triangles");
+    on_boundary_.assign(mesh_.positions.size(), 0);
+    for (int e = 0; e < topo_.num_edges(); ++e) {
+      if (topo_.edge_faces[e][1] >= 0) continue;
+      for (const int v : topo_.edges[e]) ++on_boundary_[v];
+    }
+    for (int v = 0; v < mesh_.num_vertices(); ++v) {
+      if (on_boundary_[v] != 0 && on_boundary_[v] != 2) {
+        fail("vertex " + str(v) + " " + point(pos(v)) + " is on " + str(int(on_boundary_[v])) +
+             " boundary edges (an object's boundary is made of closed loops, two edges at each "
+             "vertex)");
+      }
+    }
+  }
+
+  // An object: the triangles around an interior vertex make exactly one turn (no fold), and those
+  // around a boundary vertex less than one.
+  void check_object_turns() const {
+    std::vector<double> angle_sum(mesh_.positions.size(), 0.0);
+    for (const Tri& t : mesh_.triangles) {
+      const Vec2 a = pos(t[0]), b = pos(t[1]), c = pos(t[2]);
+      angle_sum[t[0]] += corner_angle(a, b, c);
+      angle_sum[t[1]] += corner_angle(b, c, a);
+      angle_sum[t[2]] += corner_angle(c, a, b);
+    }
+    constexpr double kTurn = 2 * std::numbers::pi, kAngleTolerance = 1e-6;
+    for (int v = 0; v < mesh_.num_vertices(); ++v) {
+      const double sum = angle_sum[v];
+      const bool bad = on_boundary_[v] ? !(sum < kTurn - kAngleTolerance)
+                                       : std::abs(sum - kTurn) > kAngleTolerance;
+      if (bad) {
+        fail("triangles overlap around vertex " + str(v) + " " + point(pos(v)) +
+             ": their angles there sum to " + num(sum / std::numbers::pi) + "*pi");
+      }
+    }
+  }
+
   void check_tiling() const {
     const int nv = mesh_.num_vertices();
     std::vector<double> angle_sum(nv, 0.0);
@@ -347,6 +400,7 @@ class LevelValidator {
   const std::string prefix_;
   MeshTopology topo_;
   std::vector<uint8_t> on_boundary_;
+  const bool object_ = false;
 };
 
 void validate_stroke(const Stroke& stroke, size_t index, int num_levels) {
@@ -422,6 +476,19 @@ MeshTopology validate_level(const ControlMesh& mesh, int width, int height, int 
   return LevelValidator(mesh, width, height, level_index).run();
 }
 
+MeshTopology validate_object(const Object& object, int width, int height, int num_levels, int index) {
+  const std::string prefix = "object " + str(index) + ": ";
+  if (object.level < 0 || object.level >= num_levels) {
+    throw Error(ErrorCode::kInvalidMesh, prefix + "level " + str(object.level) +
+                                             " is out of range (" + str(num_levels) + " levels)");
+  }
+  if (!valid_utf8(object.name)) throw Error(ErrorCode::kInvalidMesh, prefix + "name is not UTF-8");
+  if (!object.mesh.parent_vertices.empty() || !object.mesh.collapses.empty()) {
+    throw Error(ErrorCode::kInvalidMesh, prefix + "an object has no parent vertices or collapses");
+  }
+  return LevelValidator(object.mesh, width, height, prefix).run();
+}
+
 void validate(const VectorImage& image) {
   for (const auto& [name, value] : {std::pair{"width", image.width}, {"height", image.height}}) {
     if (value < 1)
@@ -447,6 +514,14 @@ void validate(const VectorImage& image) {
     validate_level(image.levels[l], image.width, image.height, static_cast<int>(l));
   for (size_t l = 0; l < image.levels.size(); ++l)
     validate_level_link(image, static_cast<int>(l));
+  if (static_cast<int64_t>(image.objects.size()) > Limits::kMaxObjects) {
+    throw Error(ErrorCode::kLimit, str(int64_t(image.objects.size())) +
+                                       " objects is over the limit of " + str(Limits::kMaxObjects));
+  }
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    validate_object(image.objects[o], image.width, image.height,
+                    static_cast<int>(image.levels.size()), static_cast<int>(o));
+  }
   if (static_cast<int64_t>(image.strokes.size()) > Limits::kMaxElements) {
     throw Error(ErrorCode::kLimit, str(int64_t(image.strokes.size())) +
                                        " strokes is over the limit of " +

@@ -40,6 +40,7 @@
 #include "render/gpu/gpu_p.h"
 #include "render/raster_p.h"
 #include "render/renderer_p.h"
+#include "render/objects_p.h"
 #include "render/strokes_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/validate.h"
@@ -327,6 +328,12 @@ struct RefineCache {
 };
 
 // Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
+// Whether any visible object is drawn over `level`.
+bool has_objects(const VectorImage& image, int level) {
+  return std::any_of(image.objects.begin(), image.objects.end(),
+                     [&](const Object& o) { return o.level == level && o.visible; });
+}
+
 // bounds each block's vertices.
 void update_blocks(const RefinedMesh& r, std::vector<detail::TriangleBlock>& blocks, int threads) {
   constexpr int32_t kBlock = 64;
@@ -409,6 +416,8 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
   const int threads = detail::resolve_threads(options.threads);
   if (plan.faces.empty()) {
     out = Image8(plan.view.width, plan.view.height, plan.channels);
+    detail::draw_objects(image, options.level, plan.view, plan.depth, options.antialias, threads,
+                         nullptr, out);
     return;
   }
   if (plan.all_faces) plan.faces.clear();
@@ -444,6 +453,8 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
       if (c.colors_stale) state.gpu->set_colors(mesh.colors);
       c.positions_stale = c.colors_stale = false;
       state.gpu->draw(plan.view, plan.channels, options.antialias, out);
+      detail::draw_objects(image, options.level, plan.view, plan.depth, options.antialias, threads,
+                           nullptr, out);
     } catch (const Error& e) {
       if (e.code() != ErrorCode::kLimit) throw;
       // Over the driver's buffers or memory: this view is drawn on the CPU.
@@ -498,7 +509,15 @@ void render_with(const VectorImage& image, State& state, const RenderOptions& op
     overlay = detail::mesh_overlay(mesh, *ls.topology, plan.view);
   if (options.overlay == Overlay::kFeatures)
     overlay = detail::feature_overlay(c.refined, plan.view);
-  detail::rasterize_into(c.refined, plan.view, raster, overlay, &state.scratch, out);
+  // Objects draw over the level and under its overlay.
+  const bool objects = has_objects(image, options.level);
+  detail::rasterize_into(c.refined, plan.view, raster,
+                         objects ? std::span<const detail::OverlayLayer>{} : overlay, &state.scratch, out);
+  if (objects) {
+    detail::draw_objects(image, options.level, plan.view, plan.depth, options.antialias, threads,
+                         nullptr, out);
+    detail::draw_overlay(out, overlay, threads);
+  }
   detail::draw_strokes(image.strokes, options.level, plan.view, out);
 }
 
@@ -623,6 +642,7 @@ void draw_tile(const VectorImage& image, const RenderOptions& options, const Mes
     if (detail::box_meets(boxes[f], tile)) work.faces.push_back(f);
   }
   if (work.faces.empty()) {
+    detail::draw_objects(image, options.level, v, plan.depth, options.antialias, threads, &clip, strip);
     if (options.overlay == Overlay::kMesh) detail::draw_overlay_clipped(strip, clip, mesh_overlay);
     detail::draw_strokes(image.strokes, options.level, v, clip, strip);
     return;
@@ -642,12 +662,18 @@ void draw_tile(const VectorImage& image, const RenderOptions& options, const Mes
   raster.clip = clip;
   std::vector<detail::OverlayLayer> features;
   if (options.overlay == Overlay::kFeatures) features = detail::feature_overlay(work.refined, v);
-  detail::rasterize_into(work.refined, v, raster,
-                         options.overlay == Overlay::kFeatures ? features
-                         : options.overlay == Overlay::kMesh
-                             ? mesh_overlay
-                             : std::span<const detail::OverlayLayer>{},
+  const std::span<const detail::OverlayLayer> overlay =
+      options.overlay == Overlay::kFeatures ? features
+      : options.overlay == Overlay::kMesh   ? mesh_overlay
+                                            : std::span<const detail::OverlayLayer>{};
+  // Objects draw over the level and under its overlay.
+  const bool objects = has_objects(image, options.level);
+  detail::rasterize_into(work.refined, v, raster, objects ? std::span<const detail::OverlayLayer>{} : overlay,
                          &work.scratch, strip);
+  if (objects) {
+    detail::draw_objects(image, options.level, v, plan.depth, options.antialias, threads, &clip, strip);
+    detail::draw_overlay_clipped(strip, clip, overlay);
+  }
   detail::draw_strokes(image.strokes, options.level, v, clip, strip);
 }
 

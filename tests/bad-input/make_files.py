@@ -544,7 +544,7 @@ def library_binary_files():
     good = svec(square_payload())
     write_library("wrong-magic.svec", b"SUBVEX" + good[6:])
     write_library("wrong-version.svec", svec(square_payload(), version=7))
-    write_library("unknown-flags.svec", svec(square_payload(), flags=1))
+    write_library("unknown-flags.svec", svec(square_payload(), flags=2))
     write_library("truncated-header.svec", good[:20])
     write_library("truncated.svec", good[:len(good) - 30])
     write_library("truncated-zstd.svec", svec(square_payload(), frame=raw_zstd_frame(square_payload())[:-30]))

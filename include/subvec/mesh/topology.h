@@ -44,7 +44,9 @@ struct MeshTopology {
 
   // Builds the topology. Throws Error(kInvalidMesh) when indices are out of range, the mesh is not
   // an edge-manifold consistently oriented triangle mesh, or a crease/feature is not a chain of
-  // mesh edges. Geometric checks are in validate().
+  // mesh edges. Geometric checks are in validate(). The vertices at the corners of the width x height
+  // image are corners; an object's mesh (Object) has none: pass kNoFrame for both.
+  static constexpr int kNoFrame = -1;
   static MeshTopology build(const ControlMesh& mesh, int width, int height);
 
  private:

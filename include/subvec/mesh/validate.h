@@ -11,6 +11,7 @@ struct Limits {
   static constexpr int32_t kMaxDimension = 1 << 16;         // width or height, pixels
   static constexpr int64_t kMaxPixels = int64_t{1} << 30;   // width * height
   static constexpr int32_t kMaxLevels = 64;
+  static constexpr int32_t kMaxObjects = 4096;
   static constexpr int64_t kMaxElements = int64_t{1} << 26; // vertices, colors, triangles per level
 };
 
@@ -25,7 +26,14 @@ struct Limits {
 //    use the same color values.
 MeshTopology validate_level(const ControlMesh& mesh, int width, int height, int level_index = 0);
 
-// Checks the whole image: size, levels (at least one), every level, and strokes.
+// Checks object `index` of an image of width x height pixels with `num_levels` levels and returns
+// its topology (built with MeshTopology::kNoFrame). As validate_level, except that the mesh need
+// not tile the image: its boundary is one or more closed loops of edges (each boundary vertex on
+// exactly two boundary edges), the triangles around each interior vertex make one full turn, and
+// positions may leave the image (within +-2^24 px). Messages start with "object N: ".
+MeshTopology validate_object(const Object& object, int width, int height, int num_levels, int index);
+
+// Checks the whole image: size, levels (at least one), every level, objects and strokes.
 void validate(const VectorImage& image);
 
 }  // namespace subvec

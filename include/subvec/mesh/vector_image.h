@@ -94,9 +94,23 @@ struct ControlMesh {
   }
 };
 
+// An object (a layer over one level): its own control mesh, drawn over the level's mesh in the
+// order of VectorImage::objects. Its mesh is a triangulated region whose boundary is the closed
+// curve it was cut along (a boundary edge is a crease, like the image border of a level), and its
+// positions may leave the image (an object moved partly off it is clipped when drawn). Moving,
+// rotating or scaling it moves its control points: the limit surface of an affine image of the
+// control points is the affine image of the limit surface. edit/objects.h makes and edits them.
+struct Object {
+  int32_t level = 0;  // the level it is drawn over
+  std::string name;
+  bool visible = true;
+  ControlMesh mesh;   // parent_vertices and collapses stay empty
+};
+
 struct VectorImage {
   int32_t width = 0, height = 0;
   std::vector<ControlMesh> levels;  // level 0 is the finest
+  std::vector<Object> objects;      // bottom to top
   std::vector<Stroke> strokes;
   std::vector<std::pair<std::string, std::string>> metadata;
 };

@@ -213,8 +213,8 @@ TEST(SvecJsonErrors, MissingKeys) {
 TEST(SvecJsonErrors, FormatAndVersion) {
   expect_json_error(edited("\"subvec\"", "\"svg\""), ErrorCode::kBadFile,
                     {"format", "expected \"subvec\""});
-  expect_json_error(edited("\"version\": 1", "\"version\": 2"), ErrorCode::kBadFile,
-                    {"unsupported .svec.json version 2 (this build reads 1)"});
+  expect_json_error(edited("\"version\": 1", "\"version\": 3"), ErrorCode::kBadFile,
+                    {"unsupported .svec.json version 3 (this build reads 1 and 2)"});
 }
 
 TEST(SvecJsonErrors, TriangleColorsMustMatch) {

@@ -1,0 +1,72 @@
+// Objects as layers (issue 26; the paper's own limitation, §7.3: "the vector image is one mesh").
+//
+// Making an object. A closed tear of a level (a GrabCut boundary from `--segment`, a feature the
+// user drew, a detected one) bounds a region of the level's control mesh. make_object cuts the mesh
+// along it:
+//  - the object (Object, mesh/vector_image.h) gets the region's triangles, vertices and inside
+//    colors, and the features and creases within it. Its boundary is the closed curve, so it
+//    renders as the region did: the inner colors depend on nothing outside the tear;
+//  - the level keeps the rest, and under the object a background is completed. The region's
+//    triangles stay (without their features and creases) and are simplified to the level's mean
+//    vertex density by half-edge collapses; their colors are the smoothest fill from the ring
+//    around the hole: the minimizer of the squared uniform Laplacian over the hole's vertices and
+//    the curve's, with the colors outside fixed (biharmonic), and the curve's inner colors set to
+//    the outer ones so the fill meets its surroundings without a step. The closed curve stays a
+//    tear of the level, so nothing outside the hole changes.
+// A feature that crosses the curve at one of its vertices is split there, each side's part going
+// to its side.
+//
+// Editing an object. Its control points move rigidly (move, rotate, scale about a pivot): the
+// limit surface of an affine image of the control points is the same affine image of the limit
+// surface, so the object moves exactly. It can be hidden, shown and reordered; objects draw over
+// their level in the order of VectorImage::objects, each anti-aliased along its boundary.
+//
+// Every function validates what it is given and throws Error(kInvalidArgument) naming the problem
+// with the image unchanged. All are deterministic.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "subvec/mesh/vector_image.h"
+
+namespace subvec {
+
+struct MakeObjectResult {
+  int object = -1;          // index of the new object in image.objects
+  int object_vertices = 0;  // control vertices of the object
+  int fill_vertices = 0;    // interior vertices of the background under it (after simplification)
+  int removed = 0;          // hole vertices removed by the simplification
+  int features_moved = 0;   // features (or parts of features) that went into the object
+};
+
+// Makes an object of the region that feature `feature` (a closed tear of level `level`) bounds.
+// Throws Error(kInvalidArgument) when the level or feature is out of range, the feature is open
+// or repeats a vertex, or the region it bounds touches the image border.
+MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name = "");
+
+// A similarity transform about `pivot` (default: the centre of the object's control points'
+// bounding box): scale, then rotate by `rotate_degrees` (clockwise on screen, y down, as SVG's
+// rotate()), then translate.
+struct ObjectTransform {
+  Vec2 translate;
+  double rotate_degrees = 0;
+  double scale = 1;
+  std::optional<Vec2> pivot;
+};
+
+// Applies `transform` to object `object`'s control points. Throws Error(kInvalidArgument) for an
+// index out of range, a non-finite value or a scale that is not positive.
+void transform_object(VectorImage& image, int object, const ObjectTransform& transform);
+
+// Shows or hides object `object`.
+void set_object_visible(VectorImage& image, int object, bool visible);
+
+// Moves object `object` to position `to` of the drawing order (0 is the bottom), shifting the
+// ones between.
+void reorder_object(VectorImage& image, int object, int to);
+
+// The pivot transform_object uses by default: the centre of the object's control bounding box.
+Vec2 object_center(const Object& object);
+
+}  // namespace subvec

@@ -1,0 +1,458 @@
+// Objects as layers: see include/subvec/edit/objects.h for what each function does and why.
+#include "subvec/edit/objects.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "core/messages_p.h"
+#include "mesh/collapse_engine_p.h"
+#include "mesh/coarsen_p.h"
+#include "subvec/core/error.h"
+#include "subvec/mesh/topology.h"
+#include "subvec/mesh/validate.h"
+
+namespace subvec {
+namespace {
+
+using detail::invalid;
+using detail::num;
+
+double area(Vec2 a, Vec2 b, Vec2 c) {
+  return 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+}
+
+// The faces of `mesh` on the side of the closed chain `chain` that does not reach the image
+// border (1 inside, 0 outside). Throws when both sides reach it.
+std::vector<uint8_t> inside_faces(const ControlMesh& mesh, const MeshTopology& topology,
+                                  const Feature& chain, const std::string& what) {
+  std::vector<uint8_t> blocked(topology.num_edges(), 0);
+  for (size_t i = 0; i + 1 < chain.vertices.size(); ++i) {
+    blocked[topology.find_edge(chain.vertices[i], chain.vertices[i + 1])] = 1;
+  }
+  // Components of the faces, across every edge but the chain's.
+  const int nf = mesh.num_triangles();
+  std::vector<int32_t> component(nf, -1);
+  std::vector<uint8_t> reaches_border;
+  std::vector<int32_t> stack;
+  for (int seed = 0; seed < nf; ++seed) {
+    if (component[seed] >= 0) continue;
+    const int32_t id = static_cast<int32_t>(reaches_border.size());
+    reaches_border.push_back(0);
+    component[seed] = id;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const int32_t f = stack.back();
+      stack.pop_back();
+      for (const int32_t e : topology.face_edges[f]) {
+        if (blocked[e]) continue;
+        const auto [a, b] = topology.edge_faces[e];
+        if (b < 0) {
+          reaches_border[id] = 1;
+          continue;
+        }
+        const int32_t g = a == f ? b : a;
+        if (component[g] < 0) {
+          component[g] = id;
+          stack.push_back(g);
+        }
+      }
+    }
+  }
+  const int e0 = topology.find_edge(chain.vertices[0], chain.vertices[1]);
+  const int32_t side_a = component[topology.edge_faces[e0][0]];
+  const int32_t side_b = component[topology.edge_faces[e0][1]];
+  if (reaches_border[side_a] == reaches_border[side_b]) {
+    invalid(what + " does not enclose a region apart from the image border");
+  }
+  const int32_t inner = reaches_border[side_a] ? side_b : side_a;
+  std::vector<uint8_t> inside(nf, 0);
+  for (int f = 0; f < nf; ++f) inside[f] = component[f] == inner;
+  return inside;
+}
+
+// Splits the features other than `skip` into the runs of edges on one side of the curve: edges
+// whose faces are inside go to `in`, the others to `out`. The first run of a feature in each mesh
+// keeps its id; later ones take ids from `next_id`.
+void split_features(const ControlMesh& mesh, const MeshTopology& topology,
+                    const std::vector<uint8_t>& inside, int skip, int32_t& next_id,
+                    std::vector<Feature>& in, std::vector<Feature>& out) {
+  for (int g = 0; g < static_cast<int>(mesh.features.size()); ++g) {
+    if (g == skip) continue;
+    const Feature& feature = mesh.features[g];
+    std::vector<int32_t> v = feature.vertices;
+    const size_t edges = v.size() - 1;
+    auto side = [&](size_t i) {
+      return inside[topology.edge_faces[topology.find_edge(v[i], v[i + 1])][0]] != 0;
+    };
+    if (feature.closed()) {
+      // Start a closed chain where it changes side, if it does.
+      for (size_t i = 1; i <= edges; ++i) {
+        if (side(i % edges) != side(i - 1)) {
+          std::vector<int32_t> turned(v.begin() + long(i % edges), v.end() - 1);
+          turned.insert(turned.end(), v.begin(), v.begin() + long(i % edges) + 1);
+          v = std::move(turned);
+          break;
+        }
+      }
+    }
+    bool first_in = true, first_out = true;
+    size_t begin = 0;
+    for (size_t i = 1; i <= edges; ++i) {
+      if (i < edges && side(i) == side(begin)) continue;
+      const bool is_in = side(begin);
+      Feature run = feature;
+      run.vertices.assign(v.begin() + long(begin), v.begin() + long(i) + 1);
+      bool& first = is_in ? first_in : first_out;
+      if (!first) run.id = next_id++;
+      first = false;
+      (is_in ? in : out).push_back(std::move(run));
+      begin = i;
+    }
+  }
+}
+
+// The object: the inside faces, their vertices and colors renumbered in ascending order.
+ControlMesh object_mesh(const ControlMesh& mesh, const MeshTopology& topology,
+                        const std::vector<uint8_t>& inside, std::vector<Feature> features) {
+  std::vector<int32_t> vmap(mesh.num_vertices(), -1), cmap(mesh.num_colors(), -1);
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    if (!inside[f]) continue;
+    for (int k = 0; k < 3; ++k) {
+      vmap[mesh.triangles[f][k]] = 0;
+      cmap[mesh.triangle_colors[f][k]] = 0;
+    }
+  }
+  ControlMesh o;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    if (vmap[v] < 0) continue;
+    vmap[v] = o.num_vertices();
+    o.positions.push_back(mesh.positions[v]);
+  }
+  for (int c = 0; c < mesh.num_colors(); ++c) {
+    if (cmap[c] < 0) continue;
+    cmap[c] = o.num_colors();
+    o.colors.push_back(mesh.colors[c]);
+  }
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    if (!inside[f]) continue;
+    Tri t, tc;
+    for (int k = 0; k < 3; ++k) t[k] = vmap[mesh.triangles[f][k]], tc[k] = cmap[mesh.triangle_colors[f][k]];
+    o.triangles.push_back(t);
+    o.triangle_colors.push_back(tc);
+  }
+  for (const EdgeVerts& e : mesh.creases) {
+    if (inside[topology.edge_faces[topology.find_edge(e[0], e[1])][0]])
+      o.creases.push_back({vmap[e[0]], vmap[e[1]]});
+  }
+  for (Feature& f : features) {
+    for (int32_t& v : f.vertices) v = vmap[v];
+  }
+  o.features = std::move(features);
+  return o;
+}
+
+// Removes interior vertices of the hole (`hole_vertex`) by half-edge collapses, shortest edge
+// first, until `target` of them remain or none can go. Returns how many went.
+int simplify_hole(coarsen_detail::Coarsener& c, const std::vector<uint8_t>& hole_vertex, int target) {
+  const int nv = c.num_vertices();
+  int remaining = 0;
+  for (int v = 0; v < nv; ++v) remaining += hole_vertex[v];
+  detail::CollapseQueue queue;
+  std::vector<uint32_t> version(nv, 0);
+  auto plan = [&](int32_t u, int32_t v) {
+    if (!hole_vertex[u]) return;
+    const Vec2 a = c.positions()[u], b = c.positions()[v];
+    queue.push(detail::make_entry((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y), u, v,
+                                  version[u], version[v]));
+  };
+  std::vector<int32_t> ring, ring2;
+  for (int32_t v = 0; v < nv; ++v) {
+    if (!hole_vertex[v]) continue;
+    c.neighbours(v, ring);
+    for (const int32_t w : ring) plan(v, w);
+  }
+  int removed = 0;
+  const auto more = [&] { return remaining > target; };
+  const auto live = [&](const detail::Entry& e) { return detail::entry_live(e, c.vertex_alive(), version); };
+  const auto step = [&](const detail::Entry& e) {
+    const int32_t u = e.remove(), v = e.keep;
+    if (!c.can_collapse(u, v, 0.0)) return;
+    c.neighbours(u, ring);
+    c.collapse(u, v);
+    --remaining, ++removed;
+    for (const int32_t w : ring) ++version[w];
+    for (const int32_t w : ring) {
+      c.neighbours(w, ring2);
+      for (const int32_t x : ring2) plan(w, x), plan(x, w);
+    }
+  };
+  detail::run_collapses(queue, nullptr, more, live, step);
+  return removed;
+}
+
+// The smoothest fill of the hole's colors. With L the uniform Laplacian of the hole's triangles
+// (a curve vertex's row over its neighbours in the hole), minimizes
+//   sum over the hole's vertices and the curve's of |(L c)_v|^2
+//   + kCurveWeight * sum over the curve of |c_v - o_v|^2
+// where o_v is the mean of v's colors outside: a thin plate whose edge follows the colors around
+// the hole, and bends away from them only where they jump along the curve (what the fill could
+// not follow smoothly). Sets the colors of the hole's corners.
+constexpr double kCurveWeight = 1.0;
+constexpr double kCurveRobust = 8.0;
+constexpr int kCurveIterations = 5;
+
+void fill_hole_colors(ControlMesh& mesh, const std::vector<uint8_t>& hole_face) {
+  const int nv = mesh.num_vertices(), nf = mesh.num_triangles();
+  std::vector<uint8_t> touches_hole(nv, 0), touches_outside(nv, 0);
+  std::vector<std::set<int32_t>> outside_colors(nv);
+  std::vector<std::set<int32_t>> neighbours(nv);  // within the hole
+  for (int f = 0; f < nf; ++f) {
+    const Tri& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      (hole_face[f] ? touches_hole : touches_outside)[t[k]] = 1;
+      if (hole_face[f]) {
+        neighbours[t[k]].insert(t[(k + 1) % 3]);
+        neighbours[t[k]].insert(t[(k + 2) % 3]);
+      }
+    }
+  }
+  // The colors around the hole: at each curve vertex, those of its outside neighbours off the
+  // curve (a control edge away from the tear, past the colors that fitted its edge), or its own
+  // outside colors where it has no such neighbour.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int f = 0; f < nf; ++f) {
+      if (hole_face[f]) continue;
+      const Tri& t = mesh.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        const int32_t v = t[k];
+        if (!touches_hole[v]) continue;
+        for (const int d : {1, 2}) {
+          const int j = (k + d) % 3;
+          if (pass == 0 ? !touches_hole[t[j]] : outside_colors[v].empty() && t[j] == v)
+            outside_colors[v].insert(mesh.triangle_colors[f][j]);
+        }
+        if (pass == 1 && outside_colors[v].empty()) outside_colors[v].insert(mesh.triangle_colors[f][k]);
+      }
+    }
+  }
+  // Every vertex of the hole is an unknown; the curve's are pulled to their outside means.
+  std::vector<int32_t> unknown(nv, -1);
+  int n = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (touches_hole[v]) unknown[v] = n++;
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<int32_t> curve;           // the curve's unknowns
+  std::vector<Eigen::Vector3d> target;  // and their outside colors
+  int rows = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (!touches_hole[v]) continue;
+    const double w = 1.0 / double(neighbours[v].size());
+    entries.emplace_back(rows, unknown[v], 1.0);
+    for (const int32_t x : neighbours[v]) entries.emplace_back(rows, unknown[x], -w);
+    ++rows;
+    if (!touches_outside[v]) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const int32_t c : outside_colors[v]) {
+      const Color k = mesh.colors[c];
+      mean += Eigen::Vector3d(k.r, k.g, k.b);
+    }
+    curve.push_back(unknown[v]);
+    target.push_back(mean / double(outside_colors[v].size()));
+  }
+  Eigen::SparseMatrix<double> laplacian(rows, n);
+  laplacian.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SparseMatrix<double> smooth = laplacian.transpose() * laplacian;
+  // Iteratively reweighted: a curve vertex whose fill lands more than kCurveRobust levels from
+  // its outside color is pulled less (Huber), so an odd color on the rim (a piece of the object
+  // left outside its curve) does not bend the fill around it.
+  std::vector<double> weight(curve.size(), kCurveWeight);
+  Eigen::MatrixX3d solution;
+  for (int iteration = 0; iteration < kCurveIterations; ++iteration) {
+    Eigen::SparseMatrix<double> normal = smooth;
+    Eigen::MatrixX3d b = Eigen::MatrixX3d::Zero(n, 3);
+    for (size_t i = 0; i < curve.size(); ++i) {
+      normal.coeffRef(curve[i], curve[i]) += weight[i];
+      b.row(curve[i]) += weight[i] * target[i].transpose();
+    }
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+    if (solver.info() != Eigen::Success) invalid("the hole's color fill could not be solved");
+    solution = solver.solve(b);
+    for (size_t i = 0; i < curve.size(); ++i) {
+      const double r = (solution.row(curve[i]).transpose() - target[i]).norm();
+      weight[i] = kCurveWeight * std::min(1.0, kCurveRobust / std::max(r, 1e-9));
+    }
+  }
+  auto clamp = [](double x) { return static_cast<float>(std::clamp(x, 0.0, 255.0)); };
+  for (int f = 0; f < nf; ++f) {
+    if (!hole_face[f]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const auto x = solution.row(unknown[mesh.triangles[f][k]]);
+      mesh.colors[mesh.triangle_colors[f][k]] = {clamp(x[0]), clamp(x[1]), clamp(x[2])};
+    }
+  }
+}
+
+Object& object_at(VectorImage& image, int object) {
+  if (object < 0 || object >= static_cast<int>(image.objects.size())) {
+    invalid("object " + std::to_string(object) + " is out of range (" +
+            std::to_string(image.objects.size()) + " objects)");
+  }
+  return image.objects[object];
+}
+
+}  // namespace
+
+MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name) {
+  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+    invalid("level " + std::to_string(level) + " is out of range (" +
+            std::to_string(image.levels.size()) + " levels)");
+  }
+  const ControlMesh& mesh = image.levels[level];
+  if (feature < 0 || feature >= static_cast<int>(mesh.features.size())) {
+    invalid("feature " + std::to_string(feature) + " is out of range (" +
+            std::to_string(mesh.features.size()) + " features on level " + std::to_string(level) + ")");
+  }
+  const Feature& chain = mesh.features[feature];
+  const std::string what = "feature " + std::to_string(feature) + " (id " + std::to_string(chain.id) + ")";
+  if (!chain.closed()) invalid(what + " is open; an object needs a closed feature");
+  {
+    std::vector<int32_t> sorted(chain.vertices.begin(), chain.vertices.end() - 1);
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+      invalid(what + " passes through a vertex twice; an object needs a simple closed curve");
+  }
+  const MeshTopology topology = validate_level(mesh, image.width, image.height, level);
+  const std::vector<uint8_t> inside = inside_faces(mesh, topology, chain, what);
+
+  int32_t next_id = 0;
+  for (const Feature& f : mesh.features) next_id = std::max(next_id, f.id + 1);
+  std::vector<Feature> in, out;
+  split_features(mesh, topology, inside, feature, next_id, in, out);
+  MakeObjectResult result;
+  result.features_moved = static_cast<int>(in.size());
+
+  Object object;
+  object.level = level;
+  object.name = name;
+  object.mesh = object_mesh(mesh, topology, inside, std::move(in));
+  result.object_vertices = object.mesh.num_vertices();
+
+  // The background: the same triangles, the features and creases outside, colors renumbered by
+  // the tears that remain (one value per hole vertex, one on the hole's side of each curve vertex).
+  ControlMesh back;
+  back.positions = mesh.positions;
+  back.triangles = mesh.triangles;
+  back.features = std::move(out);
+  back.features.push_back(chain);
+  for (const EdgeVerts& e : mesh.creases) {
+    if (!inside[topology.edge_faces[topology.find_edge(e[0], e[1])][0]]) back.creases.push_back(e);
+  }
+  {
+    const MeshTopology t = MeshTopology::build(back, image.width, image.height);
+    int nc = 0;
+    back.triangle_colors = face_varying_indices(back, t, nc);
+    back.colors.assign(nc, Color{});
+    for (int f = 0; f < back.num_triangles(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (!inside[f]) back.colors[back.triangle_colors[f][k]] = mesh.colors[mesh.triangle_colors[f][k]];
+      }
+    }
+  }
+  // Simplify the hole to the level's mean density.
+  double hole_area = 0;
+  std::vector<uint8_t> hole_vertex(back.num_vertices(), 1);
+  for (int f = 0; f < back.num_triangles(); ++f) {
+    const Tri& t = back.triangles[f];
+    if (inside[f]) {
+      hole_area += area(back.positions[t[0]], back.positions[t[1]], back.positions[t[2]]);
+    } else {
+      for (const int32_t v : t) hole_vertex[v] = 0;
+    }
+  }
+  const int target = static_cast<int>(std::lround(
+      hole_area * mesh.num_vertices() / (double(image.width) * double(image.height))));
+  std::vector<int32_t> kept;
+  for (const Feature& f : back.features) kept.push_back(f.id);
+  coarsen_detail::Coarsener coarsener(back, image.width, image.height, kept);
+  result.removed = simplify_hole(coarsener, hole_vertex, target);
+  std::vector<int32_t> parents, color_merged;
+  back = coarsener.result(parents, color_merged);
+  // The hole's faces after the collapses: those inside the curve, found again.
+  const MeshTopology t = MeshTopology::build(back, image.width, image.height);
+  const auto curve = std::find_if(back.features.begin(), back.features.end(),
+                                  [&](const Feature& f) { return f.id == chain.id; });
+  const std::vector<uint8_t> hole = inside_faces(back, t, *curve, what);
+  fill_hole_colors(back, hole);
+  for (const int32_t p : parents) result.fill_vertices += hole_vertex[p];
+
+  validate_level(back, image.width, image.height, level);
+  validate_object(object, image.width, image.height, static_cast<int>(image.levels.size()),
+                  static_cast<int>(image.objects.size()));
+  image.levels[level] = std::move(back);
+  if (level + 1 < static_cast<int>(image.levels.size())) {
+    image.levels[level + 1].parent_vertices.clear();
+    image.levels[level + 1].collapses.clear();
+  }
+  image.objects.push_back(std::move(object));
+  result.object = static_cast<int>(image.objects.size()) - 1;
+  return result;
+}
+
+Vec2 object_center(const Object& object) {
+  const std::vector<Vec2>& p = object.mesh.positions;
+  if (p.empty()) return {};
+  double x0 = p[0].x, x1 = p[0].x, y0 = p[0].y, y1 = p[0].y;
+  for (const Vec2& q : p) {
+    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  }
+  return {0.5 * (x0 + x1), 0.5 * (y0 + y1)};
+}
+
+void transform_object(VectorImage& image, int object, const ObjectTransform& transform) {
+  Object& o = object_at(image, object);
+  const Vec2 pivot = transform.pivot.value_or(object_center(o));
+  for (const auto& [field, value] :
+       {std::pair{"translate x", transform.translate.x}, {"translate y", transform.translate.y},
+        {"rotate", transform.rotate_degrees}, {"pivot x", pivot.x}, {"pivot y", pivot.y}}) {
+    if (!std::isfinite(value)) invalid(std::string(field) + " " + num(value) + " is not finite");
+  }
+  detail::check_positive("scale", transform.scale);
+  const double angle = transform.rotate_degrees * std::numbers::pi / 180;
+  const double c = transform.scale * std::cos(angle), s = transform.scale * std::sin(angle);
+  std::vector<Vec2> moved = o.mesh.positions;
+  for (Vec2& p : moved) {
+    const double x = p.x - pivot.x, y = p.y - pivot.y;
+    p = {pivot.x + c * x - s * y + transform.translate.x, pivot.y + s * x + c * y + transform.translate.y};
+  }
+  // A scale of 1e-300 or a translation of 1e30 is refused by the object's validation, unchanged.
+  Object check = o;
+  check.mesh.positions = moved;
+  validate_object(check, image.width, image.height, static_cast<int>(image.levels.size()), object);
+  o.mesh.positions = std::move(moved);
+}
+
+void set_object_visible(VectorImage& image, int object, bool visible) {
+  object_at(image, object).visible = visible;
+}
+
+void reorder_object(VectorImage& image, int object, int to) {
+  object_at(image, object);
+  if (to < 0 || to >= static_cast<int>(image.objects.size())) {
+    invalid("position " + std::to_string(to) + " is out of range (" +
+            std::to_string(image.objects.size()) + " objects)");
+  }
+  Object moving = std::move(image.objects[object]);
+  image.objects.erase(image.objects.begin() + object);
+  image.objects.insert(image.objects.begin() + to, std::move(moving));
+}
+
+}  // namespace subvec

@@ -1,0 +1,478 @@
+// Objects as layers (edit/objects.h): making one from a closed tear, the background completed
+// under it, moving, rotating, hiding and reordering it, and the render of all of it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "subvec/core/error.h"
+#include "subvec/edit/objects.h"
+#include "subvec/edit/feature_edit.h"
+#include "subvec/io/image_io.h"
+#include "subvec/io/svec.h"
+#include "subvec/mesh/validate.h"
+#include "subvec/render/renderer.h"
+#include "subvec/vectorize/vectorize.h"
+#include "support/shared_photos.h"
+#include "support/synthetic.h"
+
+namespace subvec {
+namespace {
+
+Image8 draw(const VectorImage& image) {
+  RenderOptions options;
+  options.threads = 2;
+  return render(image, options);
+}
+
+// Where object `o` covers the frame: its alpha, rendered with the level black and the object white.
+std::vector<uint8_t> footprint(const VectorImage& image, int o) {
+  VectorImage mask = image;
+  for (Color& c : mask.levels[0].colors) c = {};
+  for (size_t k = 0; k < mask.objects.size(); ++k) {
+    mask.objects[k].visible = int(k) == o;
+    for (Color& c : mask.objects[k].mesh.colors) c = {255, 255, 255};
+  }
+  const Image8 frame = draw(mask);
+  std::vector<uint8_t> alpha(size_t(frame.width) * frame.height);
+  for (size_t i = 0; i < alpha.size(); ++i) alpha[i] = frame.pixels[i * 3];
+  return alpha;
+}
+
+// `mask` grown by `r` pixels (a square), thresholded at any coverage.
+std::vector<uint8_t> grow(const std::vector<uint8_t>& mask, int w, int h, int r) {
+  std::vector<uint8_t> out(mask.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!mask[size_t(y) * w + x]) continue;
+      for (int j = std::max(0, y - r); j <= std::min(h - 1, y + r); ++j)
+        for (int i = std::max(0, x - r); i <= std::min(w - 1, x + r); ++i) out[size_t(j) * w + i] = 1;
+    }
+  return out;
+}
+
+// Bilinear sample of `im` at image point (x, y) (pixel centres at half integers).
+std::array<double, 3> sample(const Image8& im, double x, double y) {
+  const double fx = std::clamp(x - 0.5, 0.0, im.width - 1.0), fy = std::clamp(y - 0.5, 0.0, im.height - 1.0);
+  const int x0 = std::min(int(fx), im.width - 2), y0 = std::min(int(fy), im.height - 2);
+  const double ax = fx - x0, ay = fy - y0;
+  std::array<double, 3> out{};
+  for (int c = 0; c < 3; ++c) {
+    auto at = [&](int i, int j) { return double(im.row(j)[size_t(i) * 3 + c]); };
+    out[c] = (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+             ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+  }
+  return out;
+}
+
+int closed_feature(const ControlMesh& mesh) {
+  for (size_t f = 0; f < mesh.features.size(); ++f)
+    if (mesh.features[f].closed()) return int(f);
+  return -1;
+}
+
+struct Moved {
+  double object_mae = 0;     // the object's pixels against the transformed original
+  double worst_fill = 0;     // largest difference of an uncovered pixel from its 5x5 mean
+  double rest_mae = 0;       // outside both footprints
+  double hidden_fill = 0;    // the same smoothness with the object hidden, over the whole hole
+  int object_pixels = 0, fill_pixels = 0;
+  MakeObjectResult made;
+};
+
+// The measure: make an object of the segment, move it (30, 0) px rotated 10 degrees.
+Moved move_segment(const Image8& photo, PixelRect rect) {
+  VectorizeOptions options;
+  options.ratio = 0.01;
+  options.levels.levels = 1;
+  options.segment = rect;
+  const VectorImage vectorized = vectorize(photo, options);
+  const Image8 before = draw(vectorized);
+  // The reference for the moved object: the image before, rendered 4x and sampled bilinearly at
+  // the preimage of each pixel centre (a 1x render resampled would blur its edges).
+  RenderOptions fine;
+  fine.threads = 2;
+  fine.scale = 4;
+  const Image8 before4 = render(vectorized, fine);
+  const int w = before.width, h = before.height;
+
+  VectorImage image = vectorized;
+  const int f = closed_feature(image.levels[0]);
+  EXPECT_GE(f, 0);
+  const MakeObjectResult made = make_object(image, 0, f, "segment");
+  EXPECT_NO_THROW(validate(image));
+  Moved m;
+  m.made = made;
+  const std::vector<uint8_t> old_foot = footprint(image, made.object);
+  const Vec2 pivot = object_center(image.objects[made.object]);
+  ObjectTransform t;
+  t.translate = {30, 0};
+  t.rotate_degrees = 10;
+  transform_object(image, made.object, t);
+  const Image8 after = draw(image);
+  const std::vector<uint8_t> new_foot = footprint(image, made.object);
+
+  // Inverse of p' = pivot + R (p - pivot) + t.
+  const double a = -10 * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  auto source = [&](double x, double y) {
+    const double u = x - 30 - pivot.x, v = y - pivot.y;
+    return Vec2{pivot.x + c * u - s * v, pivot.y + s * u + c * v};
+  };
+  double object_sum = 0, rest_sum = 0;
+  int rest = 0;
+  const std::vector<uint8_t> old_grown = grow(old_foot, w, h, 1), new_grown = grow(new_foot, w, h, 1);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      const uint8_t* q = after.row(y) + size_t(x) * 3;
+      if (new_foot[i] == 255) {
+        // The pixel's source must lie well inside the old footprint (not on its anti-aliased rim).
+        const Vec2 p = source(x + 0.5, y + 0.5);
+        const int sx = int(std::floor(p.x)), sy = int(std::floor(p.y));
+        bool inner = sx >= 1 && sy >= 1 && sx < w - 1 && sy < h - 1;
+        for (int j = -1; inner && j <= 1; ++j)
+          for (int k = -1; inner && k <= 1; ++k) inner = old_foot[size_t(sy + j) * w + sx + k] == 255;
+        if (!inner) continue;
+        // The pixel's area: 4 x 4 subsamples, mapped back.
+        std::array<double, 3> e{};
+        for (int j = 0; j < 4; ++j)
+          for (int k = 0; k < 4; ++k) {
+            const Vec2 r = source(x + (k + 0.5) / 4, y + (j + 0.5) / 4);
+            const auto one = sample(before4, 4 * r.x, 4 * r.y);
+            for (int ch = 0; ch < 3; ++ch) e[ch] += one[ch] / 16;
+          }
+        for (int ch = 0; ch < 3; ++ch) object_sum += std::abs(q[ch] - e[ch]) / 3;
+        ++m.object_pixels;
+      } else if (!old_grown[i] && !new_grown[i]) {
+        const uint8_t* b = before.row(y) + size_t(x) * 3;
+        for (int ch = 0; ch < 3; ++ch) rest_sum += std::abs(q[ch] - b[ch]) / 3.0;
+        ++rest;
+      }
+    }
+  }
+  m.object_mae = object_sum / std::max(m.object_pixels, 1);
+  m.rest_mae = rest_sum / std::max(rest, 1);
+  // Smoothness of the fill: a pixel of the old footprint, uncovered, with its 5x5 neighbourhood
+  // uncovered too, against that neighbourhood's mean.
+  auto worst_against_mean = [&](const Image8& im, const std::vector<uint8_t>& region,
+                                const std::vector<uint8_t>& covered, int& count) {
+    double worst = 0;
+    for (int y = 2; y < h - 2; ++y) {
+      for (int x = 2; x < w - 2; ++x) {
+        if (!region[size_t(y) * w + x]) continue;
+        bool clear = true;
+        for (int j = -2; clear && j <= 2; ++j)
+          for (int k = -2; clear && k <= 2; ++k) {
+            const size_t n = size_t(y + j) * w + x + k;
+            clear = region[n] && !covered[n];
+          }
+        if (!clear) continue;
+        ++count;
+        for (int ch = 0; ch < 3; ++ch) {
+          double mean = 0;
+          for (int j = -2; j <= 2; ++j)
+            for (int k = -2; k <= 2; ++k) mean += im.row(y + j)[size_t(x + k) * 3 + ch];
+          const double d = std::abs(im.row(y)[size_t(x) * 3 + ch] - mean / 25);
+          worst = std::max(worst, d);
+        }
+      }
+    }
+    return worst;
+  };
+  std::vector<uint8_t> old_inner(old_foot.size());
+  for (size_t i = 0; i < old_foot.size(); ++i) old_inner[i] = old_foot[i] == 255;
+  m.worst_fill = worst_against_mean(after, old_inner, new_grown, m.fill_pixels);
+  set_object_visible(image, made.object, false);
+  const Image8 hidden = draw(image);
+  int hidden_pixels = 0;
+  m.hidden_fill = worst_against_mean(hidden, old_inner, std::vector<uint8_t>(old_inner.size(), 0),
+                                     hidden_pixels);
+  return m;
+}
+
+// 160 x 128 with two closed tears (circles), an arc and a segment (support/synthetic.h).
+VectorImage small_image() {
+  test::SyntheticOptions o;
+  o.width = 160;
+  o.height = 128;
+  o.vertices = 900;
+  return test::make_synthetic_image(o);
+}
+
+double mae_where(const Image8& a, const Image8& b, const std::vector<uint8_t>& where, int& count) {
+  double sum = 0;
+  count = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      if (!where[size_t(y) * a.width + x]) continue;
+      ++count;
+      for (int c = 0; c < 3; ++c) sum += std::abs(a.row(y)[x * 3 + c] - b.row(y)[x * 3 + c]) / 3.0;
+    }
+  return count ? sum / count : 0;
+}
+
+TEST(Objects, InPlaceTheObjectDrawsAsTheRegionDid) {
+  const VectorImage original = small_image();
+  VectorImage image = original;
+  const int f = closed_feature(image.levels[0]);
+  ASSERT_GE(f, 0);
+  const int32_t id = image.levels[0].features[f].id;
+  const MakeObjectResult made = make_object(image, 0, f, "disk");
+  validate(image);
+  ASSERT_EQ(image.objects.size(), 1u);
+  const Object& object = image.objects[0];
+  EXPECT_EQ(object.name, "disk");
+  EXPECT_EQ(object.mesh.num_vertices(), made.object_vertices);
+  // The closed curve stays a tear of the level (so nothing outside changes) and bounds the object.
+  EXPECT_TRUE(std::any_of(image.levels[0].features.begin(), image.levels[0].features.end(),
+                          [&](const Feature& g) { return g.id == id && g.closed(); }));
+  const Image8 before = draw(original), after = draw(image);
+  const std::vector<uint8_t> foot = footprint(image, 0);
+  const std::vector<uint8_t> rim = grow(foot, before.width, before.height, 1);
+  std::vector<uint8_t> inner(foot.size()), outer(foot.size());
+  for (size_t i = 0; i < foot.size(); ++i) inner[i] = foot[i] == 255, outer[i] = !rim[i];
+  int n_in = 0, n_out = 0;
+  const double in = mae_where(before, after, inner, n_in), out = mae_where(before, after, outer, n_out);
+  EXPECT_GT(n_in, 1000);
+  EXPECT_LE(in, 0.05) << "inside the object";
+  EXPECT_EQ(out, 0.0) << "outside the object";
+}
+
+TEST(Objects, TheBackgroundIsCompletedSmoothly) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]));
+  image.objects[0].visible = false;
+  const Image8 hidden = draw(image);
+  image.objects[0].visible = true;
+  const std::vector<uint8_t> foot = footprint(image, 0);
+  const int w = hidden.width;
+  double worst = 0;
+  int count = 0;
+  for (int y = 2; y < hidden.height - 2; ++y)
+    for (int x = 2; x < w - 2; ++x) {
+      bool inside = true;
+      for (int j = -2; inside && j <= 2; ++j)
+        for (int k = -2; inside && k <= 2; ++k) inside = foot[size_t(y + j) * w + x + k] == 255;
+      if (!inside) continue;
+      ++count;
+      for (int c = 0; c < 3; ++c) {
+        double mean = 0;
+        for (int j = -2; j <= 2; ++j)
+          for (int k = -2; k <= 2; ++k) mean += hidden.row(y + j)[(x + k) * 3 + c];
+        worst = std::max(worst, std::abs(hidden.row(y)[x * 3 + c] - mean / 25));
+      }
+    }
+  EXPECT_GT(count, 500);
+  EXPECT_LE(worst, 12);
+}
+
+TEST(Objects, MakingOneIsDeterministic) {
+  VectorImage a = small_image(), b = small_image();
+  make_object(a, 0, closed_feature(a.levels[0]));
+  make_object(b, 0, closed_feature(b.levels[0]));
+  EXPECT_EQ(to_svec_binary(a, {.lossless = true}), to_svec_binary(b, {.lossless = true}));
+}
+
+TEST(Objects, RefusesWhatCannotBeAnObject) {
+  VectorImage image = small_image();
+  const VectorImage copy = image;
+  int open = -1;
+  for (size_t f = 0; f < image.levels[0].features.size(); ++f)
+    if (!image.levels[0].features[f].closed()) open = int(f);
+  ASSERT_GE(open, 0);
+  auto message = [&](auto&& call) {
+    try {
+      call();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([&] { make_object(image, 0, open); }).find("is open; an object needs a closed feature"),
+            std::string::npos);
+  EXPECT_NE(message([&] { make_object(image, 0, 99); }).find("feature 99 is out of range"), std::string::npos);
+  EXPECT_NE(message([&] { make_object(image, 3, 0); }).find("level 3 is out of range"), std::string::npos);
+  EXPECT_EQ(to_svec_binary(image, {.lossless = true}), to_svec_binary(copy, {.lossless = true}));
+  make_object(image, 0, closed_feature(image.levels[0]));
+  ObjectTransform bad;
+  bad.scale = 0;
+  EXPECT_NE(message([&] { transform_object(image, 0, bad); }).find("scale must be a positive number"),
+            std::string::npos);
+  bad.scale = 1;
+  bad.translate.x = NAN;
+  EXPECT_NE(message([&] { transform_object(image, 0, bad); }).find("translate x nan is not finite"),
+            std::string::npos);
+  EXPECT_NE(message([&] { set_object_visible(image, 2, false); }).find("object 2 is out of range (1 objects)"),
+            std::string::npos);
+  EXPECT_NE(message([&] { reorder_object(image, 0, 1); }).find("position 1 is out of range"), std::string::npos);
+}
+
+TEST(Objects, ValidationNamesTheProblem) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]));
+  auto message = [&](const VectorImage& v) {
+    try {
+      validate(v);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("valid");
+  };
+  VectorImage flipped = image;
+  std::swap(flipped.objects[0].mesh.triangles[0][0], flipped.objects[0].mesh.triangles[0][1]);
+  std::swap(flipped.objects[0].mesh.triangle_colors[0][0], flipped.objects[0].mesh.triangle_colors[0][1]);
+  EXPECT_EQ(message(flipped).rfind("object 0: ", 0), 0u) << message(flipped);
+  VectorImage level = image;
+  level.objects[0].level = 4;
+  EXPECT_EQ(message(level), "object 0: level 4 is out of range (1 levels)");
+  VectorImage far = image;
+  far.objects[0].mesh.positions[0].x = 1e30;
+  EXPECT_NE(message(far).find("is more than 2^24 pixels away"), std::string::npos) << message(far);
+  // Moved off the image is fine: objects are clipped when drawn.
+  VectorImage off = image;
+  transform_object(off, 0, {.translate = {-150, 0}});
+  EXPECT_EQ(message(off), "valid");
+  EXPECT_NO_THROW(draw(off));
+}
+
+TEST(Objects, TransformsMoveTheControlPointsRigidly) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]));
+  const std::vector<Vec2> start = image.objects[0].mesh.positions;
+  const Vec2 c = object_center(image.objects[0]);
+  transform_object(image, 0, {.translate = {5, -3}, .rotate_degrees = 90, .scale = 2});
+  const std::vector<Vec2>& moved = image.objects[0].mesh.positions;
+  for (size_t i = 0; i < start.size(); ++i) {
+    // Scaled by 2 and turned clockwise on screen: (x, y) -> (-y, x) about the centre.
+    EXPECT_NEAR(moved[i].x, c.x - 2 * (start[i].y - c.y) + 5, 1e-9);
+    EXPECT_NEAR(moved[i].y, c.y + 2 * (start[i].x - c.x) - 3, 1e-9);
+  }
+  // And back: the inverse transform about the new centre restores every point.
+  transform_object(image, 0, {.translate = {-5, 3}, .pivot = Vec2{c.x + 5, c.y - 3}});
+  transform_object(image, 0, {.rotate_degrees = -90, .scale = 0.5, .pivot = c});
+  for (size_t i = 0; i < start.size(); ++i) {
+    EXPECT_NEAR(image.objects[0].mesh.positions[i].x, start[i].x, 1e-9);
+    EXPECT_NEAR(image.objects[0].mesh.positions[i].y, start[i].y, 1e-9);
+  }
+}
+
+TEST(Objects, HiddenAndReordered) {
+  VectorImage image = small_image();
+  const int32_t first = image.levels[0].features[closed_feature(image.levels[0])].id;
+  make_object(image, 0, closed_feature(image.levels[0]), "a");
+  // The other circle.
+  int second = -1;
+  for (size_t f = 0; f < image.levels[0].features.size(); ++f)
+    if (image.levels[0].features[f].closed() && image.levels[0].features[f].id != first) second = int(f);
+  ASSERT_GE(second, 0);
+  make_object(image, 0, second, "b");
+  validate(image);
+  ASSERT_EQ(image.objects.size(), 2u);
+  // Hidden objects draw nothing: as the level with none.
+  VectorImage none = image;
+  none.objects.clear();
+  for (Object& o : image.objects) o.visible = false;
+  EXPECT_EQ(draw(image).pixels, draw(none).pixels);
+  for (Object& o : image.objects) o.visible = true;
+  // Overlapping after a move, the upper one wins; reordering swaps them.
+  transform_object(image, 1, {.translate = {object_center(image.objects[0]).x - object_center(image.objects[1]).x,
+                                            object_center(image.objects[0]).y - object_center(image.objects[1]).y}});
+  const Image8 b_on_top = draw(image);
+  reorder_object(image, 1, 0);
+  EXPECT_EQ(image.objects[0].name, "b");
+  const Image8 a_on_top = draw(image);
+  EXPECT_NE(b_on_top.pixels, a_on_top.pixels);
+}
+
+TEST(Objects, FilesKeepThem) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]), "disk \"one\"");
+  transform_object(image, 0, {.translate = {7.25, -3.5}, .rotate_degrees = 12});
+  image.objects[0].visible = false;
+  const Image8 drawn = draw(image);
+  for (const SvecWriteOptions& options : {SvecWriteOptions{.lossless = true}, SvecWriteOptions{}}) {
+    const VectorImage back = parse_svec_binary(to_svec_binary(image, options));
+    ASSERT_EQ(back.objects.size(), 1u);
+    EXPECT_EQ(back.objects[0].name, image.objects[0].name);
+    EXPECT_FALSE(back.objects[0].visible);
+    // Objects are written exactly, whatever the levels' grids.
+    EXPECT_EQ(back.objects[0].mesh.positions, image.objects[0].mesh.positions);
+    EXPECT_EQ(back.objects[0].mesh.colors, image.objects[0].mesh.colors);
+    EXPECT_EQ(back.objects[0].mesh.features.size(), image.objects[0].mesh.features.size());
+    if (options.lossless) EXPECT_EQ(draw(back).pixels, drawn.pixels);
+  }
+  const std::string json = to_svec_json(image);
+  EXPECT_NE(json.find("\"version\": 2"), std::string::npos);
+  const VectorImage back = parse_svec_json(json);
+  EXPECT_EQ(to_svec_json(back), json);
+  EXPECT_EQ(draw(back).pixels, drawn.pixels);
+  // Without objects a file is what it always was: JSON version 1, no binary flag.
+  VectorImage plain = small_image();
+  EXPECT_NE(to_svec_json(plain).find("\"version\": 1"), std::string::npos);
+  EXPECT_EQ(to_svec_binary(plain)[12], 0);
+  // A version 1 file cannot carry objects.
+  std::string old = json;
+  old.replace(old.find("\"version\": 2"), 12, "\"version\": 1");
+  EXPECT_THROW(parse_svec_json(old), Error);
+}
+
+TEST(Objects, AFeatureAcrossTheCurveIsSplit) {
+  VectorImage image = small_image();
+  const int f = closed_feature(image.levels[0]);
+  // A line drawn across the circle meets it at two junctions.
+  const ControlMesh& m = image.levels[0];
+  double x0 = 1e9, x1 = -1e9, y = 0;
+  for (const int32_t v : m.features[f].vertices) {
+    x0 = std::min(x0, m.positions[v].x), x1 = std::max(x1, m.positions[v].x);
+    y += m.positions[v].y / double(m.features[f].vertices.size());
+  }
+  const std::vector<Vec2> line{{x0 - 6, y + 0.3}, {x1 + 6, y + 0.7}};
+  const FeatureEditResult added = add_feature(image.levels[0], image.width, image.height, line);
+  ASSERT_EQ(added.junctions, 2);
+  const size_t before = image.levels[0].features.size();
+  int circle = -1;
+  for (size_t g = 0; g < image.levels[0].features.size(); ++g)
+    if (image.levels[0].features[g].closed() && image.levels[0].features[g].id == m.features[f].id) circle = int(g);
+  ASSERT_GE(circle, 0);
+  const MakeObjectResult made = make_object(image, 0, circle);
+  validate(image);
+  EXPECT_GE(made.features_moved, 1);  // the piece inside
+  EXPECT_EQ(image.levels[0].features.size() + image.objects[0].mesh.features.size(), before);
+}
+
+TEST(Objects, MoveASegmentOnPhotographs) {
+  struct Case {
+    const char* name;
+    PixelRect rect;
+  };
+  const Case cases[] = {{"butterfly", {3, 70, 486, 250}},
+                        {"squirrel", {120, 100, 260, 250}},
+                        {"apple", {30, 40, 440, 460}}};
+  const std::filesystem::path dir = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
+  int removed = 0;
+  for (const Case& c : cases) {
+    const std::filesystem::path path = dir / (std::string(c.name) + ".png");
+    if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
+    const Moved m = move_segment(read_image(path), c.rect);
+    std::printf("%s: object MAE %.3f over %d px, fill worst %.2f over %d px, hidden %.2f, rest MAE %.3f\n",
+                c.name, m.object_mae, m.object_pixels, m.worst_fill, m.fill_pixels, m.hidden_fill, m.rest_mae);
+    EXPECT_LE(m.object_mae, 1.0) << c.name;
+    EXPECT_LE(m.worst_fill, 12) << c.name;
+    EXPECT_LE(m.hidden_fill, 12) << c.name;
+    EXPECT_LE(m.rest_mae, 0.3) << c.name;
+    // The hole is simplified to the level's mean density where it is denser (butterfly, squirrel).
+    EXPECT_LT(m.made.fill_vertices, m.made.object_vertices) << c.name;
+    removed += m.made.removed;
+  }
+  EXPECT_GT(removed, 0);
+}
+
+}  // namespace
+}  // namespace subvec
