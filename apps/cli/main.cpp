@@ -292,6 +292,15 @@ void run_info(const std::string& input, bool json) {
       j["levels"].back()["collapses"] = image.levels[i].collapses.size();
       // ---- end levels ----
     }
+    j["objects"] = nlohmann::ordered_json::array();
+    for (const subvec::Object& o : image.objects) {
+      j["objects"].push_back({{"level", o.level},
+                              {"name", o.name},
+                              {"visible", o.visible},
+                              {"vertices", o.mesh.num_vertices()},
+                              {"triangles", o.mesh.num_triangles()},
+                              {"features", o.mesh.features.size()}});
+    }
     j["strokes"] = image.strokes.size();
     j["metadata"] = nlohmann::ordered_json::object();
     for (const auto& [key, value] : image.metadata) j["metadata"][key] = value;
@@ -319,6 +328,14 @@ void run_info(const std::string& input, bool json) {
     const LevelInfo& l = levels[i];
     std::printf("  %5zu  %8d  %9d  %8d  %8d  %10d  %12d  %7d\n", i, l.vertices, l.triangles,
                 l.colors, l.features, l.tear_edges, l.crease_edges, l.corners);
+  }
+  if (image.objects.empty()) return;
+  std::printf("\n  object  level  vertices  triangles  features  visible  name\n");
+  for (size_t i = 0; i < image.objects.size(); ++i) {
+    const subvec::Object& o = image.objects[i];
+    std::printf("  %6zu  %5d  %8d  %9d  %8zu  %7s  %s\n", i, o.level, o.mesh.num_vertices(),
+                o.mesh.num_triangles(), o.mesh.features.size(), o.visible ? "yes" : "no",
+                one_line(o.name).c_str());
   }
 }
 

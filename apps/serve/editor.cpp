@@ -140,6 +140,11 @@ std::string edit_label(const EditOp& op) {
     case EditOp::Kind::kMoveVertices: return "move" + points(op.vertices.size());
     case EditOp::Kind::kAddFeature: return "new feature" + at(op.points.front());
     case EditOp::Kind::kDeleteFeature: return "feature deleted" + at(op.at);
+    case EditOp::Kind::kMakeObject: return "new object" + at(op.at);
+    case EditOp::Kind::kMoveObject: return "object " + std::to_string(op.object) + " moved";
+    case EditOp::Kind::kHideObject: return "object " + std::to_string(op.object) + " hidden";
+    case EditOp::Kind::kShowObject: return "object " + std::to_string(op.object) + " shown";
+    case EditOp::Kind::kOrderObject: return "object " + std::to_string(op.object) + " reordered";
   }
   return op.name();
 }

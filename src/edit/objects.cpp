@@ -407,6 +407,25 @@ MakeObjectResult make_object(VectorImage& image, int level, int feature, const s
   return result;
 }
 
+int closed_feature_around(const ControlMesh& mesh, Vec2 p) {
+  int best = -1;
+  double best_area = 0;
+  for (int f = 0; f < static_cast<int>(mesh.features.size()); ++f) {
+    const Feature& feature = mesh.features[f];
+    if (!feature.closed()) continue;
+    bool inside = false;
+    double twice_area = 0;
+    for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
+      const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
+      twice_area += a.x * b.y - b.x * a.y;
+      if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
+    }
+    const double area = std::abs(twice_area) / 2;
+    if (inside && (best < 0 || area < best_area)) best = f, best_area = area;
+  }
+  return best;
+}
+
 Vec2 object_center(const Object& object) {
   const std::vector<Vec2>& p = object.mesh.positions;
   if (p.empty()) return {};

@@ -15,6 +15,7 @@
 #include "io/json_p.h"
 #include "subvec/core/error.h"
 #include "subvec/edit/color.h"
+#include "subvec/edit/objects.h"
 #include "subvec/edit/selection.h"
 #include "subvec/edit/shape.h"
 #include "subvec/mesh/validate.h"
@@ -150,9 +151,20 @@ EditOp parse_op(const Json& j, Place& at) {
     op.kind = EditOp::Kind::kAddFeature;
   } else if (kind == "delete-feature") {
     op.kind = EditOp::Kind::kDeleteFeature;
+  } else if (kind == "make-object") {
+    op.kind = EditOp::Kind::kMakeObject;
+  } else if (kind == "move-object") {
+    op.kind = EditOp::Kind::kMoveObject;
+  } else if (kind == "hide-object") {
+    op.kind = EditOp::Kind::kHideObject;
+  } else if (kind == "show-object") {
+    op.kind = EditOp::Kind::kShowObject;
+  } else if (kind == "order-object") {
+    op.kind = EditOp::Kind::kOrderObject;
   } else {
     at.fail("unknown op \"" + printable(kind) +
-            "\" (expected drag, move-feature, color, move-vertices, add-feature or delete-feature)");
+            "\" (expected drag, move-feature, color, move-vertices, add-feature, delete-feature, "
+            "make-object, move-object, hide-object, show-object or order-object)");
   }
   at.op = kind;
 
@@ -200,7 +212,45 @@ EditOp parse_op(const Json& j, Place& at) {
       op.vertices.push_back(static_cast<int32_t>(v.get<int64_t>()));
     }
   };
+  // An object index, or a position in the drawing order.
+  auto index = [&](const char* key) {
+    const Json& j = fields.required(key);
+    if (!j.is_number_integer() || j.get<int64_t>() < 0 || j.get<int64_t>() >= Limits::kMaxObjects) {
+      at.fail(key, "expected an object index, 0 to " + std::to_string(Limits::kMaxObjects - 1) + ", got " +
+                       (j.is_number() ? j.dump() : type_name(j)));
+    }
+    return static_cast<int>(j.get<int64_t>());
+  };
   switch (op.kind) {
+    case EditOp::Kind::kMakeObject:
+      op.at = vec2(fields.required("at"), at, "at");
+      if (const Json* n = fields.optional("name")) op.object_name = string_value(*n, at, "name");
+      break;
+    case EditOp::Kind::kMoveObject: {
+      op.object = index("object");
+      const Json* translate = fields.optional("translate");
+      const Json* rotate = fields.optional("rotate");
+      const Json* scale = fields.optional("scale");
+      if (!translate && !rotate && !scale) {
+        at.fail("missing key \"translate\", \"rotate\" or \"scale\" (give one or more)");
+      }
+      if (translate) op.translate = vec2(*translate, at, "translate");
+      if (rotate) op.rotate = number(*rotate, at, "rotate");
+      if (scale) {
+        op.scale = number(*scale, at, "scale");
+        if (!(op.scale > 0)) at.fail("scale", "expected a positive number, got " + num(op.scale));
+      }
+      if (const Json* p = fields.optional("pivot")) op.pivot = vec2(*p, at, "pivot");
+      break;
+    }
+    case EditOp::Kind::kHideObject:
+    case EditOp::Kind::kShowObject:
+      op.object = index("object");
+      break;
+    case EditOp::Kind::kOrderObject:
+      op.object = index("object");
+      op.position = index("to");
+      break;
     case EditOp::Kind::kAddFeature: {
       const Json& list = fields.required("points");
       if (!list.is_array() || list.size() < 2) {
@@ -336,6 +386,81 @@ std::string feature_name(const ControlMesh& mesh, int f) {
   return "feature " + std::to_string(f) + " (id " + std::to_string(mesh.features[f].id) + ")";
 }
 
+bool is_object_op(EditOp::Kind kind) {
+  using K = EditOp::Kind;
+  return kind == K::kMakeObject || kind == K::kMoveObject || kind == K::kHideObject ||
+         kind == K::kShowObject || kind == K::kOrderObject;
+}
+
+// The object operations (edit/objects.h); returns the log line's text.
+template <class Inside, class Reach>
+std::string apply_object_op(VectorImage& image, const EditOp& op, const std::string& where,
+                            Inside&& inside, Reach&& within_reach) {
+  using K = EditOp::Kind;
+  const int count = static_cast<int>(image.objects.size());
+  auto object_name = [&](int o) {
+    const std::string& name = image.objects[o].name;
+    return "object " + std::to_string(o) + (name.empty() ? "" : " (\"" + printable(name) + "\")");
+  };
+  if (op.kind != K::kMakeObject && op.object >= count) {
+    refuse(where, "object " + std::to_string(op.object) + " is out of range (the image has " +
+                      std::to_string(count) + (count == 1 ? " object)" : " objects)"));
+  }
+  try {
+    switch (op.kind) {
+      case K::kMakeObject: {
+        inside("at", op.at);
+        const ControlMesh& mesh = image.levels[op.level];
+        const int f = closed_feature_around(mesh, op.at);
+        if (f < 0) refuse(where, "no closed feature of level " + std::to_string(op.level) + " encloses " + point(op.at));
+        const std::string feature = feature_name(mesh, f);
+        const MakeObjectResult r = make_object(image, op.level, f, op.object_name);
+        if (op.level + 1 < static_cast<int>(image.levels.size())) {
+          image.levels[op.level + 1].parent_vertices.clear();
+          image.levels[op.level + 1].collapses.clear();
+        }
+        return object_name(r.object) + " made of the region inside " + feature + ": " +
+               std::to_string(r.object_vertices) + " vertices, " + std::to_string(r.features_moved) +
+               (r.features_moved == 1 ? " feature" : " features") + " inside; the background under it has " +
+               std::to_string(r.fill_vertices) + " vertices (" + std::to_string(r.removed) + " removed)";
+      }
+      case K::kMoveObject: {
+        within_reach(op.translate);
+        ObjectTransform t;
+        t.translate = op.translate;
+        t.rotate_degrees = op.rotate;
+        t.scale = op.scale;
+        t.pivot = op.pivot;
+        const Vec2 pivot = op.pivot.value_or(object_center(image.objects[op.object]));
+        transform_object(image, op.object, t);
+        return object_name(op.object) + " scaled by " + num(op.scale) + " and rotated by " + num(op.rotate) +
+               " degrees about " + point(pivot) + ", moved by " + point(op.translate);
+      }
+      case K::kHideObject:
+      case K::kShowObject:
+        set_object_visible(image, op.object, op.kind == K::kShowObject);
+        return object_name(op.object) + (op.kind == K::kShowObject ? " shown" : " hidden");
+      case K::kOrderObject: {
+        if (op.position >= count) {
+          refuse(where, "\"to\" " + std::to_string(op.position) + " is out of range (the image has " +
+                            std::to_string(count) + (count == 1 ? " object)" : " objects)"));
+        }
+        const std::string name = object_name(op.object);
+        reorder_object(image, op.object, op.position);
+        return name + " moved to position " + std::to_string(op.position) + " of " + std::to_string(count) +
+               " (0 is the bottom)";
+      }
+      default:
+        break;
+    }
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    if (message.rfind(where, 0) == 0) throw;
+    refuse(where, message);
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string EditOp::name() const {
@@ -352,6 +477,16 @@ std::string EditOp::name() const {
       return "add-feature";
     case Kind::kDeleteFeature:
       return "delete-feature";
+    case Kind::kMakeObject:
+      return "make-object";
+    case Kind::kMoveObject:
+      return "move-object";
+    case Kind::kHideObject:
+      return "hide-object";
+    case Kind::kShowObject:
+      return "show-object";
+    case Kind::kOrderObject:
+      return "order-object";
   }
   return "?";
 }
@@ -408,6 +543,10 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
                           num(h) + ")");
       }
     };
+    if (is_object_op(op.kind)) {
+      log.push_back(where + ": " + apply_object_op(image, op, where, inside, within_reach));
+      continue;
+    }
     ControlMesh mesh = image.levels[op.level];
     const MeshTopology topology = validate_level(mesh, image.width, image.height, op.level);
     // Shape edits and deletions pick among the tear features and the crease chains.

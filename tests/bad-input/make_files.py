@@ -377,6 +377,19 @@ def ops_files():
     ops("ops-add-feature-crossing.json", [{"op": "add-feature", "points": [[5, 47.3], [91, 47.3]]}])
     ops("ops-add-feature-outside.json", [{"op": "add-feature", "points": [[10, 10], [10, 1e9]]}])
     ops("ops-delete-feature-outside.json", [{"op": "delete-feature", "at": [-3, 10]}])
+    # Objects (edit/objects.h): the example disk made an object, then edited as one.
+    ops("ops-objects.json", [
+        {"op": "make-object", "at": [48, 48], "name": "disk"},
+        {"op": "move-object", "object": 0, "translate": [20, -5], "rotate": 15, "scale": 0.8},
+        {"op": "hide-object", "object": 0},
+        {"op": "show-object", "object": 0},
+        {"op": "order-object", "object": 0, "to": 0}])
+    ops("ops-make-object-nowhere.json", [{"op": "make-object", "at": [3, 3]}])
+    ops("ops-move-object-missing.json", [{"op": "move-object", "object": 0, "translate": [5, 5]}])
+    ops("ops-move-object-scale-zero.json", [{"op": "move-object", "object": 0, "scale": 0}])
+    ops("ops-move-object-nothing.json", [{"op": "move-object", "object": 0}])
+    ops("ops-order-object-to-far.json", [{"op": "make-object", "at": [48, 48]},
+                                         {"op": "order-object", "object": 0, "to": 3}])
     ops("ops-deep-nesting.json", "[" * 5000 + "]" * 5000 + "\n")
     ops("ops-duplicate-key.json", '[{"op": "drag", "op": "drag", "select": "vertex", "from": [1, 1], "to": [2, 2]}]\n')
 

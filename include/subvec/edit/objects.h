@@ -45,6 +45,11 @@ struct MakeObjectResult {
 // or repeats a vertex, or the region it bounds touches the image border.
 MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name = "");
 
+// The innermost closed tear of `mesh` around point p: the feature whose control polygon encloses
+// p with the smallest area (the limit curve lies within a fraction of a control edge of it), or
+// -1 when none does.
+int closed_feature_around(const ControlMesh& mesh, Vec2 p);
+
 // A similarity transform about `pivot` (default: the centre of the object's control points'
 // bounding box): scale, then rotate by `rotate_degrees` (clockwise on screen, y down, as SVG's
 // rotate()), then translate.

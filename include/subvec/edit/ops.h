@@ -3,6 +3,7 @@
 // needs the image (points inside it, something to select).
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -24,6 +25,11 @@ struct EditOp {
     kMoveVertices, // vertices, translate (the editor's direct handles)
     kAddFeature,   // points, feature_kind (edit/feature_edit.h)
     kDeleteFeature,// at: the nearest feature
+    kMakeObject,   // at: the innermost closed tear around it; name (edit/objects.h)
+    kMoveObject,   // object; translate, rotate (degrees), scale, pivot
+    kHideObject,   // object
+    kShowObject,   // object
+    kOrderObject,  // object; to (its new position, 0 the bottom)
   };
   Kind kind = Kind::kDrag;
   int level = 0;
@@ -42,9 +48,15 @@ struct EditOp {
   std::vector<int32_t> vertices;  // move-vertices; color with select "vertices"
   std::vector<Vec2> points;       // add-feature: the drawn polyline
   FeatureKind feature_kind = FeatureKind::kTear;  // add-feature
+  int object = 0;                 // the object ops: index in VectorImage::objects
+  double scale = 1;               // move-object
+  std::optional<Vec2> pivot;      // move-object; default the object's centre (object_center)
+  int position = 0;               // order-object: the new position ("to" in the file)
+  std::string object_name;        // make-object
 
   // "drag vertex", "drag feature", "move-feature", "color blend", "color transform",
-  // "move-vertices", "add-feature", "delete-feature".
+  // "move-vertices", "add-feature", "delete-feature", "make-object", "move-object", "hide-object",
+  // "show-object", "order-object".
   std::string name() const;
 };
 
