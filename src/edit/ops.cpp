@@ -214,12 +214,12 @@ EditOp parse_op(const Json& j, Place& at) {
   };
   // An object index, or a position in the drawing order.
   auto index = [&](const char* key) {
-    const Json& j = fields.required(key);
-    if (!j.is_number_integer() || j.get<int64_t>() < 0 || j.get<int64_t>() >= Limits::kMaxObjects) {
+    const Json& value = fields.required(key);
+    if (!value.is_number_integer() || value.get<int64_t>() < 0 || value.get<int64_t>() >= Limits::kMaxObjects) {
       at.fail(key, "expected an object index, 0 to " + std::to_string(Limits::kMaxObjects - 1) + ", got " +
-                       (j.is_number() ? j.dump() : type_name(j)));
+                       (value.is_number() ? value.dump() : type_name(value)));
     }
-    return static_cast<int>(j.get<int64_t>());
+    return static_cast<int>(value.get<int64_t>());
   };
   switch (op.kind) {
     case EditOp::Kind::kMakeObject:
@@ -659,6 +659,12 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
                  " color values refitted";
           break;
         }
+        case EditOp::Kind::kMakeObject:
+        case EditOp::Kind::kMoveObject:
+        case EditOp::Kind::kHideObject:
+        case EditOp::Kind::kShowObject:
+        case EditOp::Kind::kOrderObject:
+          break;  // applied above (apply_object_op)
         case EditOp::Kind::kColor: {
           if (op.select != EditSelect::kVertices) inside("at", op.at);
           const ColorSelection s = select_colors(mesh, topology, op.select, op.at, op.radius,

@@ -419,11 +419,11 @@ double check_export_options(const VectorImage& image, const ExportOptions& optio
   return scale;
 }
 
-RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
-                        ExportReport& report) {
-  const double scale = check_export_options(image, options);
-  const ControlMesh& mesh = image.levels[options.level];
-  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
+namespace {
+
+// export_mesh() of one control mesh (a level's, or an object's) with its topology.
+RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology, double scale,
+                           const ExportOptions& options, Shading shading, ExportReport& report) {
   const int64_t faces = mesh.num_triangles();
   const LimitEvaluator evaluator(mesh, topology);
   std::vector<uint8_t> depths;
@@ -464,6 +464,38 @@ RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, 
   report.min_depth = depths.empty() ? 0 : *std::min_element(depths.begin(), depths.end());
   report.triangles = refined.num_triangles();
   return refined;
+}
+
+}  // namespace
+
+RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
+                        ExportReport& report) {
+  const double scale = check_export_options(image, options);
+  const ControlMesh& mesh = image.levels[options.level];
+  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
+  return export_mesh_of(mesh, topology, scale, options, shading, report);
+}
+
+std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const ExportOptions& options,
+                                             Shading shading, ExportReport& report) {
+  const double scale = check_export_options(image, options);
+  std::vector<ObjectMesh> out;
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    const Object& object = image.objects[o];
+    if (object.level != options.level || !object.visible) continue;
+    const MeshTopology topology = validate_object(object, image.width, image.height,
+                                                  static_cast<int>(image.levels.size()), static_cast<int>(o));
+    ExportReport part;
+    RefinedMesh mesh = export_mesh_of(object.mesh, topology, scale, options, shading, part);
+    report.depth = std::max(report.depth, part.depth);
+    report.min_depth = std::min(report.min_depth, part.min_depth);
+    report.triangles += part.triangles;
+    report.max_position_error = std::max(report.max_position_error, part.max_position_error);
+    report.max_color_error = std::max(report.max_color_error, part.max_color_error);
+    ++report.objects;
+    out.push_back({static_cast<int>(o), std::move(mesh)});
+  }
+  return out;
 }
 
 }  // namespace subvec::detail

@@ -69,4 +69,13 @@ double check_export_options(const VectorImage& image, const ExportOptions& optio
 RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
                         ExportReport& report);
 
+// The visible objects of options.level (mesh/vector_image.h), bottom to top, each refined as
+// export_mesh() refines a level; the report adds their triangles, depths, errors and count.
+struct ObjectMesh {
+  int object = 0;  // index in VectorImage::objects
+  RefinedMesh mesh;
+};
+std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const ExportOptions& options,
+                                             Shading shading, ExportReport& report);
+
 }  // namespace subvec::detail

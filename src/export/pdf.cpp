@@ -103,8 +103,7 @@ std::string stream_object(std::string dict, const std::string& data) {
 constexpr double kHintColorTolerance = 1.0;
 
 // The tear hints and strokes drawn over the shadings, in image pixels.
-std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const ExportOptions& options, double s,
-                     ExportReport& report) {
+std::string hints(const RefinedMesh& mesh, const ExportOptions& options, double s, ExportReport& report) {
   std::string content;
   if (options.tear_hints) {
     // Coordinates to a hundredth of an output unit, colors to a quarter of a level.
@@ -121,6 +120,11 @@ std::string overlays(const VectorImage& image, const RefinedMesh& mesh, const Ex
       content += " h f\n";
     }
   }
+  return content;
+}
+
+std::string strokes(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
+  std::string content;
   for (const Stroke& stroke : image.strokes) {
     if (stroke.level != options.level) continue;
     const std::vector<Vec2> outline = detail::stroke_outline(stroke);
@@ -176,6 +180,8 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport& r = report ? *report : local;
   const RefinedMesh mesh =
       detail::export_mesh(image, options, detail::Shading::kGouraud, r);
+  const std::vector<detail::ObjectMesh> objects =
+      detail::export_object_meshes(image, options, detail::Shading::kGouraud, r);
   const double w = image.width, h = image.height, s = export_scale(options, image.width);
 
   // The shading streams.
@@ -198,8 +204,17 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
   // the page (docs/export.md, "PDF.js").
   // The right edge x = w is a whole code, so that it decodes to w (MuPDF rounds vertices to
   // pixels, and a right edge a hair inside the page lost it the last column).
-  const double x_end = w * kCoordinateMax / std::floor(kCoordinateMax * w / (w + 2 / s));
-  auto stream = [&](const detail::Strips& part, int channel) {
+  // The coordinates' range: [x0, x_end] x [y0, y1] in image pixels, the page for the level's mesh
+  // and an object's bounding box for its own.
+  struct Range {
+    double x0 = 0, x_end = 0, y0 = 0, y1 = 0;
+  };
+  auto range_of = [&](double x0, double x1, double y0, double y1) {
+    const double span = x1 - x0;
+    return Range{x0, x0 + span * kCoordinateMax / std::floor(kCoordinateMax * span / (span + 2 / s)), y0, y1};
+  };
+  const Range page = range_of(0, w, 0, h);
+  auto stream = [&](const RefinedMesh& drawn, const Range& range, const detail::Strips& part, int channel) {
     std::vector<uint8_t> data;
     data.reserve(part.flags.size() * (channel < 0 ? 13 : 9));
     auto put = [&](uint64_t v, int bytes) {
@@ -207,15 +222,15 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     };
     for (size_t i = 0; i < part.flags.size(); ++i) {
       const auto [t, k] = part.corners[i];
-      const int32_t v = mesh.triangles[t][k], c = mesh.triangle_colors[t][k];
+      const int32_t v = drawn.triangles[t][k], c = drawn.triangle_colors[t][k];
       put(part.flags[i], 1);
-      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v] / x_end, 0.0, 1.0) * kCoordinateMax)),
-          cbits / 8);
-      put(uint64_t(std::lround(std::clamp(mesh.positions[2 * v + 1] / h, 0.0, 1.0) * kCoordinateMax)),
-          cbits / 8);
+      const double x = (drawn.positions[2 * v] - range.x0) / (range.x_end - range.x0);
+      const double y = (drawn.positions[2 * v + 1] - range.y0) / (range.y1 - range.y0);
+      put(uint64_t(std::lround(std::clamp(x, 0.0, 1.0) * kCoordinateMax)), cbits / 8);
+      put(uint64_t(std::lround(std::clamp(y, 0.0, 1.0) * kCoordinateMax)), cbits / 8);
       for (int ch = 0; ch < 3; ++ch) {
         if (channel >= 0 && ch != channel) continue;
-        const double value = std::clamp(double(mesh.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
+        const double value = std::clamp(double(drawn.colors[3 * c + ch]) / 255.0, 0.0, 1.0);
         put(uint64_t(std::lround(value * double((1 << kbits) - 1))), kbits / 8);
       }
     }
@@ -234,8 +249,9 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     extra.push_back(std::move(body));
     return std::to_string(5 + extra.size()) + " 0 R";
   };
-  const std::string decode = "/Decode [0 " + detail::fixed(x_end, 6) + " 0 " + detail::fixed(h, 6);
-  auto shading = [&](const std::string& data, int channel, double offset) {
+  auto shading = [&](const std::string& data, int channel, double offset, const Range& range) {
+    const std::string decode = "/Decode [" + detail::fixed(range.x0, 6) + " " + detail::fixed(range.x_end, 6) +
+                               " " + detail::fixed(range.y0, 6) + " " + detail::fixed(range.y1, 6);
     std::string dict = "<< /ShadingType 4 /ColorSpace /DeviceRGB /BitsPerCoordinate " + std::to_string(cbits) +
                        " /BitsPerComponent " + std::to_string(kbits) + " /BitsPerFlag 8 " + decode;
 
@@ -259,7 +275,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
                         detail::fixed(h * s, 6) + " cm\n";
   std::string resources;
   if (!channels) {
-    resources = "/Shading << /Sh0 " + shading(stream(strips, -1), -1, 0) + " >>";
+    resources = "/Shading << /Sh0 " + shading(stream(mesh, page, strips, -1), -1, 0, page) + " >>";
     content += "/Sh0 sh\n";
   } else {
     // Two layers, each the three channel meshes over black in an isolated transparency group (a
@@ -287,7 +303,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       for (int ch = 0; ch < 3; ++ch) {
         const std::string name = "/Sh" + std::to_string(ch);
         const double offset = layer == 0 ? 0 : 0.5 / 255;
-        names += " " + name + " " + shading(stream(layer == 0 ? strips : backward, ch), ch, offset);
+        names += " " + name + " " + shading(stream(mesh, page, layer == 0 ? strips : backward, ch), ch, offset, page);
         paint += " " + name + " sh";
       }
       const std::string group =
@@ -301,7 +317,36 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     }
     resources = "/XObject <<" + forms + " >> /ExtGState << /GA0 << /ca 1 >> /GA1 << /ca 0.5 >> >>";
   }
-  content += overlays(image, mesh, options, s, r);
+  content += hints(mesh, options, s, r);
+  // Each object over the level, bottom to top: its own RGB mesh (whatever the target), in a marked
+  // group named by the object, with the hints along its tears.
+  std::string object_shadings;
+  for (const detail::ObjectMesh& object : objects) {
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int i = 0; i < object.mesh.num_vertices(); ++i) {
+      x0 = std::min(x0, double(object.mesh.positions[2 * i])), x1 = std::max(x1, double(object.mesh.positions[2 * i]));
+      y0 = std::min(y0, double(object.mesh.positions[2 * i + 1])), y1 = std::max(y1, double(object.mesh.positions[2 * i + 1]));
+    }
+    // The mesh's own box, clipped to it: the triangle of no area that ends the mesh (for PDF.js,
+    // above) lies past its right side, and inside the page it would show as a dot.
+    const double bx0 = std::floor(x0), bx1 = std::ceil(x1) + 1, by0 = std::floor(y0), by1 = std::ceil(y1) + 1;
+    const Range range = range_of(bx0, bx1, by0, by1);
+    const std::string clip = detail::fixed(bx0, 6) + " " + detail::fixed(by0, 6) + " " +
+                             detail::fixed(bx1 - bx0, 6) + " " + detail::fixed(by1 - by0, 6) + " re W n ";
+    const std::string name = "/Ob" + std::to_string(object.object);
+    object_shadings += " " + name + " " +
+                       shading(stream(object.mesh, range, detail::make_strips(object.mesh), -1), -1, 0, range);
+    content += "/Subvec_object_" + std::to_string(object.object) + " BMC q q " + clip + name + " sh Q\n" +
+               hints(object.mesh, options, s, r) + "Q EMC\n";
+  }
+  if (!object_shadings.empty()) {
+    if (!channels) {
+      resources.insert(resources.size() - 3, object_shadings);  // before the dictionary's " >>"
+    } else {
+      resources += " /Shading <<" + object_shadings + " >>";
+    }
+  }
+  content += strokes(image, options, r);
   content += "Q\n";
 
   std::string pdf = assemble(image, w, h, s, resources, content, extra);

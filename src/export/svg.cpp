@@ -115,13 +115,11 @@ std::string stroke_paths(const VectorImage& image, int level, int decimals, Expo
 // exactly. A triangle is a Coons patch whose third side has collapsed to its third corner. The
 // corners take the limit colors of the face's side of any tear. Each face is a path filled with
 // its own one-patch gradient, so Inkscape's mesh tool edits each face's corners and colors.
-std::string svg_mesh(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
-  const double scale = detail::check_export_options(image, options);
-  const ControlMesh& mesh = image.levels[options.level];
-  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
+// One control mesh's patches (a level's or an object's): a gradient per face into `defs`, named
+// `prefix` and the face's number in base 36, and the path it fills into `paths`.
+void mesh_patches(const ControlMesh& mesh, const MeshTopology& topology, int decimals,
+                  const std::string& prefix, std::string& defs, std::string& paths) {
   const LimitEvaluator evaluator(mesh, topology);
-  // Coordinates in image pixels, to a tenth of an output pixel.
-  const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(scale * 10) - 1e-9)), 1, 9);
 
   // Each control edge as a cubic Bézier from its lower-numbered vertex, from its first face.
   struct Curve {
@@ -151,15 +149,14 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
   }
 
   // Base-36 ids: the file repeats one per face twice.
-  auto id_of = [](int f) {
+  auto id_of = [&](int f) {
     std::string id;
     do {
       id += "0123456789abcdefghijklmnopqrstuvwxyz"[f % 36];
       f /= 36;
     } while (f > 0);
-    return "m" + id;
+    return prefix + id;
   };
-  std::string defs, paths;
   for (int f = 0; f < mesh.num_triangles(); ++f) {
     const Tri& v = mesh.triangles[f];
     std::array<std::array<Vec2, 4>, 3> side;
@@ -227,14 +224,38 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
     d.command('z');
     paths += "<path fill=\"url(#" + id + ")\" d=\"" + d.text() + "\"/>\n";
   }
+}
+
+std::string svg_mesh(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
+  const double scale = detail::check_export_options(image, options);
+  const ControlMesh& mesh = image.levels[options.level];
+  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
+  // Coordinates in image pixels, to a tenth of an output pixel.
+  const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(scale * 10) - 1e-9)), 1, 9);
+  std::string defs, paths;
+  mesh_patches(mesh, topology, decimals, "m", defs, paths);
   report.depth = report.min_depth = 0;
   report.triangles = 0;
   report.patches = mesh.num_triangles();
+  paths = "<g>\n" + paths + "</g>\n";
+  // Each object a group of its own patches over the level, bottom to top.
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    const Object& object = image.objects[o];
+    if (object.level != options.level || !object.visible) continue;
+    const MeshTopology t = validate_object(object, image.width, image.height,
+                                           static_cast<int>(image.levels.size()), static_cast<int>(o));
+    std::string group;
+    mesh_patches(object.mesh, t, decimals, "o" + std::to_string(o) + "m", defs, group);
+    paths += "<g id=\"object-" + std::to_string(o) + "\"><title>" + xml_text(object.name) + "</title>\n" +
+             group + "</g>\n";
+    report.patches += object.mesh.num_triangles();
+    ++report.objects;
+  }
 
   std::string svg = header(image, scale, " xmlns:xlink=\"http://www.w3.org/1999/xlink\"");
   // The template holds what every face's gradient shares.
   svg += "<defs>\n<meshgradient id=\"t\" gradientUnits=\"userSpaceOnUse\" type=\"bicubic\"/>\n" +
-         defs + "</defs>\n<g>\n" + paths + "</g>\n";
+         defs + "</defs>\n" + paths;
   svg += stroke_paths(image, options.level, decimals + 1, report);
   svg += "</svg>\n";
   report.bytes = static_cast<int64_t>(svg.size());
@@ -249,6 +270,8 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   if (options.svg_target == SvgTarget::kInkscape) return svg_mesh(image, options, r);
   const RefinedMesh mesh =
       detail::export_mesh(image, options, detail::Shading::kFlat, r);
+  const std::vector<detail::ObjectMesh> objects =
+      detail::export_object_meshes(image, options, detail::Shading::kFlat, r);
   const double s = export_scale(options, image.width);
   // Coordinates in image pixels, to a tenth of an output pixel (crisp edges sample pixel centres).
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 10) - 1e-9)), 1, 9);
@@ -257,56 +280,66 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   const double unit = std::pow(10.0, decimals), offset = 0.5 / unit;
   auto grid = [&](double v) { return double(std::llround((v - offset) * unit)) / unit; };
 
-  // Triangles of one color share a path, in order of first appearance.
-  std::vector<std::string> order;
-  std::unordered_map<std::string, PathData> paths;
-  for (int32_t t = 0; t < mesh.num_triangles(); ++t) {
-    const Tri& v = mesh.triangles[t];
-    const Tri& c = mesh.triangle_colors[t];
-    double mean[3] = {0, 0, 0};
-    for (int k = 0; k < 3; ++k)
-      for (int ch = 0; ch < 3; ++ch) mean[ch] += mesh.colors[3 * c[k] + ch] / 3.0;
-    const std::string color = hex_color(mean[0], mean[1], mean[2]);
-    auto [it, fresh] = paths.try_emplace(color, decimals);
-    if (fresh) order.push_back(color);
-    PathData& d = it->second;
-    double px = grid(mesh.positions[2 * v[0]]), py = grid(mesh.positions[2 * v[0] + 1]);
-    d.command('M');
-    d.number(px);
-    d.number(py);
-    d.command('l');
-    for (int k = 1; k < 3; ++k) {
-      const double x = grid(mesh.positions[2 * v[k]]), y = grid(mesh.positions[2 * v[k] + 1]);
-      d.number(x - px);
-      d.number(y - py);
-      px = x;
-      py = y;
-    }
-    d.command('z');
-  }
-
-  std::string svg = header(image, s, "");
-  svg += "<g shape-rendering=\"crispEdges\" transform=\"translate(" + detail::fixed(offset, 9) +
-         " " + detail::fixed(offset, 9) + ")\">\n";
-  for (const std::string& color : order)
-    svg += "<path fill=\"" + color + "\" d=\"" + paths.at(color).text() + "\"/>\n";
-  svg += "</g>\n";
-  if (options.tear_hints) {
-    for (const detail::TearHint& hint : detail::tear_hints(mesh, 1.0 / s, kHintColorTolerance)) {
-      ++r.tear_hints;
-      PathData d(decimals + 1);
+  // One refined mesh: its triangles, those of one color sharing a path in order of first
+  // appearance, then the hints along its tears.
+  auto draw = [&](const RefinedMesh& refined) {
+    std::vector<std::string> order;
+    std::unordered_map<std::string, PathData> paths;
+    for (int32_t t = 0; t < refined.num_triangles(); ++t) {
+      const Tri& v = refined.triangles[t];
+      const Tri& c = refined.triangle_colors[t];
+      double mean[3] = {0, 0, 0};
+      for (int k = 0; k < 3; ++k)
+        for (int ch = 0; ch < 3; ++ch) mean[ch] += refined.colors[3 * c[k] + ch] / 3.0;
+      const std::string color = hex_color(mean[0], mean[1], mean[2]);
+      auto [it, fresh] = paths.try_emplace(color, decimals);
+      if (fresh) order.push_back(color);
+      PathData& d = it->second;
+      double px = grid(refined.positions[2 * v[0]]), py = grid(refined.positions[2 * v[0] + 1]);
       d.command('M');
-      d.number(hint.polygon[0].x);
-      d.number(hint.polygon[0].y);
-      d.command('L');
-      for (size_t k = 1; k < hint.polygon.size(); ++k) {
-        d.number(hint.polygon[k].x);
-        d.number(hint.polygon[k].y);
+      d.number(px);
+      d.number(py);
+      d.command('l');
+      for (int k = 1; k < 3; ++k) {
+        const double x = grid(refined.positions[2 * v[k]]), y = grid(refined.positions[2 * v[k] + 1]);
+        d.number(x - px);
+        d.number(y - py);
+        px = x;
+        py = y;
       }
       d.command('z');
-      svg += "<path fill=\"" + hex_color(hint.color[0], hint.color[1], hint.color[2]) +
-             "\" d=\"" + d.text() + "\"/>\n";
     }
+    std::string out = "<g shape-rendering=\"crispEdges\" transform=\"translate(" + detail::fixed(offset, 9) +
+                      " " + detail::fixed(offset, 9) + ")\">\n";
+    for (const std::string& color : order)
+      out += "<path fill=\"" + color + "\" d=\"" + paths.at(color).text() + "\"/>\n";
+    out += "</g>\n";
+    if (options.tear_hints) {
+      for (const detail::TearHint& hint : detail::tear_hints(refined, 1.0 / s, kHintColorTolerance)) {
+        ++r.tear_hints;
+        PathData d(decimals + 1);
+        d.command('M');
+        d.number(hint.polygon[0].x);
+        d.number(hint.polygon[0].y);
+        d.command('L');
+        for (size_t k = 1; k < hint.polygon.size(); ++k) {
+          d.number(hint.polygon[k].x);
+          d.number(hint.polygon[k].y);
+        }
+        d.command('z');
+        out += "<path fill=\"" + hex_color(hint.color[0], hint.color[1], hint.color[2]) +
+               "\" d=\"" + d.text() + "\"/>\n";
+      }
+    }
+    return out;
+  };
+
+  std::string svg = header(image, s, "");
+  svg += draw(mesh);
+  // Each object a group over the level, bottom to top, named by its title.
+  for (const detail::ObjectMesh& object : objects) {
+    svg += "<g id=\"object-" + std::to_string(object.object) + "\"><title>" +
+           xml_text(image.objects[object.object].name) + "</title>\n" + draw(object.mesh) + "</g>\n";
   }
   svg += stroke_paths(image, options.level, decimals + 1, r);
   svg += "</svg>\n";

@@ -494,10 +494,10 @@ std::string string_text(const std::string& s) {
 }
 
 // One mesh as a JSON object, `base` levels deeper than a level of "levels".
-void write_level(JsonWriter& w, const ControlMesh& m, bool last, int base = 0, const std::string& key = "") {
+void write_level(JsonWriter& w, const ControlMesh& m, bool last, int base = 0, const std::string& name = "") {
   const bool implicit_colors =
       m.colors.size() == m.positions.size() && m.triangle_colors == m.triangles;
-  w.line(base + 2, key.empty() ? "{" : "\"" + key + "\": {");
+  w.line(base + 2, name.empty() ? "{" : "\"" + name + "\": {");
   std::vector<const char*> keys = {"vertices", "colors", "triangles"};
   if (!implicit_colors) keys.push_back("triangle_colors");
   if (!m.creases.empty()) keys.push_back("creases");

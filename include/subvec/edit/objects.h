@@ -54,10 +54,10 @@ int closed_feature_around(const ControlMesh& mesh, Vec2 p);
 // bounding box): scale, then rotate by `rotate_degrees` (clockwise on screen, y down, as SVG's
 // rotate()), then translate.
 struct ObjectTransform {
-  Vec2 translate;
+  Vec2 translate = {};
   double rotate_degrees = 0;
   double scale = 1;
-  std::optional<Vec2> pivot;
+  std::optional<Vec2> pivot = std::nullopt;
 };
 
 // Applies `transform` to object `object`'s control points. Throws Error(kInvalidArgument) for an

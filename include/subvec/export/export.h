@@ -70,6 +70,7 @@ struct ExportReport {
   int64_t patches = 0;
   int64_t tear_hints = 0;
   int64_t strokes = 0;
+  int64_t objects = 0;  // objects drawn (the visible ones of the level), each as its own group
   int64_t bytes = 0;
 };
 

@@ -406,7 +406,9 @@ TEST(Objects, FilesKeepThem) {
     EXPECT_EQ(back.objects[0].mesh.positions, image.objects[0].mesh.positions);
     EXPECT_EQ(back.objects[0].mesh.colors, image.objects[0].mesh.colors);
     EXPECT_EQ(back.objects[0].mesh.features.size(), image.objects[0].mesh.features.size());
-    if (options.lossless) EXPECT_EQ(draw(back).pixels, drawn.pixels);
+    if (options.lossless) {
+      EXPECT_EQ(draw(back).pixels, drawn.pixels);
+    }
   }
   const std::string json = to_svec_json(image);
   EXPECT_NE(json.find("\"version\": 2"), std::string::npos);
