@@ -243,6 +243,17 @@ subvec::Image8 render_image(const VectorImage& image, std::optional<int> width,
   return subvec::render(image, options);
 }
 
+// The objects (mesh/vector_image.h), bottom to top.
+py::list object_list(const VectorImage& image) {
+  py::list objects;
+  for (const subvec::Object& o : image.objects) {
+    objects.append(py::dict("level"_a = o.level, "name"_a = o.name, "visible"_a = o.visible,
+                            "vertices"_a = o.mesh.num_vertices(), "triangles"_a = o.mesh.num_triangles(),
+                            "features"_a = o.mesh.features.size()));
+  }
+  return objects;
+}
+
 py::dict info(const VectorImage& image) {
   py::list levels;
   for (const subvec::ControlMesh& mesh : image.levels) {
@@ -263,11 +274,25 @@ py::dict info(const VectorImage& image) {
   py::dict metadata;
   for (const auto& [key, value] : image.metadata) metadata[py::str(key)] = value;
   return py::dict("width"_a = image.width, "height"_a = image.height, "levels"_a = levels,
-                  "strokes"_a = image.strokes.size(), "metadata"_a = metadata);
+                  "objects"_a = object_list(image), "strokes"_a = image.strokes.size(),
+                  "metadata"_a = metadata);
 }
 
+py::dict mesh_dict_of(const subvec::ControlMesh& m);
+
 py::dict mesh_dict(const VectorImage& image, int level) {
-  const subvec::ControlMesh& m = image.levels[size_t(check_level(image, level))];
+  return mesh_dict_of(image.levels[size_t(check_level(image, level))]);
+}
+
+py::dict object_mesh_dict(const VectorImage& image, int object) {
+  if (object < 0 || object >= static_cast<int>(image.objects.size())) {
+    throw py::index_error("object " + std::to_string(object) + " is out of range (" +
+                          std::to_string(image.objects.size()) + " objects)");
+  }
+  return mesh_dict_of(image.objects[size_t(object)].mesh);
+}
+
+py::dict mesh_dict_of(const subvec::ControlMesh& m) {
   py::list features;
   for (const subvec::Feature& f : m.features) {
     features.append(py::dict("id"_a = f.id, "vertices"_a = index_vector(f.vertices),
@@ -323,6 +348,15 @@ std::string apply_op(VectorImage& image, const subvec::EditOp& op) {
   const std::vector<subvec::EditOp> ops{op};
   const std::vector<std::string> log = subvec::apply_edit_ops(image, ops);
   return log.empty() ? std::string() : log.front();
+}
+
+// An object index (or a position in the drawing order) in range, as an IndexError otherwise.
+int object_index(const VectorImage& image, int object) {
+  if (object < 0 || object >= static_cast<int>(image.objects.size())) {
+    throw py::index_error("object " + std::to_string(object) + " is out of range (" +
+                          std::to_string(image.objects.size()) + " objects)");
+  }
+  return object;
 }
 
 subvec::EditSelect parse_select(const std::string& s) {
@@ -525,6 +559,55 @@ void def_edits(PyVectorImage& vi) {
             return apply_op(v, op);
           },
           "points"_a, py::kw_only(), "kind"_a = "tear", "level"_a = 0)
+      .def(
+          "make_object",
+          [](VectorImage& v, std::array<double, 2> at, const std::string& name, int level) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kMakeObject;
+            op.at = point(at, "at");
+            op.object_name = name;
+            op.level = level;
+            return apply_op(v, op);
+          },
+          "at"_a, py::kw_only(), "name"_a = "", "level"_a = 0)
+      .def(
+          "move_object",
+          [](VectorImage& v, int object, std::array<double, 2> translate, double rotate, double scale,
+             std::optional<std::array<double, 2>> pivot) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kMoveObject;
+            op.object = object_index(v, object);
+            op.translate = point(translate, "translate");
+            if (!std::isfinite(rotate)) invalid("rotate is not finite");
+            if (!(std::isfinite(scale) && scale > 0)) invalid("scale must be a positive number");
+            op.rotate = rotate;
+            op.scale = scale;
+            if (pivot) op.pivot = point(*pivot, "pivot");
+            return apply_op(v, op);
+          },
+          "object"_a, py::kw_only(), "translate"_a = std::array<double, 2>{0, 0}, "rotate"_a = 0.0,
+          "scale"_a = 1.0, "pivot"_a = py::none())
+      .def(
+          "set_object_visible",
+          [](VectorImage& v, int object, bool visible) {
+            subvec::EditOp op;
+            op.kind = visible ? subvec::EditOp::Kind::kShowObject : subvec::EditOp::Kind::kHideObject;
+            op.object = object_index(v, object);
+            return apply_op(v, op);
+          },
+          "object"_a, "visible"_a)
+      .def(
+          "order_object",
+          [](VectorImage& v, int object, int to) {
+            subvec::EditOp op;
+            op.kind = subvec::EditOp::Kind::kOrderObject;
+            op.object = object_index(v, object);
+            op.position = object_index(v, to);
+            return apply_op(v, op);
+          },
+          "object"_a, "to"_a)
+      .def_property_readonly("objects", &object_list)
+      .def("object_mesh", &object_mesh_dict, "object"_a)
       .def(
           "delete_feature",
           [](VectorImage& v, std::array<double, 2> at, int level) {

@@ -35,10 +35,19 @@ class LevelInfo(TypedDict):
     edges: int
     corners: int
 
+class ObjectInfo(TypedDict):
+    level: int
+    name: str
+    visible: bool
+    vertices: int
+    triangles: int
+    features: int
+
 class Info(TypedDict):
     width: int
     height: int
     levels: list[LevelInfo]
+    objects: list[ObjectInfo]
     strokes: int
     metadata: dict[str, str]
 
@@ -119,6 +128,19 @@ class VectorImage:
     def add_feature(self, points: npt.ArrayLike, *, kind: Literal["tear", "crease"] = "tear",
                     level: int = 0) -> str:
         """A new tear (or crease) along the drawn polyline's C^2 fit; returns the log line."""
+    def make_object(self, at: _Point, *, name: str = "", level: int = 0) -> str:
+        """Makes an object of the innermost closed tear around `at` (its own mesh over a
+        completed background); returns the log line."""
+    def move_object(self, object: int, *, translate: _Point = (0, 0), rotate: float = 0,
+                    scale: float = 1, pivot: _Point | None = None) -> str:
+        """Scales, rotates (degrees, clockwise on screen) and moves an object rigidly about
+        `pivot` (default: its centre); returns the log line."""
+    def set_object_visible(self, object: int, visible: bool) -> str: ...
+    def order_object(self, object: int, to: int) -> str:
+        """Moves an object to position `to` of the drawing order (0 is the bottom)."""
+    @property
+    def objects(self) -> list[ObjectInfo]: ...
+    def object_mesh(self, object: int) -> Mesh: ...
     def delete_feature(self, at: _Point, *, level: int = 0) -> str:
         """Deletes the feature nearest to `at`, joining its colors by a ramp; returns the log line."""
     def select_colors(self, at: _Point, *, select: Literal["vertex", "feature", "region"] = "vertex",

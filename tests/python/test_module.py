@@ -289,6 +289,40 @@ def test_add_and_delete_features():
         image.add_feature([[10, 10], "x"])
 
 
+def test_objects():
+    image = subvec.load(EXAMPLES / "01-disk.svec.json")
+    before = image.render()
+    line = image.make_object((48, 48), name="disk")
+    assert 'object 0 ("disk") made of the region inside feature 0' in line
+    assert image.objects == [{"level": 0, "name": "disk", "visible": True,
+                              "vertices": image.object_mesh(0)["positions"].shape[0],
+                              "triangles": image.object_mesh(0)["triangles"].shape[0], "features": 0}]
+    assert image.info()["objects"] == image.objects
+    # In place, the picture is the same but along the object's anti-aliased rim.
+    assert np.abs(image.render().astype(int) - before.astype(int)).mean() < 0.5
+    start = image.object_mesh(0)["positions"]
+    assert "moved by [10, 0]" in image.move_object(0, translate=(10, 0))
+    assert np.allclose(image.object_mesh(0)["positions"], start + (10, 0))
+    image.move_object(0, rotate=90, pivot=(48, 48))
+    image.set_object_visible(0, False)
+    assert not image.objects[0]["visible"]
+    # Hidden, the completed background shows: smooth where the disk was.
+    hidden = image.render().astype(float)
+    assert np.abs(np.diff(hidden[36:60, 36:60], axis=1)).max() < 12
+    assert image.order_object(0, 0).endswith("(0 is the bottom)")
+    # Saved and read back, in both forms.
+    for form in ("svec", "json"):
+        back = subvec.from_bytes(image.to_bytes(format=form, lossless=True))
+        assert back.objects == image.objects
+        assert np.array_equal(back.render(), image.render())
+    with pytest.raises(IndexError, match="object 3 is out of range"):
+        image.move_object(3, translate=(1, 1))
+    with pytest.raises(ValueError, match="scale must be a positive number"):
+        image.move_object(0, scale=0)
+    with pytest.raises(ValueError, match="no closed feature of level 0 encloses"):
+        image.make_object((3, 3))
+
+
 def test_color_selection_blend_and_transform():
     image = subvec.load(BUTTERFLY)
     sel = image.select_colors((160, 175), radius=40)
