@@ -359,6 +359,18 @@ int object_index(const VectorImage& image, int object) {
   return object;
 }
 
+// An edit of object `object`'s own mesh instead of the level's (edit/ops.h, EditOp::in_object).
+void in_object(const VectorImage& image, subvec::EditOp& op, std::optional<int> object) {
+  if (!object) return;
+  op.in_object = true;
+  op.object = object_index(image, *object);
+}
+
+// The mesh an operation edits: its object's, or its level's.
+const subvec::ControlMesh& mesh_of(const VectorImage& image, const subvec::EditOp& op) {
+  return op.in_object ? image.objects[size_t(op.object)].mesh : image.levels[size_t(op.level)];
+}
+
 subvec::EditSelect parse_select(const std::string& s) {
   if (const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s)) return *e;
   invalid("select must be 'vertex', 'feature', 'region' or 'vertices', got '" + s + "'");
@@ -488,7 +500,7 @@ void def_edits(PyVectorImage& vi) {
       .def(
           "drag",
           [](VectorImage& v, std::array<double, 2> from, std::array<double, 2> to,
-             const std::string& select, double sigma, double region, int level) {
+             const std::string& select, double sigma, double region, int level, std::optional<int> object) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kDrag;
             op.select = parse_select(select);
@@ -499,14 +511,15 @@ void def_edits(PyVectorImage& vi) {
             op.level = level;
             if (!(std::isfinite(sigma) && sigma > 0)) invalid("sigma must be a positive number");
             if (!(std::isfinite(region) && region >= 0)) invalid("region must be >= 0");
+            in_object(v, op, object);
             return apply_op(v, op);
           },
           "from_"_a, "to"_a, py::kw_only(), "select"_a = "vertex", "sigma"_a = 20.0,
-          "region"_a = 0.0, "level"_a = 0)
+          "region"_a = 0.0, "level"_a = 0, "object"_a = py::none())
       .def(
           "move_feature",
           [](VectorImage& v, std::array<double, 2> at, std::array<double, 2> translate,
-             double rotate, double region, int level) {
+             double rotate, double region, int level, std::optional<int> object) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kMoveFeature;
             op.at = point(at, "at");
@@ -516,24 +529,26 @@ void def_edits(PyVectorImage& vi) {
             op.rotate = rotate;
             op.region = region;
             op.level = level;
+            in_object(v, op, object);
             return apply_op(v, op);
           },
           "at"_a, py::kw_only(), "translate"_a = std::array<double, 2>{0, 0}, "rotate"_a = 0.0,
-          "region"_a = 0.0, "level"_a = 0)
+          "region"_a = 0.0, "level"_a = 0, "object"_a = py::none())
       .def(
           "move_vertices",
           [](VectorImage& v, const py::object& vertices, std::array<double, 2> translate,
-             double region, int level) {
+             double region, int level, std::optional<int> object) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kMoveVertices;
             op.level = check_level(v, level);
-            op.vertices = index_list(vertices, v.levels[size_t(op.level)].num_vertices(), "vertices");
+            in_object(v, op, object);
+            op.vertices = index_list(vertices, mesh_of(v, op).num_vertices(), "vertices");
             op.translate = point(translate, "translate");
             if (!(std::isfinite(region) && region >= 0)) invalid("region must be >= 0");
             op.region = region;
             return apply_op(v, op);
           },
-          "vertices"_a, "translate"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0)
+          "vertices"_a, "translate"_a, py::kw_only(), "region"_a = 0.0, "level"_a = 0, "object"_a = py::none())
       .def(
           "add_feature",
           [](VectorImage& v, const py::object& points, const std::string& kind, int level) {
@@ -622,7 +637,7 @@ void def_edits(PyVectorImage& vi) {
           "recolor",
           [](VectorImage& v, std::optional<std::array<double, 2>> at, std::array<double, 3> color,
              const std::string& mode, const std::string& select, std::optional<double> radius,
-             std::optional<double> tolerance, const py::object& vertices, double amount, int level) {
+             std::optional<double> tolerance, const py::object& vertices, double amount, int level, std::optional<int> object) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kColor;
             op.select = parse_select(select);
@@ -644,18 +659,16 @@ void def_edits(PyVectorImage& vi) {
             if ((op.select == subvec::EditSelect::kVertices) != !vertices.is_none()) {
               invalid("vertices go with select='vertices', and it needs them");
             }
-            if (!vertices.is_none()) {
-              op.vertices = index_list(vertices, v.levels[size_t(check_level(v, level))].num_vertices(),
-                                       "vertices");
-            }
+            op.level = check_level(v, level);
+            in_object(v, op, object);
+            if (!vertices.is_none()) op.vertices = index_list(vertices, mesh_of(v, op).num_vertices(), "vertices");
             if (!(amount >= 0 && amount <= 1)) invalid("amount must be in [0, 1]");
             op.amount = amount;
-            op.level = level;
             return apply_op(v, op);
           },
           "at"_a, "color"_a, py::kw_only(), "mode"_a = "blend", "select"_a = "vertex",
           "radius"_a = py::none(), "tolerance"_a = py::none(), "vertices"_a = py::none(),
-          "amount"_a = 0.5, "level"_a = 0);
+          "amount"_a = 0.5, "level"_a = 0, "object"_a = py::none());
 }
 
 // The building blocks of color and shape edits (edit/selection.h, edit/color.h, edit/shape.h).

@@ -189,6 +189,17 @@ EditOp parse_op(const Json& j, Place& at) {
     return EditSelect::kVertex;
   };
 
+  // Inside an object (its own mesh) instead of the level's.
+  auto in_object = [&]() {
+    if (const Json* o = fields.optional("object")) {
+      if (!o->is_number_integer() || o->get<int64_t>() < 0 || o->get<int64_t>() >= Limits::kMaxObjects) {
+        at.fail("object", "expected an object index, 0 to " + std::to_string(Limits::kMaxObjects - 1) +
+                              ", got " + (o->is_number() ? o->dump() : type_name(*o)));
+      }
+      op.in_object = true;
+      op.object = static_cast<int>(o->get<int64_t>());
+    }
+  };
   auto region = [&]() {
     if (const Json* r = fields.optional("region")) {
       op.region = number(*r, at, "region");
@@ -279,11 +290,13 @@ EditOp parse_op(const Json& j, Place& at) {
       op.at = vec2(fields.required("at"), at, "at");
       break;
     case EditOp::Kind::kMoveVertices:
+      in_object();
       region();
       vertex_list();
       op.translate = vec2(fields.required("translate"), at, "translate");
       break;
     case EditOp::Kind::kDrag:
+      in_object();
       region();
       op.select = select(false);
       op.from = vec2(fields.required("from"), at, "from");
@@ -296,6 +309,7 @@ EditOp parse_op(const Json& j, Place& at) {
       }
       break;
     case EditOp::Kind::kMoveFeature: {
+      in_object();
       region();
       op.select = EditSelect::kFeature;
       op.at = vec2(fields.required("at"), at, "at");
@@ -316,6 +330,7 @@ EditOp parse_op(const Json& j, Place& at) {
         at.fail("mode", "expected \"blend\" or \"transform\", got \"" + printable(mode) + "\"");
       }
       at.op = "color " + mode;
+      in_object();
       op.select = select(true);
       // Listed vertices need no point.
       if (op.select == EditSelect::kVertices) {
@@ -547,8 +562,21 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
       log.push_back(where + ": " + apply_object_op(image, op, where, inside, within_reach));
       continue;
     }
-    ControlMesh mesh = image.levels[op.level];
-    const MeshTopology topology = validate_level(mesh, image.width, image.height, op.level);
+    // The mesh edited: the level's, or an object's (its own mesh, with no image frame around it).
+    if (op.in_object && op.object >= static_cast<int>(image.objects.size())) {
+      const int count = static_cast<int>(image.objects.size());
+      refuse(where, "object " + std::to_string(op.object) + " is out of range (the image has " +
+                        std::to_string(count) + (count == 1 ? " object)" : " objects)"));
+    }
+    ControlMesh mesh = op.in_object ? image.objects[op.object].mesh : image.levels[op.level];
+    auto check = [&](const ControlMesh& m) {
+      if (!op.in_object) return validate_level(m, image.width, image.height, op.level);
+      Object o;
+      o.level = image.objects[op.object].level;
+      o.mesh = m;
+      return validate_object(o, image.width, image.height, num_levels, op.object);
+    };
+    const MeshTopology topology = check(mesh);
     // Shape edits and deletions pick among the tear features and the crease chains.
     const std::vector<Feature> chains = editable_chains(mesh, topology);
     auto pick_feature = [&](Vec2 p) {
@@ -587,7 +615,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
             if (op.select == EditSelect::kVertex) {
               const int v = nearest_vertex(mesh, op.from);
               const Vec2 p = mesh.positions[v];
-              if ((p.x == 0 || p.x == w) && (p.y == 0 || p.y == h)) {
+              if (!op.in_object && (p.x == 0 || p.x == w) && (p.y == 0 || p.y == h)) {
                 refuse(where, "nothing to drag: the nearest control vertex to " + point(op.from) +
                                   " is the image corner " + point(p) + ", which stays fixed");
               }
@@ -609,7 +637,8 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
                    point(op.translate);
           }
           handles.region = op.region;
-          ShapeEditor editor(mesh, image.width, image.height);
+          ShapeEditor editor(mesh, op.in_object ? MeshTopology::kNoFrame : image.width,
+                             op.in_object ? MeshTopology::kNoFrame : image.height);
           mesh.positions = editor.deform(handles);
           double moved = 0;
           for (int v = 0; v < mesh.num_vertices(); ++v) {
@@ -682,7 +711,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
           break;
         }
       }
-      validate_level(mesh, image.width, image.height, op.level);
+      check(mesh);
     } catch (const Error& e) {
       const std::string message = e.what();
       if (message.rfind(where, 0) == 0) throw;
@@ -691,6 +720,11 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
     // Strokes on the level follow a shape edit (issue 29): each point keeps its place in its
     // control triangle. All of the level's points go through one call (one point-location grid).
     const bool topology_edit = op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature;
+    if (op.in_object) {
+      image.objects[op.object].mesh = std::move(mesh);
+      log.push_back(where + ": object " + std::to_string(op.object) + ": " + done);
+      continue;
+    }
     if (topology_edit && op.level + 1 < num_levels) {
       // The next level's link to this one (its parents' numbering) no longer holds.
       image.levels[op.level + 1].parent_vertices.clear();

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <cstdio>
 #include <numbers>
 #include <string>
@@ -94,8 +95,20 @@ Handles move_feature(const ControlMesh& mesh, const Feature& feature, Vec2 trans
 
 ShapeEditor::ShapeEditor(const ControlMesh& mesh, int width, int height)
     : rest_(mesh.positions), triangles_(mesh.triangles), width_(width), height_(height) {
-  sides_.resize(rest_.size());
-  for (size_t v = 0; v < rest_.size(); ++v) {
+  sides_.assign(rest_.size(), 0);
+  if (width < 0) {
+    // An object's mesh: its boundary (the edges of one triangle) holds it in place, as the frame
+    // holds a level's.
+    std::map<std::pair<int32_t, int32_t>, int> uses;
+    for (const Tri& t : triangles_) {
+      for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+    }
+    pinned_.assign(rest_.size(), 0);
+    for (const auto& [edge, count] : uses) {
+      if (count == 1) pinned_[edge.first] = pinned_[edge.second] = 1;
+    }
+  }
+  for (size_t v = 0; v < rest_.size() && width >= 0; ++v) {
     const Vec2 p = rest_[v];
     sides_[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.x == width ? 2 : 0) |
                                      (p.y == 0 ? 4 : 0) | (p.y == height ? 8 : 0));
@@ -115,6 +128,7 @@ const ArapDeformer& ShapeEditor::deformer_for(std::vector<int32_t> handles, doub
   for (size_t v = 0; v < rest_.size(); ++v) {
     const unsigned s = sides_[v];
     fixed[v] = static_cast<FixedAxes>(((s & 3u) ? 1u : 0u) | ((s & 12u) ? 2u : 0u));
+    if (!pinned_.empty() && pinned_[v]) fixed[v] = FixedAxes::kXY;
   }
   if (region > 0) {
     const double r2 = region * region;
@@ -167,6 +181,10 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
     }
     // Border handles slide along their side; corners stay. The frame stops the others: a
     // target outside it is taken to the nearest point a margin inside.
+    if (width_ < 0) {  // an object's mesh: no frame
+      targets_[v] = t;
+      continue;
+    }
     const unsigned s = sides_[v];
     const double m = kFrameMargin;
     framed_ |= (!(s & 3u) && (t.x < kFrameMargin || t.x > width_ - kFrameMargin)) ||

@@ -315,8 +315,19 @@ def test_objects():
         back = subvec.from_bytes(image.to_bytes(format=form, lossless=True))
         assert back.objects == image.objects
         assert np.array_equal(back.render(), image.render())
+    # Edits inside the object reach its own mesh, not the level's.
+    level_colors = image.mesh()["colors"].copy()
+    centre = image.object_mesh(0)["positions"].mean(axis=0)
+    assert "object 0: " in image.recolor(tuple(centre), (0, 0, 255), amount=1.0, radius=6, object=0)
+    assert np.array_equal(image.mesh()["colors"], level_colors)
+    assert np.abs(image.object_mesh(0)["colors"] - (0, 0, 255)).min() < 1e-3
+    moved = image.object_mesh(0)["positions"].copy()
+    image.move_vertices([0], (2, 1), object=0)
+    assert np.allclose(image.object_mesh(0)["positions"][0], moved[0] + (2, 1))
     with pytest.raises(IndexError, match="object 3 is out of range"):
         image.move_object(3, translate=(1, 1))
+    with pytest.raises(IndexError, match="object 3 is out of range"):
+        image.drag((40, 40), (42, 42), object=3)
     with pytest.raises(ValueError, match="scale must be a positive number"):
         image.move_object(0, scale=0)
     with pytest.raises(ValueError, match="no closed feature of level 0 encloses"):

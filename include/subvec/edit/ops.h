@@ -49,6 +49,7 @@ struct EditOp {
   std::vector<Vec2> points;       // add-feature: the drawn polyline
   FeatureKind feature_kind = FeatureKind::kTear;  // add-feature
   int object = 0;                 // the object ops: index in VectorImage::objects
+  bool in_object = false;         // drag, move-feature, move-vertices, color: edit object `object`'s mesh
   double scale = 1;               // move-object
   std::optional<Vec2> pivot;      // move-object; default the object's centre (object_center)
   int position = 0;               // order-object: the new position ("to" in the file)

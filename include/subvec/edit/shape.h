@@ -106,6 +106,9 @@ class ShapeEditor {
  public:
   // The rest shape is `mesh`'s positions now; `width` x `height` is the image. Throws
   // Error(kInvalidArgument) for a mesh with a degenerate triangle.
+  // With width and height MeshTopology::kNoFrame (an object's mesh, edit/objects.h) there is no
+  // frame: targets go anywhere, and the object's boundary holds as the frame does (its vertices
+  // stay unless they are handles).
   ShapeEditor(const ControlMesh& mesh, int width, int height);
 
   const std::vector<Vec2>& rest() const { return rest_; }
@@ -141,6 +144,7 @@ class ShapeEditor {
   int width_, height_;
   static constexpr double kFrameMargin = 0.25;  // pixels: how close the frame lets a handle come
   std::vector<uint8_t> sides_;  // per vertex: bit 0 left, 1 right, 2 top, 3 bottom
+  std::vector<uint8_t> pinned_;  // an object's mesh (no frame): its boundary vertices, held
   std::list<Cached> cache_;     // most recently used first
   int first_flip(const std::vector<Vec2>& positions) const;
   void fold_free(const ArapDeformer& deformer, std::vector<Vec2>& out);

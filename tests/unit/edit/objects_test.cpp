@@ -13,6 +13,7 @@
 
 #include "subvec/core/error.h"
 #include "subvec/edit/objects.h"
+#include "subvec/edit/ops.h"
 #include "subvec/edit/feature_edit.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
@@ -447,6 +448,46 @@ TEST(Objects, AFeatureAcrossTheCurveIsSplit) {
   validate(image);
   EXPECT_GE(made.features_moved, 1);  // the piece inside
   EXPECT_EQ(image.levels[0].features.size() + image.objects[0].mesh.features.size(), before);
+}
+
+TEST(Objects, EditsReachInsideAnObject) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]));
+  transform_object(image, 0, {.translate = {-20, 0}});  // partly off its old place
+  const VectorImage before = image;
+  const Vec2 c = object_center(image.objects[0]);
+  const std::vector<EditOp> ops = parse_edit_ops(
+      "[{\"op\": \"drag\", \"object\": 0, \"from\": [" + std::to_string(c.x) + ", " + std::to_string(c.y) +
+      "], \"to\": [" + std::to_string(c.x + 4) + ", " + std::to_string(c.y - 3) + "], \"region\": 15},"
+      " {\"op\": \"color\", \"mode\": \"blend\", \"object\": 0, \"at\": [" + std::to_string(c.x) + ", " +
+      std::to_string(c.y) + "], \"select\": \"vertex\", \"radius\": 8, \"color\": [0, 0, 255], \"amount\": 1}]");
+  const std::vector<std::string> log = apply_edit_ops(image, ops);
+  EXPECT_NE(log[0].find("object 0: vertex"), std::string::npos) << log[0];
+  EXPECT_NE(log[1].find("object 0: "), std::string::npos) << log[1];
+  validate(image);
+  // The object changed; the level did not.
+  EXPECT_NE(image.objects[0].mesh.positions, before.objects[0].mesh.positions);
+  EXPECT_NE(image.objects[0].mesh.colors, before.objects[0].mesh.colors);
+  EXPECT_EQ(image.levels[0].positions, before.levels[0].positions);
+  EXPECT_EQ(image.levels[0].colors, before.levels[0].colors);
+  // An object's mesh has no frame: its boundary vertices move freely (none is pinned to a side).
+  const std::vector<EditOp> far = parse_edit_ops(
+      "[{\"op\": \"move-vertices\", \"object\": 0, \"vertices\": [0], \"translate\": [-30, 0]}]");
+  apply_edit_ops(image, far);
+  validate(image);
+  EXPECT_LT(image.objects[0].mesh.positions[0].x, before.objects[0].mesh.positions[0].x - 1);
+  const std::vector<EditOp> missing = parse_edit_ops(
+      "[{\"op\": \"color\", \"mode\": \"blend\", \"object\": 4, \"at\": [10, 10], \"color\": [0, 0, 0]}]");
+  try {
+    apply_edit_ops(image, missing);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ops[0] (color blend): object 4 is out of range (the image has 1 object)"),
+              std::string::npos)
+        << e.what();
+  }
+  // A feature edit does not take "object" (yet).
+  EXPECT_THROW(parse_edit_ops("[{\"op\": \"add-feature\", \"object\": 0, \"points\": [[1, 1], [9, 9]]}]"), Error);
 }
 
 TEST(Objects, MoveASegmentOnPhotographs) {
