@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <numbers>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,8 @@
 #include "subvec/core/error.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/edit/feature_edit.h"
+#include "subvec/render/renderer.h"
 
 namespace subvec {
 namespace {
@@ -29,14 +32,18 @@ double area(Vec2 a, Vec2 b, Vec2 c) {
   return 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
 }
 
-// The faces of `mesh` on the side of the closed chain `chain` that does not reach the image
+// Marks the edges of the closed vertex cycle `cycle` (first vertex repeated at the end).
+std::vector<uint8_t> cycle_edges(const MeshTopology& topology, std::span<const int32_t> cycle) {
+  std::vector<uint8_t> on(topology.num_edges(), 0);
+  for (size_t i = 0; i + 1 < cycle.size(); ++i) on[topology.find_edge(cycle[i], cycle[i + 1])] = 1;
+  return on;
+}
+
+// The faces of `mesh` on the side of the closed cycle of edges that does not reach the image
 // border (1 inside, 0 outside). Throws when both sides reach it.
 std::vector<uint8_t> inside_faces(const ControlMesh& mesh, const MeshTopology& topology,
-                                  const Feature& chain, const std::string& what) {
-  std::vector<uint8_t> blocked(topology.num_edges(), 0);
-  for (size_t i = 0; i + 1 < chain.vertices.size(); ++i) {
-    blocked[topology.find_edge(chain.vertices[i], chain.vertices[i + 1])] = 1;
-  }
+                                  std::span<const int32_t> cycle, const std::string& what) {
+  const std::vector<uint8_t> blocked = cycle_edges(topology, cycle);
   // Components of the faces, across every edge but the chain's.
   const int nf = mesh.num_triangles();
   std::vector<int32_t> component(nf, -1);
@@ -66,7 +73,7 @@ std::vector<uint8_t> inside_faces(const ControlMesh& mesh, const MeshTopology& t
       }
     }
   }
-  const int e0 = topology.find_edge(chain.vertices[0], chain.vertices[1]);
+  const int e0 = topology.find_edge(cycle[0], cycle[1]);
   const int32_t side_a = component[topology.edge_faces[e0][0]];
   const int32_t side_b = component[topology.edge_faces[e0][1]];
   if (reaches_border[side_a] == reaches_border[side_b]) {
@@ -78,19 +85,19 @@ std::vector<uint8_t> inside_faces(const ControlMesh& mesh, const MeshTopology& t
   return inside;
 }
 
-// Splits the features other than `skip` into the runs of edges on one side of the curve: edges
-// whose faces are inside go to `in`, the others to `out`. The first run of a feature in each mesh
-// keeps its id; later ones take ids from `next_id`.
+// Splits the features into the runs of edges on one side of the curve: edges whose faces are
+// inside go to `in`, the others (those of the curve too: it stays a tear of the level) to `out`.
+// The first run of a feature in each mesh keeps its id; later ones take ids from `next_id`.
 void split_features(const ControlMesh& mesh, const MeshTopology& topology,
-                    const std::vector<uint8_t>& inside, int skip, int32_t& next_id,
-                    std::vector<Feature>& in, std::vector<Feature>& out) {
+                    const std::vector<uint8_t>& inside, const std::vector<uint8_t>& on_curve,
+                    int32_t& next_id, std::vector<Feature>& in, std::vector<Feature>& out) {
   for (int g = 0; g < static_cast<int>(mesh.features.size()); ++g) {
-    if (g == skip) continue;
     const Feature& feature = mesh.features[g];
     std::vector<int32_t> v = feature.vertices;
     const size_t edges = v.size() - 1;
     auto side = [&](size_t i) {
-      return inside[topology.edge_faces[topology.find_edge(v[i], v[i + 1])][0]] != 0;
+      const int e = topology.find_edge(v[i], v[i + 1]);
+      return !on_curve[e] && inside[topology.edge_faces[e][0]] != 0;
     };
     if (feature.closed()) {
       // Start a closed chain where it changes side, if it does.
@@ -311,32 +318,21 @@ Object& object_at(VectorImage& image, int object) {
 
 }  // namespace
 
-MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name) {
-  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
-    invalid("level " + std::to_string(level) + " is out of range (" +
-            std::to_string(image.levels.size()) + " levels)");
-  }
+namespace {
+
+// make_object() along a closed cycle of tear edges of the level (first vertex repeated at the end),
+// which may be one closed feature or parts of several meeting at junctions.
+MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<int32_t> cycle,
+                                   const MeshTopology& topology, const std::string& what,
+                                   const std::string& name) {
   const ControlMesh& mesh = image.levels[level];
-  if (feature < 0 || feature >= static_cast<int>(mesh.features.size())) {
-    invalid("feature " + std::to_string(feature) + " is out of range (" +
-            std::to_string(mesh.features.size()) + " features on level " + std::to_string(level) + ")");
-  }
-  const Feature& chain = mesh.features[feature];
-  const std::string what = "feature " + std::to_string(feature) + " (id " + std::to_string(chain.id) + ")";
-  if (!chain.closed()) invalid(what + " is open; an object needs a closed feature");
-  {
-    std::vector<int32_t> sorted(chain.vertices.begin(), chain.vertices.end() - 1);
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
-      invalid(what + " passes through a vertex twice; an object needs a simple closed curve");
-  }
-  const MeshTopology topology = validate_level(mesh, image.width, image.height, level);
-  const std::vector<uint8_t> inside = inside_faces(mesh, topology, chain, what);
+  const std::vector<uint8_t> inside = inside_faces(mesh, topology, cycle, what);
+  const std::vector<uint8_t> on_curve = cycle_edges(topology, cycle);
 
   int32_t next_id = 0;
   for (const Feature& f : mesh.features) next_id = std::max(next_id, f.id + 1);
   std::vector<Feature> in, out;
-  split_features(mesh, topology, inside, feature, next_id, in, out);
+  split_features(mesh, topology, inside, on_curve, next_id, in, out);
   MakeObjectResult result;
   result.features_moved = static_cast<int>(in.size());
 
@@ -346,13 +342,13 @@ MakeObjectResult make_object(VectorImage& image, int level, int feature, const s
   object.mesh = object_mesh(mesh, topology, inside, std::move(in));
   result.object_vertices = object.mesh.num_vertices();
 
-  // The background: the same triangles, the features and creases outside, colors renumbered by
-  // the tears that remain (one value per hole vertex, one on the hole's side of each curve vertex).
+  // The background: the same triangles, the features and creases outside (and the curve's),
+  // colors renumbered by the tears that remain (one value per hole vertex, one on the hole's side
+  // of each curve vertex).
   ControlMesh back;
   back.positions = mesh.positions;
   back.triangles = mesh.triangles;
   back.features = std::move(out);
-  back.features.push_back(chain);
   for (const EdgeVerts& e : mesh.creases) {
     if (!inside[topology.edge_faces[topology.find_edge(e[0], e[1])][0]]) back.creases.push_back(e);
   }
@@ -386,11 +382,13 @@ MakeObjectResult make_object(VectorImage& image, int level, int feature, const s
   result.removed = simplify_hole(coarsener, hole_vertex, target);
   std::vector<int32_t> parents, color_merged;
   back = coarsener.result(parents, color_merged);
-  // The hole's faces after the collapses: those inside the curve, found again.
+  // The hole's faces after the collapses: those inside the curve (whose vertices all stay),
+  // found again in the new numbering.
+  std::vector<int32_t> renumbered(mesh.num_vertices(), -1);
+  for (size_t v = 0; v < parents.size(); ++v) renumbered[parents[v]] = static_cast<int32_t>(v);
+  for (int32_t& v : cycle) v = renumbered[v];
   const MeshTopology t = MeshTopology::build(back, image.width, image.height);
-  const auto curve = std::find_if(back.features.begin(), back.features.end(),
-                                  [&](const Feature& f) { return f.id == chain.id; });
-  const std::vector<uint8_t> hole = inside_faces(back, t, *curve, what);
+  const std::vector<uint8_t> hole = inside_faces(back, t, cycle, what);
   fill_hole_colors(back, hole);
   for (const int32_t p : parents) result.fill_vertices += hole_vertex[p];
 
@@ -404,6 +402,110 @@ MakeObjectResult make_object(VectorImage& image, int level, int feature, const s
   }
   image.objects.push_back(std::move(object));
   result.object = static_cast<int>(image.objects.size()) - 1;
+  return result;
+}
+
+void check_level_index(const VectorImage& image, int level) {
+  if (level < 0 || level >= static_cast<int>(image.levels.size())) {
+    invalid("level " + std::to_string(level) + " is out of range (" +
+            std::to_string(image.levels.size()) + " levels)");
+  }
+}
+
+}  // namespace
+
+MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name) {
+  check_level_index(image, level);
+  const ControlMesh& mesh = image.levels[level];
+  if (feature < 0 || feature >= static_cast<int>(mesh.features.size())) {
+    invalid("feature " + std::to_string(feature) + " is out of range (" +
+            std::to_string(mesh.features.size()) + " features on level " + std::to_string(level) + ")");
+  }
+  const Feature& chain = mesh.features[feature];
+  const std::string what = "feature " + std::to_string(feature) + " (id " + std::to_string(chain.id) + ")";
+  if (!chain.closed()) invalid(what + " is open; an object needs a closed feature");
+  {
+    std::vector<int32_t> sorted(chain.vertices.begin(), chain.vertices.end() - 1);
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+      invalid(what + " passes through a vertex twice; an object needs a simple closed curve");
+  }
+  const MeshTopology topology = validate_level(mesh, image.width, image.height, level);
+  return make_object_along(image, level, chain.vertices, topology, what, name);
+}
+
+constexpr double kFramedShare = 0.2;
+
+MakeObjectResult make_object_in_rect(VectorImage& image, int level, const PixelRect& rect,
+                                     const std::string& name) {
+  check_level_index(image, level);
+  // A closed tear inside the rectangle: the largest.
+  const ControlMesh& mesh = image.levels[level];
+  int best = -1;
+  double best_area = 0;
+  for (int f = 0; f < static_cast<int>(mesh.features.size()); ++f) {
+    const Feature& feature = mesh.features[f];
+    if (!feature.closed()) continue;
+    bool within = true;
+    double twice_area = 0;
+    for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
+      const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
+      within = within && a.x >= rect.x && a.x <= rect.x + rect.width && a.y >= rect.y && a.y <= rect.y + rect.height;
+      twice_area += a.x * b.y - b.x * a.y;
+    }
+    if (within && (best < 0 || std::abs(twice_area) > best_area)) best = f, best_area = std::abs(twice_area);
+  }
+  // It must be what the rectangle frames, not a detail inside it: a fifth of its area at least.
+  if (best >= 0 && best_area / 2 < kFramedShare * double(rect.width) * double(rect.height)) best = -1;
+  if (best >= 0) return make_object(image, level, best, name);
+
+  // GrabCut on the level as drawn (without its objects), then its boundary cut in as a tear.
+  VectorImage alone;
+  alone.width = image.width;
+  alone.height = image.height;
+  alone.levels.push_back(mesh);
+  RenderOptions options;
+  const RegionMask mask = segment_foreground(render(alone, options), rect);
+  const std::vector<DetectedFeature> boundary = region_boundary_features(mask);
+  if (boundary.size() != 1 || !boundary[0].closed()) {
+    invalid("the foreground GrabCut finds in the rectangle reaches the image border; an object needs a closed boundary");
+  }
+  VectorImage work = image;
+  ControlMesh& cut = work.levels[level];
+  const int before = static_cast<int>(cut.features.size());
+  FeatureEditResult added;
+  try {
+    added = add_feature(cut, image.width, image.height, boundary[0].points, FeatureKind::kTear);
+  } catch (const Error& e) {
+    invalid(std::string("the boundary GrabCut finds in the rectangle cannot be cut in: ") + e.what() +
+            "; make an object of a closed feature instead (draw one with the pen)");
+  }
+  // The curve: the new pieces, joined end to end at their junctions.
+  std::vector<std::vector<int32_t>> pieces;
+  for (int f = before; f < static_cast<int>(cut.features.size()); ++f) pieces.push_back(cut.features[f].vertices);
+  std::vector<int32_t> cycle = pieces.front();
+  std::vector<uint8_t> used(pieces.size(), 0);
+  used[0] = 1;
+  for (size_t joined = 1; joined < pieces.size(); ++joined) {
+    bool found = false;
+    for (size_t k = 0; k < pieces.size() && !found; ++k) {
+      if (used[k]) continue;
+      std::vector<int32_t> piece = pieces[k];
+      if (piece.back() == cycle.back()) std::reverse(piece.begin(), piece.end());
+      if (piece.front() != cycle.back()) continue;
+      cycle.insert(cycle.end(), piece.begin() + 1, piece.end());
+      used[k] = found = true;
+    }
+    if (!found) break;
+  }
+  if (cycle.size() < 4 || cycle.front() != cycle.back()) {
+    invalid("the boundary GrabCut finds does not close after meeting " + std::to_string(added.junctions) +
+            " features; draw the object's outline with the pen instead");
+  }
+  const MeshTopology topology = validate_level(cut, image.width, image.height, level);
+  const std::string what = "the boundary of the foreground in the rectangle";
+  MakeObjectResult result = make_object_along(work, level, cycle, topology, what, name);
+  image = std::move(work);
   return result;
 }
 

@@ -233,10 +233,28 @@ EditOp parse_op(const Json& j, Place& at) {
     return static_cast<int>(value.get<int64_t>());
   };
   switch (op.kind) {
-    case EditOp::Kind::kMakeObject:
-      op.at = vec2(fields.required("at"), at, "at");
+    case EditOp::Kind::kMakeObject: {
+      const Json* point = fields.optional("at");
+      const Json* rect = fields.optional("rect");
+      if ((point != nullptr) == (rect != nullptr)) at.fail("give \"at\" or \"rect\" (one of them)");
+      if (point) op.at = vec2(*point, at, "at");
+      if (rect) {
+        std::array<int, 4> r{};
+        const bool four = rect->is_array() && rect->size() == 4;
+        for (size_t k = 0; four && k < 4; ++k) {
+          const Json& v = (*rect)[k];
+          if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > Limits::kMaxDimension) {
+            at.fail("rect", "expected [x, y, width, height] (whole pixels, 0 to " +
+                                std::to_string(Limits::kMaxDimension) + "), got " + v.dump());
+          }
+          r[k] = static_cast<int>(v.get<int64_t>());
+        }
+        if (!four) at.fail("rect", std::string("expected [x, y, width, height], got ") + type_name(*rect));
+        op.rect = r;
+      }
       if (const Json* n = fields.optional("name")) op.object_name = string_value(*n, at, "name");
       break;
+    }
     case EditOp::Kind::kMoveObject: {
       op.object = index("object");
       const Json* translate = fields.optional("translate");
@@ -424,6 +442,15 @@ std::string apply_object_op(VectorImage& image, const EditOp& op, const std::str
   try {
     switch (op.kind) {
       case K::kMakeObject: {
+        if (op.rect) {
+          const auto [x, y, rw, rh] = *op.rect;
+          const MakeObjectResult r = make_object_in_rect(image, op.level, {x, y, rw, rh}, op.object_name);
+          return object_name(r.object) + " made of what [" + std::to_string(x) + ", " + std::to_string(y) +
+                 ", " + std::to_string(rw) + ", " + std::to_string(rh) + "] frames: " +
+                 std::to_string(r.object_vertices) + " vertices, " + std::to_string(r.features_moved) +
+                 (r.features_moved == 1 ? " feature" : " features") + " inside; the background under it has " +
+                 std::to_string(r.fill_vertices) + " vertices (" + std::to_string(r.removed) + " removed)";
+        }
         inside("at", op.at);
         const ControlMesh& mesh = image.levels[op.level];
         const int f = closed_feature_around(mesh, op.at);

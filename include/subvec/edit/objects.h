@@ -29,6 +29,7 @@
 #include <string>
 
 #include "subvec/mesh/vector_image.h"
+#include "subvec/vectorize/segment.h"
 
 namespace subvec {
 
@@ -44,6 +45,18 @@ struct MakeObjectResult {
 // Throws Error(kInvalidArgument) when the level or feature is out of range, the feature is open
 // or repeats a vertex, or the region it bounds touches the image border.
 MakeObjectResult make_object(VectorImage& image, int level, int feature, const std::string& name = "");
+
+// Makes an object of what `rect` frames on level `level` (the editor's rectangle): the largest
+// closed tear whose control polygon lies inside the rectangle and covers a fifth of it at least;
+// or, when none does, the foreground
+// GrabCut finds in the rectangle on the level's render (segment_foreground, vectorize/segment.h),
+// whose boundary is first cut into the level as a closed tear (add_feature, edit/feature_edit.h:
+// it meets the features it crosses at junctions, and the object's curve is then made of the
+// pieces between them). Throws Error(kInvalidArgument), the image unchanged, for a rectangle
+// GrabCut cannot use, a foreground that reaches the image border, or a boundary add_feature
+// refuses.
+MakeObjectResult make_object_in_rect(VectorImage& image, int level, const PixelRect& rect,
+                                     const std::string& name = "");
 
 // The innermost closed tear of `mesh` around point p: the feature whose control polygon encloses
 // p with the smallest area (the limit curve lies within a fraction of a control edge of it), or

@@ -3,6 +3,7 @@
 // needs the image (points inside it, something to select).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <span>
 #include <string>
@@ -25,7 +26,7 @@ struct EditOp {
     kMoveVertices, // vertices, translate (the editor's direct handles)
     kAddFeature,   // points, feature_kind (edit/feature_edit.h)
     kDeleteFeature,// at: the nearest feature
-    kMakeObject,   // at: the innermost closed tear around it; name (edit/objects.h)
+    kMakeObject,   // at: the innermost closed tear around it, or rect (make_object_in_rect); name
     kMoveObject,   // object; translate, rotate (degrees), scale, pivot
     kHideObject,   // object
     kShowObject,   // object
@@ -54,6 +55,7 @@ struct EditOp {
   std::optional<Vec2> pivot;      // move-object; default the object's centre (object_center)
   int position = 0;               // order-object: the new position ("to" in the file)
   std::string object_name;        // make-object
+  std::optional<std::array<int, 4>> rect;  // make-object: x, y, width, height (whole pixels)
 
   // "drag vertex", "drag feature", "move-feature", "color blend", "color transform",
   // "move-vertices", "add-feature", "delete-feature", "make-object", "move-object", "hide-object",

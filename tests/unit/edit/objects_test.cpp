@@ -490,6 +490,41 @@ TEST(Objects, EditsReachInsideAnObject) {
   EXPECT_THROW(parse_edit_ops("[{\"op\": \"add-feature\", \"object\": 0, \"points\": [[1, 1], [9, 9]]}]"), Error);
 }
 
+TEST(Objects, FromARectangle) {
+  // A rectangle that frames a closed tear makes it an object.
+  VectorImage image = small_image();
+  const Feature& circle = image.levels[0].features[closed_feature(image.levels[0])];
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  for (const int32_t v : circle.vertices) {
+    const Vec2 p = image.levels[0].positions[v];
+    x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+  }
+  const int32_t id = circle.id;
+  const PixelRect around{int(x0) - 3, int(y0) - 3, int(x1 - x0) + 7, int(y1 - y0) + 7};
+  const MakeObjectResult framed = make_object_in_rect(image, 0, around, "framed");
+  validate(image);
+  EXPECT_EQ(framed.object, 0);
+  EXPECT_TRUE(std::any_of(image.levels[0].features.begin(), image.levels[0].features.end(),
+                          [&](const Feature& f) { return f.id == id; }));
+  // Elsewhere GrabCut's foreground is cut in as a closed tear first: a disk vectorized without
+  // features (it stands out through a smooth ramp).
+  VectorizeOptions options;
+  options.ratio = 0.05;
+  options.levels.levels = 1;
+  options.features.min_length = 1e6;
+  VectorImage smooth = vectorize(test::textured_disk(160, 128), options);
+  ASSERT_TRUE(smooth.levels[0].features.empty());
+  const MakeObjectResult cut = make_object_in_rect(smooth, 0, {40, 24, 80, 80}, "cut");
+  validate(smooth);
+  EXPECT_EQ(smooth.objects.size(), 1u);
+  EXPECT_EQ(smooth.levels[0].features.size(), 1u);  // the new closed tear, round the hole
+  EXPECT_GT(cut.object_vertices, 10);
+  // A rectangle GrabCut cannot use is refused by name, the image unchanged.
+  const std::vector<uint8_t> bytes = to_svec_binary(smooth, {.lossless = true});
+  EXPECT_THROW(make_object_in_rect(smooth, 0, {150, 120, 40, 40}), Error);
+  EXPECT_EQ(to_svec_binary(smooth, {.lossless = true}), bytes);
+}
+
 TEST(Objects, MoveASegmentOnPhotographs) {
   struct Case {
     const char* name;
