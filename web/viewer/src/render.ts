@@ -41,6 +41,7 @@ export interface RenderStats {
 // quarter of the triangles: the difference is a few tenths of a level (docs/viewer.md). The C++
 // renderer allows 2^24 triangles; a browser gets 2^22.
 export const DEFAULT_MAX_EDGE_PIXELS = 5;
+const CPP_MAX_EDGE_PIXELS = 2.5;
 const MAX_DEPTH = 8;
 const MAX_TRIANGLES = 1 << 22;
 
@@ -208,6 +209,7 @@ export class SubvecRenderer {
   #cache: Cache | null = null;
   #objectTopologies: Array<Topology | undefined> = [];
   #objectCaches: Array<Cache | undefined> = [];
+  #objectDepth = 0;
   #coverage: { texture: WebGLTexture; framebuffer: WebGLFramebuffer; width: number; height: number } | null = null;
 
   constructor(readonly canvas: HTMLCanvasElement | OffscreenCanvas) {
@@ -323,22 +325,27 @@ export class SubvecRenderer {
     let topo = this.#topologies[this.#level];
     if (!topo) topo = this.#topologies[this.#level] = buildTopology(image.levels[this.#level], image.width, image.height);
     const [visible, edges] = visibleFaces(topo, w, view);
-    this.stats.depth = 0;
+    this.stats.depth = this.#objectDepth = 0;
     if (visible.length === 0) return null;
-    const depth = (this.stats.depth = chooseDepth(edges / (3 * visible.length), this.maxEdgePixels, Math.min(view.sx, view.sy), visible.length));
+    const mean = edges / (3 * visible.length), zoom = Math.min(view.sx, view.sy);
+    const depth = (this.stats.depth = chooseDepth(mean, this.maxEdgePixels, zoom, visible.length));
+    this.#objectDepth = chooseDepth(mean, Math.min(this.maxEdgePixels, CPP_MAX_EDGE_PIXELS), zoom, visible.length);
     return (this.#cache = this.#refined(this.#cache, this.#level, topo, visible, depth, view));
   }
 
   // The level's visible objects (draw_objects of src/render/objects.cpp), bottom to top: each
-  // refined at the level's depth (fewer steps past the triangle budget), over its faces in view.
-  // Their topology has no image corners (width and height NaN): the boundary is all crease.
+  // refined over its faces in view at the depth `subvec render` gives the level (its rule of
+  // 2.5-pixel edges, fewer steps past the triangle budget): an object's boundary is drawn by its
+  // chords, which the viewer's coarser depth for the level would show as facets; the adaptive
+  // triangles keep only what the tolerances need. Their topology has no image corners (width and
+  // height NaN): the boundary is all crease.
   #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache[] {
     const out: Cache[] = [];
     image.objects.forEach((object, i) => {
       if (object.level !== this.#level || !object.visible) return;
       const topo = (this.#objectTopologies[i] ??= buildTopology(object.mesh, NaN, NaN));
       const [visible] = visibleFaces(topo, w, view);
-      let depth = this.stats.depth;
+      let depth = this.#objectDepth;
       while (depth > 0 && visible.length * 4 ** depth > MAX_TRIANGLES) --depth;
       if (visible.length) out.push((this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)));
     });
