@@ -6,13 +6,15 @@
 //  1. it rejects exactly the files of the bad-input corpora (tests/data/bad, fuzz/corpus) that
 //     `subvec info` rejects, each with a SvecError of one non-empty line (both messages printed);
 //  2. good files (the examples as JSON and as .svec versions 1, 2 and 3, a vectorized and a stylized
-//     photograph, a hand-made image with strokes and metadata) decode to what the C++ reader
+//     photograph, a hand-made image with strokes and metadata, files with objects made by
+//     `subvec edit` in every version) decode to what the C++ reader
 //     gives, as `subvec convert X -o X.svec.json --lossless` writes it: same numbering, same
 //     values (positions within 1e-9 relative, colors exact in float32);
 //  3. the worked examples of docs/format.md (JSON, and the version 2 and 3 payloads) decode as the
 //     document says;
-//  4. small crafted inputs (JSON corner cases, huge counts in tiny payloads) are accepted or
-//     rejected as by the C++ reader;
+//  4. small crafted inputs (JSON corner cases, huge counts in tiny payloads, objects good and bad
+//     in both forms) are accepted or rejected as by the C++ reader (bad objects with the C++
+//     reader's message, word for word);
 //  5. mutations of good files (truncations; flipped bytes of the file, and of the payload wrapped
 //     in a fresh zstd frame) always give a SvecError or a valid image, quickly; accept/reject as
 //     the C++ reader does;
@@ -142,22 +144,30 @@ function compare(image, ref) {
   eq(image.width, ref.width, 'width');
   eq(image.height, ref.height, 'height');
   eq(image.levels.length, ref.levels.length, 'levels');
-  ref.levels.forEach((r, l) => {
-    const m = image.levels[l];
-    if (!m) return;
-    array(m.positions, flat(r.vertices), `level ${l} positions`, close);
-    array(m.colors, flat(r.colors).map(Math.fround), `level ${l} colors`);
-    array(m.triangles, flat(r.triangles), `level ${l} triangles`);
-    array(m.triangleColors, flat(r.triangle_colors ?? r.triangles), `level ${l} triangle colors`);
-    array(m.creases, flat(r.creases), `level ${l} creases`);
-    eq(m.features.length, (r.features ?? []).length, `level ${l} features`);
+  const mesh = (m, r, l) => {
+    array(m.positions, flat(r.vertices), `${l} positions`, close);
+    array(m.colors, flat(r.colors).map(Math.fround), `${l} colors`);
+    array(m.triangles, flat(r.triangles), `${l} triangles`);
+    array(m.triangleColors, flat(r.triangle_colors ?? r.triangles), `${l} triangle colors`);
+    array(m.creases, flat(r.creases), `${l} creases`);
+    eq(m.features.length, (r.features ?? []).length, `${l} features`);
     (r.features ?? []).forEach((f, i) => {
       const g = m.features[i];
       if (!g) return;
-      eq(g.id, f.id, `level ${l} feature ${i} id`);
-      close(g.saliency, f.saliency, `level ${l} feature ${i} saliency`);
-      array(g.vertices, f.vertices, `level ${l} feature ${i} vertices`);
+      eq(g.id, f.id, `${l} feature ${i} id`);
+      close(g.saliency, f.saliency, `${l} feature ${i} saliency`);
+      array(g.vertices, f.vertices, `${l} feature ${i} vertices`);
     });
+  };
+  ref.levels.forEach((r, l) => image.levels[l] && mesh(image.levels[l], r, `level ${l}`));
+  eq(image.objects.length, (ref.objects ?? []).length, 'objects');
+  (ref.objects ?? []).forEach((o, i) => {
+    const p = image.objects[i];
+    if (!p) return;
+    eq(p.level, o.level ?? 0, `object ${i} level`);
+    eq(p.name, o.name ?? '', `object ${i} name`);
+    eq(p.visible, o.visible ?? true, `object ${i} visible`);
+    mesh(p.mesh, o.mesh, `object ${i}`);
   });
   eq(image.strokes.length, (ref.strokes ?? []).length, 'strokes');
   (ref.strokes ?? []).forEach((s, i) => {
@@ -177,9 +187,11 @@ function same_as_cpp(file, label = path.relative(tmp, file)) {
   if (!check(j.ok, `${label}: the viewer rejects it: ${j.message}`)) return undefined;
   const diffs = compare(j.image, reference(file));
   const v = fs.readFileSync(file).subarray(0, 8).toString('latin1') === 'SUBVEC\0\x1a' ? `v${fs.readFileSync(file).readUInt32LE(8)}` : 'json';
-  const sizes = j.image.levels.map((m) => `${m.positions.length / 2}/${m.triangles.length / 3}/${m.colors.length / 3}`).join(' ');
+  const size = (m) => `${m.positions.length / 2}/${m.triangles.length / 3}/${m.colors.length / 3}`;
+  const sizes = j.image.levels.map(size).join(' ');
+  const objects = j.image.objects.length ? `, objects ${j.image.objects.map((o) => `${size(o.mesh)}${o.visible ? '' : ' hidden'}`).join(' ')}` : '';
   if (check(!diffs.length, `${label}: differs from the C++ decode: ${diffs.join('; ')}`))
-    console.log(`  ${label} (${v}, levels V/T/C ${sizes}, ${j.image.strokes.length} strokes, ${j.image.metadata.length} metadata): same as C++ (${j.ms.toFixed(1)} ms)`);
+    console.log(`  ${label} (${v}, levels V/T/C ${sizes}${objects}, ${j.image.strokes.length} strokes, ${j.image.metadata.length} metadata): same as C++ (${j.ms.toFixed(1)} ms)`);
   return j.image;
 }
 
@@ -218,6 +230,24 @@ if (rocket) {
   make('rocket.svec.json', 'convert', rocket, '-o', '@');
   make('rocket-styled.svec', 'stylize', rocket, '-o', '@');
 }
+// Objects (docs/format.md, "Objects"): the disk made an object, moved, rotated, scaled, hidden and
+// shown again (tests/bad-input/files/ops-objects.json), in every version; two objects, one hidden,
+// over the second level of a pyramid, with strokes.
+{
+  const disk = path.join(root, 'examples/01-disk.svec.json'), ops = path.join(root, 'tests/bad-input/files/ops-objects.json');
+  const object = make('disk-object.svec', 'edit', disk, '-o', '@', '--ops', ops);
+  if (object) {
+    make('disk-object-v1.svec', 'convert', object, '-o', '@', '--lossless');
+    make('disk-object-v2.svec', 'convert', object, '-o', '@', '--compact-version', '2');
+    make('disk-object.svec.json', 'convert', object, '-o', '@');
+  }
+  fs.writeFileSync(path.join(tmp, 'ops-two.json'), JSON.stringify([
+    { op: 'make-object', at: [48, 48], name: 'first' }, { op: 'move-object', object: 0, translate: [-10, 8], scale: 0.5 },
+    { op: 'make-object', at: [48, 48], name: 'second ✓' }, { op: 'hide-object', object: 0 },
+  ]));
+  const two = make('two-objects.svec', 'edit', disk, '-o', '@', '--ops', path.join(tmp, 'ops-two.json'));
+  if (two) make('two-objects-v1.svec', 'convert', two, '-o', '@', '--lossless');
+}
 for (const file of goods) same_as_cpp(file, path.relative(file.startsWith(tmp) ? tmp : root, file));
 
 // ---------------------------------------------------------------------------------------------
@@ -226,7 +256,7 @@ const doc = fs.readFileSync(path.join(root, 'docs/format.md'), 'utf8');
 const blocks = (tag) => [...doc.matchAll(new RegExp('```' + tag + '\\n([^]*?)```', 'g'))].map((m) => m[1]);
 const hexBytes = (text) => Buffer.from(text.split('\n').map((l) => l.replace(/#.*/, '')).join(' ').trim().split(/\s+/).join(''), 'hex');
 // A .svec file around a payload: the header and a zstd frame of raw blocks (content size, no checksum).
-function svecFile(payload, version) {
+function svecFile(payload, version, flags = 0) {
   const frame = [Buffer.from([0x28, 0xb5, 0x2f, 0xfd, 0xe0]), Buffer.alloc(8)];
   frame[1].writeBigUInt64LE(BigInt(payload.length));
   for (let pos = 0; pos < payload.length || pos === 0; ) {
@@ -238,6 +268,7 @@ function svecFile(payload, version) {
   const f = Buffer.concat(frame), header = Buffer.alloc(32);
   header.write('SUBVEC\0\x1a', 'latin1');
   header.writeUInt32LE(version, 8);
+  header.writeUInt32LE(flags, 12);
   header.writeBigUInt64LE(BigInt(payload.length), 16);
   header.writeBigUInt64LE(BigInt(f.length), 24);
   return Buffer.concat([header, f]);
@@ -286,12 +317,84 @@ const square = (extra = '', level = '') =>
   `"colors": [[255, 0, 0], [255, 0, 0], [0, 0, 255], [0, 0, 255], [127.5, 0, 127.5]], "triangles": [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]${level}}]}`;
 const deep = (n) => `{"format": "subvec", "version": 1, "metadata": {"a": ${'['.repeat(n)}${']'.repeat(n)}}}`;
 const le = (...words) => Buffer.concat(words.map(([type, v]) => {
+  if (type === 'bytes') return Buffer.from(v);
   const b = Buffer.alloc(type === 'f64' ? 8 : type === 'u8' ? 1 : 4);
   if (type === 'f64') b.writeDoubleLE(v);
+  else if (type === 'f32') b.writeFloatLE(v);
   else if (type === 'u8') b.writeUInt8(v);
   else b.writeUInt32LE(v >>> 0);
   return b;
 }));
+// Objects over the 4 x 4 square: good, and each breaking one rule (JSON version 2, binary flag 1).
+// A triangle is the smallest object: one boundary loop of three edges.
+const triangle = { vertices: [[1, 1], [3, 1], [2, 3]], colors: [[0, 200, 0], [0, 200, 0], [0, 100, 0]], triangles: [[0, 1, 2]] };
+function objectFiles() {
+  const json = (objects, version = 2, extra = '') => square(`${extra}, "objects": ${JSON.stringify(objects)}`).replace('"version": 1', `"version": ${version}`);
+  const with_ = (change) => [{ level: 0, name: 'tri', visible: true, mesh: { ...triangle, ...change } }];
+  // Two triangles sharing vertex 0 only: a boundary pinched there (four boundary edges).
+  const bowtie = { vertices: [[2, 2], [3, 1], [3, 3], [1, 3], [1, 1]], colors: Array(5).fill([9, 9, 9]), triangles: [[0, 1, 2], [0, 3, 4]] };
+  // A fan of four triangles whose boundary vertex 0 is turned around once (a slit from 0 to 1 = 5).
+  const slit = { vertices: [[2, 2], [3, 2], [2, 3], [1, 2], [2, 1], [3, 2]], colors: Array(6).fill([9, 9, 9]),
+    triangles: [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]] };
+  const files = {
+    'object-json.svec.json': json(with_({})),
+    'object-json-defaults.svec.json': json([{ mesh: triangle }, { mesh: triangle, level: 0, visible: false, name: 'é' }]),
+    'object-json-version-1.svec.json': json(with_({}), 1),
+    'object-json-version-3.svec.json': json(with_({}), 3),
+    'object-json-no-objects-v2.svec.json': square().replace('"version": 1', '"version": 2'),
+    'object-json-level-4.svec.json': json([{ level: 4, mesh: triangle }]),
+    'object-json-level-negative.svec.json': json([{ level: -1, mesh: triangle }]),
+    'object-json-visible-1.svec.json': json([{ visible: 1, mesh: triangle }]),
+    'object-json-name-number.svec.json': json([{ name: 5, mesh: triangle }]),
+    'object-json-unknown-key.svec.json': json([{ mesh: triangle, hidden: true }]),
+    'object-json-no-mesh.svec.json': json([{ name: 'x' }]),
+    'object-json-not-array.svec.json': json({ mesh: triangle }),
+    'object-json-mesh-unknown-key.svec.json': json(with_({ tears: [] })),
+    'object-json-parents.svec.json': json(with_({ parent_vertices: [0, 1, 2] })),
+    'object-json-far.svec.json': json(with_({ vertices: [[2 ** 24 + 1, 1], [2 ** 24 + 3, 1], [2 ** 24 + 2, 3]] })),
+    'object-json-outside.svec.json': json(with_({ vertices: [[-100, -50], [300, -50], [100, 1000]] })),
+    'object-json-corner.svec.json': json(with_({ vertices: [[0, 0], [4, 0], [0, 4]] })),
+    'object-json-flipped.svec.json': json(with_({ triangles: [[0, 2, 1]] })),
+    'object-json-unused-vertex.svec.json': json(with_({ vertices: [...triangle.vertices, [2, 2]], colors: [...triangle.colors, [1, 1, 1]] })),
+    'object-json-no-triangles.svec.json': json(with_({ vertices: [], colors: [], triangles: [] })),
+    'object-json-pinched.svec.json': json(with_(bowtie)),
+    'object-json-boundary-turn.svec.json': json(with_(slit)),
+    'object-json-double-turn.svec.json': json(with_({ vertices: [[2, 2], [3, 2], [2, 3], [1, 2], [2, 1], [3, 2.0001], [2.0001, 3], [1, 2.0001], [2.0001, 1]],
+      colors: Array(9).fill([9, 9, 9]), triangles: [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 6], [0, 6, 7], [0, 7, 8], [0, 8, 1]] })),
+    'object-json-crease-on-boundary.svec.json': json(with_({ creases: [[0, 1]] })),
+    'object-json-color-owner.svec.json': json(with_({ triangle_colors: [[0, 1, 1]] })),
+    'object-json-unused-color.svec.json': json(with_({ colors: [...triangle.colors, [1, 1, 1]], triangle_colors: [[0, 1, 2]] })),
+    'object-json-too-many.svec.json': json(Array(4097).fill({ mesh: triangle })),
+  };
+  // Binary: the square in version 1, then the objects (flag 1).
+  const mesh = (m) => le(['u32', m.vertices.length], ['u32', m.colors.length], ['u32', m.triangles.length], ['u32', 0], ['u32', 0],
+    ...m.vertices.flat().map((v) => ['f64', v]), ...m.colors.flat().map((v) => ['f32', v]), ...m.triangles.flat().map((v) => ['u32', v]),
+    ...m.triangles.flat().map((v) => ['u32', v]));
+  const sq = { vertices: [[0, 0], [4, 0], [4, 4], [0, 4], [2, 2]], colors: [[255, 0, 0], [255, 0, 0], [0, 0, 255], [0, 0, 255], [127.5, 0, 127.5]],
+    triangles: [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]] };
+  const object = ({ level = 0, visible = 1, name = [0x74], m = triangle } = {}) => le(['u32', level], ['u8', visible], ['u32', name.length], ['bytes', name], ['bytes', mesh(m)]);
+  const payload = (objects, count = objects.length) => Buffer.concat([le(['u32', 4], ['u32', 4], ['u32', 1]), mesh(sq), le(['u32', count]), ...objects, le(['u32', 0], ['u32', 0])]);
+  const good = payload([object(), object({ visible: 0, name: [0xc3, 0xa9] })]);
+  Object.assign(files, {
+    'object-v1.svec': svecFile(good, 1, 1),
+    'object-v1-no-flag.svec': svecFile(good, 1, 0),
+    'object-v1-flags-2.svec': svecFile(good, 1, 2),
+    'object-v1-flags-3.svec': svecFile(good, 1, 3),
+    'object-v1-none.svec': svecFile(payload([]), 1, 1),
+    'object-v1-visibility-2.svec': svecFile(payload([object({ visible: 2 })]), 1, 1),
+    'object-v1-level-4.svec': svecFile(payload([object({ level: 4 })]), 1, 1),
+    'object-v1-name-latin1.svec': svecFile(payload([object({ name: [0x63, 0x61, 0x66, 0xe9] })]), 1, 1),
+    'object-v1-count-4097.svec': svecFile(payload([object()], 4097), 1, 1),
+    'object-v1-count-3.svec': svecFile(payload([object()], 3), 1, 1),
+    'object-v1-truncated.svec': svecFile(good.subarray(0, good.length - 40), 1, 1),
+    'object-v1-huge-name.svec': svecFile(Buffer.concat([good.subarray(0, good.length - 8 - mesh(triangle).length - 6), le(['u32', 2 ** 26 + 1])]), 1, 1),
+    'object-v1-far.svec': svecFile(payload([object({ m: { ...triangle, vertices: [[0, -(2 ** 25)], [2, -(2 ** 25)], [1, 2 - 2 ** 25]] } })]), 1, 1),
+    'object-v1-flipped.svec': svecFile(payload([object({ m: { ...triangle, triangles: [[0, 2, 1]] } })]), 1, 1),
+    'object-v1-bad-index.svec': svecFile(payload([object({ m: { ...triangle, triangles: [[0, 1, 7]] } })]), 1, 1),
+    'object-v1-nan-color.svec': svecFile(payload([object({ m: { ...triangle, colors: [[0, 0, 0], [0, NaN, 0], [0, 0, 0]] } })]), 1, 1),
+  });
+  return files;
+}
 const crafted = {
   'json-float-width.svec.json': square().replace('"width": 4', '"width": 4.0'),
   'json-exponent-index.svec.json': square().replace('[0, 1, 4]', '[0, 1, 4e0]'),
@@ -321,6 +424,7 @@ const crafted = {
   'v1-huge-count.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 1], ['u32', 2 ** 26 - 1], ['u32', 0], ['u32', 0], ['u32', 0], ['u32', 0], ['f64', 0]), 1),
   'v3-huge-count.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 1], ['u32', 2 ** 26], ['u32', 2 ** 26], ['u32', 2 ** 27], ['u32', 0], ['u32', 0], ['u8', 2], ['u8', 255], ['u32', 8], ['u32', 0x01020304], ['u32', 0x05060708]), 3),
   'v1-too-many-levels.svec': svecFile(le(['u32', 4], ['u32', 4], ['u32', 65]), 1),
+  ...objectFiles(),
 };
 const craftedFiles = Object.entries(crafted).map(([name, content]) => (fs.writeFileSync(path.join(tmp, name), content), path.join(tmp, name)));
 const craftedVerdicts = await cppAll(craftedFiles);
@@ -330,6 +434,8 @@ for (const [k, file] of craftedFiles.entries()) {
   check(j.ms < 1000, `${name}: took ${j.ms.toFixed(0)} ms`);
   if (check(c.ok === j.ok, `${name}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`))
     console.log(`  ${name}: ${c.ok ? 'both accept' : `both reject\n    C++:    ${c.message}\n    viewer: ${j.message}`}`);
+  // Objects are new: their messages are the C++ reader's, word for word.
+  if (name.startsWith('object') && !c.ok && !j.ok) check(c.message === j.message, `${name}: the viewer's message differs from the C++ reader's`);
   if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${name}: differs from the C++ decode`);
 }
 // load(): bytes, Blob, File, and failures as SvecError.
@@ -370,7 +476,7 @@ function judge({ bytes, what, file }, c) {
   if (check(c.ok === j.ok, `${what}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`)) stats.agree++;
   if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${what}: differs from the C++ decode`);
 }
-const sources = ['rocket.svec', 'rocket-v1.svec', 'rocket-v2.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
+const sources = ['rocket.svec', 'rocket-v1.svec', 'rocket-v2.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec', 'disk-object-v1.svec', 'two-objects.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
 for (const file of sources) {
   const bytes = fs.readFileSync(file), label = path.basename(file), version = bytes.readUInt32LE(8);
   for (let k = 0; k < (label.startsWith('rocket') ? 20 : 8); k++) {

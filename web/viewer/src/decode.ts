@@ -50,9 +50,9 @@ function unzstd(f: Uint8Array, expected: number, end: number, partial: number, d
 // The binary form: header, payload version 1 (lossless), trailer, pyramid records.
 
 function binary(b: Uint8Array): SvecImage {
-  const [size, end, partial, d, version] = container(b);
-  const [image, records, topologies] = readPayload(unzstd(b.subarray(HEADER), size, end, partial, d), version);
-  validate(image, records, topologies);
+  const [size, end, partial, d, version, flags] = container(b);
+  const [image, records, topologies, objectRecords] = readPayload(unzstd(b.subarray(HEADER), size, end, partial, d), version, flags);
+  validate(image, records, topologies, objectRecords);
   return image;
 }
 
@@ -60,8 +60,8 @@ function binary(b: Uint8Array): SvecImage {
 // The JSON form: read in WebAssembly (wasm/json.c), checked here as the binary form is.
 
 function json(b: Uint8Array): SvecImage {
-  const [image, records] = readJson(b);
-  validate(image, records);
+  const [image, records, , objectRecords] = readJson(b);
+  validate(image, records, [], objectRecords);
   return image;
 }
 

@@ -1,8 +1,12 @@
 // Draws a vector image into a canvas with WebGL2, as `subvec render` draws it on the CPU
 // (src/render/renderer.cpp): the same view plan (visible faces from ring boxes, the depth rule in
 // output pixels), the same refinement (subdivide.ts), Gouraud-shaded limit triangles, then the
-// strokes. Tears and the image border are anti-aliased by the canvas's 4x multisampling (the C++
-// rasterizer supersamples the pixels along tears 4 x 4); strokes by their coverage (strokes.ts).
+// level's visible objects (src/render/objects.cpp: each refined at the level's depth, its boundary
+// a crease, drawn over the level in file order), then the strokes. Tears, the image border and the
+// objects' boundaries are anti-aliased by the canvas's 4x multisampling (the C++ rasterizer
+// supersamples those pixels 4 x 4): an object drawn opaque over the level's samples composites
+// with its coverage, as the C++ renderer's layer with alpha = coverage does; strokes by their
+// coverage (strokes.ts).
 // (Drawing each refined tear edge again as a band that mixes its two sides' colors by area was
 // tried: no closer to the C++ renderer, because colors ramp steeply beside tears, and not faster.)
 //
@@ -37,6 +41,7 @@ export interface RenderStats {
 // quarter of the triangles: the difference is a few tenths of a level (docs/viewer.md). The C++
 // renderer allows 2^24 triangles; a browser gets 2^22.
 export const DEFAULT_MAX_EDGE_PIXELS = 5;
+const CPP_MAX_EDGE_PIXELS = 2.5;
 const MAX_DEPTH = 8;
 const MAX_TRIANGLES = 1 << 22;
 
@@ -140,9 +145,9 @@ function checkWindow(w: ViewWindow): void {
   if (!ok) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
 }
 
-// The refinement of the last view, on the GPU.
+// The refinement of the last view of a mesh (the level's, or an object's), on the GPU.
 interface Cache {
-  level: number;
+  level: number; // the level, or -1 - the object's index
   depth: number;
   faces: Int32Array | null; // ascending; null: all faces
   refined: Refined;
@@ -150,6 +155,24 @@ interface Cache {
   numIndices: number;
   vao: WebGLVertexArrayObject;
   buffers: WebGLBuffer[];
+}
+
+// The faces of a mesh whose ring box meets the window, and the sum of their edges' lengths in
+// output pixels.
+function visibleFaces(topo: Topology, w: ViewWindow, view: ViewTransform): [number[], number] {
+  const { triangles: tri, positions: p } = topo.level;
+  const nf = tri.length / 3, boxes = topo.ringBoxes;
+  const visible: number[] = [];
+  let edges = 0;
+  for (let f = 0; f < nf; ++f) {
+    if (boxes[4 * f + 2] < w.x0 || boxes[4 * f] > w.x1 || boxes[4 * f + 3] < w.y0 || boxes[4 * f + 1] > w.y1) continue;
+    visible.push(f);
+    for (let k = 0; k < 3; ++k) {
+      const a = tri[3 * f + k], b = tri[3 * f + ((k + 1) % 3)];
+      edges += Math.hypot((p[2 * b] - p[2 * a]) * view.sx, (p[2 * b + 1] - p[2 * a + 1]) * view.sy);
+    }
+  }
+  return [visible, edges];
 }
 
 // Whether the ascending list `want` (null: all) is within `have` (null: all).
@@ -184,6 +207,9 @@ export class SubvecRenderer {
   #topologies: Array<Topology | undefined> = [];
   #window: ViewWindow | null = null;
   #cache: Cache | null = null;
+  #objectTopologies: Array<Topology | undefined> = [];
+  #objectCaches: Array<Cache | undefined> = [];
+  #objectDepth = 0;
   #coverage: { texture: WebGLTexture; framebuffer: WebGLFramebuffer; width: number; height: number } | null = null;
 
   constructor(readonly canvas: HTMLCanvasElement | OffscreenCanvas) {
@@ -222,6 +248,7 @@ export class SubvecRenderer {
     this.#dropCache();
     this.#image = image;
     this.#topologies = [];
+    this.#objectTopologies = [];
     this.#level = 0;
     this.setLevel(level);
   }
@@ -254,15 +281,19 @@ export class SubvecRenderer {
 
     const t0 = performance.now();
     const cache = this.#plan(image, w, view);
+    const meshes = [...(cache ? [cache] : []), ...this.#planObjects(image, w, view)];
     const t1 = performance.now();
-    this.stats.refineMs = cache ? t1 - t0 : 0;
-    if (cache) {
+    this.stats.refineMs = meshes.length ? t1 - t0 : 0;
+    this.stats.triangles = meshes.reduce((n, c) => n + c.numIndices / 3, 0);
+    if (meshes.length) {
       if (!this.#meshLinked) this.#meshLinked = !!linked(gl, this.#mesh);
       gl.useProgram(this.#mesh);
       gl.uniform4f(gl.getUniformLocation(this.#mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
       gl.uniform2f(gl.getUniformLocation(this.#mesh, 'size'), width, height);
-      gl.bindVertexArray(cache.vao);
-      gl.drawElements(gl.TRIANGLES, cache.numIndices, gl.UNSIGNED_INT, 0);
+      for (const c of meshes) {
+        gl.bindVertexArray(c.vao);
+        gl.drawElements(gl.TRIANGLES, c.numIndices, gl.UNSIGNED_INT, 0);
+      }
       gl.bindVertexArray(null);
     }
     this.#drawStrokes(image, view);
@@ -293,36 +324,48 @@ export class SubvecRenderer {
   #plan(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache | null {
     let topo = this.#topologies[this.#level];
     if (!topo) topo = this.#topologies[this.#level] = buildTopology(image.levels[this.#level], image.width, image.height);
-    const { triangles: tri, positions: p } = topo.level;
-    const nf = tri.length / 3, boxes = topo.ringBoxes;
-    const visible: number[] = [];
-    let edges = 0;
-    for (let f = 0; f < nf; ++f) {
-      if (boxes[4 * f + 2] < w.x0 || boxes[4 * f] > w.x1 || boxes[4 * f + 3] < w.y0 || boxes[4 * f + 1] > w.y1) continue;
-      visible.push(f);
-      for (let k = 0; k < 3; ++k) {
-        const a = tri[3 * f + k], b = tri[3 * f + ((k + 1) % 3)];
-        edges += Math.hypot((p[2 * b] - p[2 * a]) * view.sx, (p[2 * b + 1] - p[2 * a + 1]) * view.sy);
-      }
+    const [visible, edges] = visibleFaces(topo, w, view);
+    this.stats.depth = this.#objectDepth = 0;
+    if (visible.length === 0) return null;
+    const mean = edges / (3 * visible.length), zoom = Math.min(view.sx, view.sy);
+    const depth = (this.stats.depth = chooseDepth(mean, this.maxEdgePixels, zoom, visible.length));
+    this.#objectDepth = chooseDepth(mean, Math.min(this.maxEdgePixels, CPP_MAX_EDGE_PIXELS), zoom, visible.length);
+    return (this.#cache = this.#refined(this.#cache, this.#level, topo, visible, depth, view));
+  }
+
+  // The level's visible objects (draw_objects of src/render/objects.cpp), bottom to top: each
+  // refined over its faces in view at the depth `subvec render` gives the level (its rule of
+  // 2.5-pixel edges, fewer steps past the triangle budget): an object's boundary is drawn by its
+  // chords, which the viewer's coarser depth for the level would show as facets; the adaptive
+  // triangles keep only what the tolerances need. Their topology has no image corners (width and
+  // height NaN): the boundary is all crease.
+  #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache[] {
+    const out: Cache[] = [];
+    image.objects.forEach((object, i) => {
+      if (object.level !== this.#level || !object.visible) return;
+      const topo = (this.#objectTopologies[i] ??= buildTopology(object.mesh, NaN, NaN));
+      const [visible] = visibleFaces(topo, w, view);
+      let depth = this.#objectDepth;
+      while (depth > 0 && visible.length * 4 ** depth > MAX_TRIANGLES) --depth;
+      if (visible.length) out.push((this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)));
+    });
+    return out;
+  }
+
+  // The refinement of `visible` faces of a mesh at `depth`: `cache` when it holds them (a subset
+  // of its faces at the same depth), else a new one; and its triangles for the view's scale.
+  #refined(cache: Cache | null | undefined, key: number, topo: Topology, visible: number[], depth: number, view: ViewTransform): Cache {
+    const faces = visible.length === topo.level.triangles.length / 3 ? null : Int32Array.from(visible);
+    if (!(cache && cache.level === key && cache.depth === depth && covers(cache.faces, faces))) {
+      this.#drop(cache);
+      cache = this.#upload(key, topo, faces, depth);
     }
-    if (visible.length === 0) {
-      this.stats.depth = this.stats.triangles = 0;
-      return null;
-    }
-    const depth = chooseDepth(edges / (3 * visible.length), this.maxEdgePixels, Math.min(view.sx, view.sy), visible.length);
-    const faces = visible.length === nf ? null : Int32Array.from(visible);
-    const c = this.#cache;
-    if (!(c && c.level === this.#level && c.depth === depth && covers(c.faces, faces))) this.#upload(topo, faces, depth);
-    const cache = this.#cache!;
     const scale = Math.min(view.sx, view.sy);
     if (cache.scale !== scale) this.#uploadIndices(cache, scale);
-    this.stats.depth = depth;
-    this.stats.triangles = cache.numIndices / 3;
     return cache;
   }
 
-  #upload(topo: Topology, faces: Int32Array | null, depth: number): void {
-    this.#dropCache();
+  #upload(key: number, topo: Topology, faces: Int32Array | null, depth: number): Cache {
     const gl = this.#gl;
     const refined = refine(topo, faces, depth);
     const vao = gl.createVertexArray()!;
@@ -336,7 +379,7 @@ export class SubvecRenderer {
     gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
     gl.bindVertexArray(null);
-    this.#cache = { level: this.#level, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
+    return { level: key, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
   }
 
   // The triangles to draw at this scale: each face as deep as it needs (the position tolerance is
@@ -352,11 +395,16 @@ export class SubvecRenderer {
     cache.numIndices = indices.length;
   }
 
+  #drop(cache: Cache | null | undefined): void {
+    if (!cache) return;
+    this.#gl.deleteVertexArray(cache.vao);
+    for (const b of cache.buffers) this.#gl.deleteBuffer(b);
+  }
+
   #dropCache(): void {
-    if (!this.#cache) return;
-    this.#gl.deleteVertexArray(this.#cache.vao);
-    for (const b of this.#cache.buffers) this.#gl.deleteBuffer(b);
+    for (const c of [this.#cache, ...this.#objectCaches]) this.#drop(c);
     this.#cache = null;
+    this.#objectCaches = [];
   }
 
   // Each stroke of the level: its coverage (the maximum over its chords) into a texture, then

@@ -52,6 +52,8 @@ export interface Topology {
   ringBoxes: Float64Array;
 }
 
+/** The topology of a level of a `width` x `height` image; NaN for both: an object's mesh, which has
+ * no image corners (its boundary vertices are creases, as in MeshTopology::build with kNoFrame). */
 export function buildTopology(level: Level, width: number, height: number): Topology {
   const { positions: p, triangles: tri } = level;
   const nv = p.length / 2, nf = tri.length / 3;
@@ -108,7 +110,7 @@ export function buildTopology(level: Level, width: number, height: number): Topo
   const corner = new Uint8Array(nv);
   for (let v = 0; v < nv; ++v) {
     const x = p[2 * v], y = p[2 * v + 1];
-    const imageCorner = (x === 0 || x === width) && (y === 0 || y === height);
+    const imageCorner = width >= 0 && (x === 0 || x === width) && (y === 0 || y === height);
     const c = creases[v], t = tears[v];
     corner[v] = imageCorner || endpoint[v] || !((c === 0 && t === 0) || (c === 2 && t === 0) || (t === 2 && c === 0)) ? 1 : 0;
   }

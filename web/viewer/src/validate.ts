@@ -11,11 +11,12 @@
 // rules); then the pyramid records, strokes and metadata. (Counts are capped where they are read:
 // decode.ts checks each against MAX_ELEMENTS before it sizes an array.)
 import { SvecError, SvecImage, num } from './image';
-import { checkLevel, type Edges } from './wasm';
+import { checkLevel, checkObject, type Edges } from './wasm';
 
 export const MAX_ELEMENTS = 2 ** 26;
 export const MAX_LEVELS = 64;
 export const MAX_DIMENSION = 65536;
+export const MAX_OBJECTS = 4096;
 
 /** A level's pyramid record (docs/format.md, "Levels and the pyramid"): the parent of each vertex
  * in the level before, and the collapses [removed, kept] that made the level, flattened. */
@@ -27,6 +28,9 @@ export interface PyramidRecord {
 export function fail(message: string): never {
   throw new SvecError(message);
 }
+
+// A JS string is valid UTF-8 when it has no lone surrogate (wasm.ts turns invalid bytes into one).
+const invalid = (s: string) => /[\ud800-\udfff]/u.test(s);
 
 const point = (x: number, y: number) => `(${num(x)}, ${num(y)})`;
 
@@ -63,9 +67,11 @@ const quoted = (s: string) => `"${escape(s.slice(0, 60).replace(/["\\]/g, '\\$&'
 
 /** Throws a SvecError naming the first rule of docs/format.md ("Validity rules") that the image
  * breaks. `records` are the pyramid records by level, where the file has them; `topologies` those
- * of levels the decoder has already built. */
-export function validate(image: SvecImage, records: Array<PyramidRecord | undefined> = [], topologies: Edges[] = []): void {
-  const { width, height, levels, strokes, metadata } = image;
+ * of levels the decoder has already built; `objectRecords` what the objects' meshes name of a
+ * pyramid record (nothing is allowed). */
+export function validate(image: SvecImage, records: Array<PyramidRecord | undefined> = [], topologies: Edges[] = [],
+  objectRecords: Array<PyramidRecord | undefined> = []): void {
+  const { width, height, levels, objects, strokes, metadata } = image;
   for (const [name, v] of [['width', width], ['height', height]] as const) {
     if (v < 1) fail(`${name} ${v} is not positive`);
     if (v > MAX_DIMENSION) fail(`${name} ${v} is over the limit of ${MAX_DIMENSION}`);
@@ -74,6 +80,16 @@ export function validate(image: SvecImage, records: Array<PyramidRecord | undefi
   if (!levels.length) fail('the image has no levels');
   levels.forEach((m, l) => checkLevel(m, width, height, l, topologies[l]));
   levels.forEach((_, l) => validateLink(image, records[l], l));
+  // Objects (validate_object of src/mesh/validate.cpp): the mesh's rules are checked in
+  // WebAssembly (wasm/decode.c, check_object).
+  if (objects.length > MAX_OBJECTS) fail(`${objects.length} objects is over the limit of ${MAX_OBJECTS}`);
+  objects.forEach((o, i) => {
+    const bad = (message: string): never => fail(`object ${i}: ${message}`), record = objectRecords[i];
+    if (o.level < 0 || o.level >= levels.length) bad(`level ${o.level} is out of range (${levels.length} levels)`);
+    if (invalid(o.name)) bad('name is not UTF-8');
+    if (record && (record.parents.length || record.collapses.length)) bad('an object has no parent vertices or collapses');
+    checkObject(o.mesh, i);
+  });
   strokes.forEach((s, i) => {
     const bad = (message: string): never => fail(`stroke ${i}: ${message}`), n = s.points.length / 2;
     if (s.level < 0 || s.level >= levels.length) bad(`level ${s.level} is out of range (${levels.length} levels)`);
@@ -87,8 +103,7 @@ export function validate(image: SvecImage, records: Array<PyramidRecord | undefi
     if (!(s.taper >= 0 && s.taper <= 0.5)) bad(`taper ${num(s.taper)} is outside [0, 0.5]`);
   });
   if (metadata.length > MAX_ELEMENTS) fail(`${metadata.length} metadata entries is over the limit of ${MAX_ELEMENTS}`);
-  // A JS string is valid UTF-8 when it has no lone surrogate (decode.ts turns invalid bytes into one).
-  const keys = new Set<string>(), invalid = (s: string) => /[\ud800-\udfff]/u.test(s);
+  const keys = new Set<string>();
   metadata.forEach(([key, value], i) => {
     const where = `metadata entry ${i}`;
     if (invalid(key)) fail(`${where}: key is not valid UTF-8`);

@@ -8,7 +8,7 @@
 // The module is small (compiled synchronously on first use, 2-3 ms) and keeps no state between
 // calls: each call resets its arena, copies the inputs in and the outputs out.
 import { Decompress } from 'fzstd';
-import type { Feature, Level, Stroke, SvecImage } from './image';
+import type { Feature, Level, Stroke, SvecImage, SvecObject } from './image';
 import type { PyramidRecord } from './validate';
 import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
@@ -26,9 +26,10 @@ interface Exports {
   adaptive(...args: number[]): number;
   compact(...args: number[]): number;
   check_level(...args: number[]): number;
+  check_object(...args: number[]): number;
   xxh64(bytes: number, length: number): number;
   json(bytes: number, length: number): number;
-  payload(bytes: number, length: number, version: number): number;
+  payload(bytes: number, length: number, version: number, flags: number): number;
   container(bytes: number, length: number): number;
 }
 
@@ -229,26 +230,33 @@ export interface Edges {
 /** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
  * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
  * by construction. */
-export function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void {
+export const checkLevel = (level: Level, width: number, height: number, l: number, built?: Edges): void =>
+  checkMesh(level, (m, args, put) => {
+    let edges = 0;
+    if (built) {
+      const fields = new Int32Array(16);
+      fields.set([built.a.length, put(built.a), put(built.b), 0, put(built.g), 0, 0, -1]);
+      edges = put(fields);
+    }
+    return m.check_level(...args, width, height, edges, l);
+  });
+
+/** The same for object `index`'s mesh (docs/format.md, "Objects"): it need not tile the image. */
+export const checkObject = (mesh: Level, index: number): void => checkMesh(mesh, (m, args) => m.check_object(...args, index));
+
+function checkMesh(level: Level, run: (m: Exports, args: number[], put: (a: Typed) => number) => number): void {
   const { positions: p, colors: c, triangles: t, features } = level, nf = features.length;
   const offsets = new Int32Array(nf + 1);
   features.forEach((f, i) => (offsets[i + 1] = offsets[i] + f.vertices.length));
   const verts = new Int32Array(offsets[nf]);
   features.forEach((f, i) => verts.set(f.vertices, offsets[i]));
   call(
-      (put, m) => {
-        let edges = 0;
-        if (built) {
-          const fields = new Int32Array(16);
-          fields.set([built.a.length, put(built.a), put(built.b), 0, put(built.g), 0, 0, -1]);
-          edges = put(fields);
-        }
-        return m.check_level(p.length / 2, put(p), c.length / 3, put(c), t.length / 3, put(t), put(level.triangleColors),
-          level.creases.length / 2, put(level.creases), nf, put(Int32Array.from(features, (f) => f.id)),
-          put(Float64Array.from(features, (f) => f.saliency)), put(offsets), put(verts), width, height, edges, l);
-      },
-      () => undefined,
-    );
+    (put, m) =>
+      run(m, [p.length / 2, put(p), c.length / 3, put(c), t.length / 3, put(t), put(level.triangleColors), level.creases.length / 2,
+        put(level.creases), nf, put(Int32Array.from(features, (f) => f.id)), put(Float64Array.from(features, (f) => f.saliency)),
+        put(offsets), put(verts)], put),
+    () => undefined,
+  );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -268,9 +276,10 @@ function string(at: number, n: number, out: number): number {
 
 type Get = <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T;
 
-// wasm/json.c's JsonImage, JsonLevel, JsonStroke, JsonEntry (32-bit fields; an Array is n, then
-// a pointer).
-function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): [SvecImage, PyramidRecord[], Edges[]] {
+// wasm/json.c's JsonImage, JsonLevel, JsonObject, JsonStroke, JsonEntry (32-bit fields; an Array
+// is n, then a pointer). Returns the image, the pyramid records of its levels, the edges of its
+// compact levels and the records of its objects' meshes (which must have none).
+function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): [SvecImage, PyramidRecord[], Edges[], PyramidRecord[]] {
   const f = (p: number, k: number) => i32(p + 4 * k);
   const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
   const text = (p: number, k: number) => {
@@ -280,10 +289,10 @@ function image(at: number, get: Get, i32: (at: number) => number, binary: boolea
       return '\ud800'; // invalid UTF-8, which validate() reports in its place in the order
     }
   };
-  const records: PyramidRecord[] = [], topologies: Edges[] = [];
-  const levels = Array.from({ length: f(at, 2) }, (_, l): Level => {
-    const p = f(at, 3) + 92 * l, nf = f(p, 14), edge = (k: number) => get(Int32Array, f(p, k), f(p, 19));
-    records[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
+  const records: PyramidRecord[] = [], topologies: Edges[] = [], objectRecords: PyramidRecord[] = [];
+  const mesh = (p: number, into: PyramidRecord[], l: number): Level => {
+    const nf = f(p, 14), edge = (k: number) => get(Int32Array, f(p, k), f(p, 19));
+    into[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
     if (f(p, 18)) topologies[l] = { a: edge(20), b: edge(21), g: edge(22) };
     const saliency = get(Float64Array, f(p, 16), nf);
     return {
@@ -294,22 +303,28 @@ function image(at: number, get: Get, i32: (at: number) => number, binary: boolea
         return binary ? { id, saliency: saliency[k], vertices } : { id, vertices, saliency: saliency[k] };
       }),
     };
+  };
+  const levels = Array.from({ length: f(at, 2) }, (_, l) => mesh(f(at, 3) + 92 * l, records, l));
+  const objects = Array.from({ length: f(at, 8) }, (_, k): SvecObject => {
+    const p = f(at, 9) + 108 * k;
+    return { level: f(p, 0), name: text(p, 2), visible: !!f(p, 1), mesh: mesh(p + 16, objectRecords, k) };
   });
   const strokes = Array.from({ length: f(at, 4) }, (_, k): Stroke => {
     const p = f(at, 5) + 32 * k, v = get(Float32Array, p + 4, 5);
     return { level: f(p, 0), points: get(Float64Array, f(p, 7), f(p, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
   });
   const metadata = Array.from({ length: f(at, 6) }, (_, k): [string, string] => [text(f(at, 7) + 16 * k, 0), text(f(at, 7) + 16 * k, 2)]);
-  return [{ width: f(at, 0), height: f(at, 1), levels, strokes, metadata }, records, topologies];
+  return [{ width: f(at, 0), height: f(at, 1), levels, objects, strokes, metadata }, records, topologies, objectRecords];
 }
 
-/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
+/** A .svec.json file's image (before validate()), its pyramid records (and its objects'), or a SvecError. */
 export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), (at, get, i32) => image(at, get, i32, false));
 
-/** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
-export const readPayload = (b: Uint8Array, version: number) =>
-  call((put, m) => m.payload(put(b), b.length, version), (at, get, i32) => image(at, get, i32, true));
+/** A .svec payload's image (before validate()), its pyramid records, the compact levels' edges
+ * and its objects' records, or a SvecError. `flags`: the header's (1: the payload holds objects). */
+export const readPayload = (b: Uint8Array, version: number, flags: number) =>
+  call((put, m) => m.payload(put(b), b.length, version, flags), (at, get, i32) => image(at, get, i32, true));
 
 /** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
- * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version. */
-export const container = (b: Uint8Array) => call((put, m) => m.container(put(b), b.length), (at, get) => get(Float64Array, at, 5));
+ * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version, the flags. */
+export const container = (b: Uint8Array) => call((put, m) => m.container(put(b), b.length), (at, get) => get(Float64Array, at, 6));

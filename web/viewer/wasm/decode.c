@@ -701,23 +701,75 @@ Level *compact(int32_t version, const Section *sections, double ops, int32_t nv,
 
 static const double PI = 3.141592653589793;
 
+// The angle of triangle h / 3 at its corner h (corner_angle of src/mesh/validate.cpp).
+static double corner_angle(const double *p, const int32_t *t, int32_t h) {
+  int32_t u = t[h], v = t[next3(h)], w = t[prev3(h)];
+  double ux = p[2 * v] - p[2 * u], uy = p[2 * v + 1] - p[2 * u + 1], vx = p[2 * w] - p[2 * u], vy = p[2 * w + 1] - p[2 * u + 1];
+  return js_atan2(ux * vy - uy * vx, ux * vx + uy * vy);
+}
+
+// The image's frame (check_mesh, for a level): border edges on the image rectangle and its
+// corners present; tiling (angle sums per vertex, the total area).
+static void check_frame(int32_t nv, const double *p, int32_t nt, const int32_t *t, const double *area, const Edges *E, uint8_t *sides,
+                        uint8_t *border, double *angles, double width, double height) {
+  int32_t nh = 3 * nt;
+  // Sides of the image rectangle each vertex lies on, exactly: 1 left, 2 right, 4 top, 8 bottom;
+  // and the image corners: 1 (0, 0), 2 (W, 0), 4 (W, H), 8 (0, H).
+  int corners = 0;
+  for (int32_t v = 0; v < nv; ++v) {
+    double x = p[2 * v], y = p[2 * v + 1];
+    int s = sides[v] = (uint8_t)((x == 0) | (x == width) << 1 | (y == 0) << 2 | (y == height) << 3);
+    corners |= s == 5 ? 1 : s == 6 ? 2 : s == 10 ? 4 : s == 9 ? 8 : 0;
+  }
+  for (int32_t e = 0; e < E->numEdges; ++e) {
+    if (E->g[e] >= 0) continue;
+    int32_t u = E->a[e], v = E->b[e];
+    if (!(sides[u] & sides[v])) FAIL(V_GAP_EDGE, u, v, u, v);
+    border[u] = border[v] = 1;
+  }
+  for (int k = 0; k < 4; ++k)
+    if (!(corners & (1 << k))) FAIL(V_NO_CORNER, k % 3 ? width : 0, k > 1 ? height : 0);
+
+  // Tiling: angle sums per vertex, then the total area (summed compensated, as C++ sums it in
+  // long double).
+  double total = 0, lost = 0;
+  for (int32_t h = 0; h < nh; ++h) angles[t[h]] += corner_angle(p, t, h);
+  for (int32_t f = 0; f < nt; ++f) {
+    double s = area[f], sum = total + s;
+    lost += __builtin_fabs(total) >= __builtin_fabs(s) ? total - sum + s : s - sum + total;
+    total = sum;
+  }
+  total += lost;
+  for (int32_t v = 0; v < nv; ++v) {
+    int corner = border[v] && sides[v] & 3 && sides[v] & 12, kind = corner ? 0 : border[v] ? 1 : 2;
+    double expected = corner ? PI / 2 : border[v] ? PI : 2 * PI;
+    if (__builtin_fabs(angles[v] - expected) > 1e-6) FAIL(V_ANGLES, angles[v] > expected ? W_OVERLAP : W_GAP, v, v, angles[v] / PI, W_CORNER + kind, expected / PI);
+  }
+  double image = width * height;
+  if (__builtin_fabs(total - image) > 1e-9 * image) FAIL(V_AREA, total, width * height, width, height);
+}
+
 // validateLevel of the old validate.ts (src/mesh/validate.cpp), in its order: finite positions in
 // the image; (*) finite colors and indices in range; unique feature ids, finite saliencies;
 // (*) the topology; positive areas; used vertices; border edges on the image rectangle and its
 // corners present; tiling (angle sums per vertex, the total area); (*) the wedge color rules.
 // `built`: the topology of a level this module decoded (compact), which makes the checks marked *
-// true by construction; 0 for the others (JSON, version 1). Returns 1; problems go to fail().
-EXPORT(check_level)
-int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
-                    int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
-                    const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built,
-                    int32_t level) {
-  message_level = level, message_prefix = 1, message_positions = p;
+// true by construction; 0 for the others (JSON, version 1). `object`: an object's mesh
+// (validate_object), which need not tile the image: positions within 2^24 pixels instead of in
+// the image, and instead of the border and tiling, its boundary made of closed loops (two
+// boundary edges at each boundary vertex) and the triangles around each vertex making one turn
+// (less at a boundary vertex). Returns 1; problems go to fail().
+static int32_t check_mesh(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
+                          int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
+                          const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built,
+                          int32_t object) {
   int32_t nh = 3 * nt;
   for (int32_t v = 0; v < nv; ++v) {
     double x = p[2 * v], y = p[2 * v + 1];
     if (!__builtin_isfinite(x) || !__builtin_isfinite(y)) FAIL(V_POSITION_NOT_FINITE, v, v);
-    if (x < 0 || x > width || y < 0 || y > height) FAIL(V_POSITION_OUTSIDE, v, v, width, height);
+    if (object) {
+      if (__builtin_fabs(x) > 16777216.0 || __builtin_fabs(y) > 16777216.0) FAIL(V_POSITION_FAR, v, v);
+    } else if (x < 0 || x > width || y < 0 || y > height) FAIL(V_POSITION_OUTSIDE, v, v, width, height);
   }
   if (!built) {
     for (int32_t i = 0; i < 3 * nc; ++i)
@@ -769,45 +821,19 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
   }
   for (int32_t v = 0; v < nv; ++v)
     if (!used[v]) FAIL(V_UNUSED_VERTEX, v, v);
-
-  // Sides of the image rectangle each vertex lies on, exactly: 1 left, 2 right, 4 top, 8 bottom;
-  // and the image corners: 1 (0, 0), 2 (W, 0), 4 (W, H), 8 (0, H).
-  int corners = 0;
-  for (int32_t v = 0; v < nv; ++v) {
-    double x = p[2 * v], y = p[2 * v + 1];
-    int s = sides[v] = (uint8_t)((x == 0) | (x == width) << 1 | (y == 0) << 2 | (y == height) << 3);
-    corners |= s == 5 ? 1 : s == 6 ? 2 : s == 10 ? 4 : s == 9 ? 8 : 0;
-  }
-  for (int32_t e = 0; e < E->numEdges; ++e) {
-    if (E->g[e] >= 0) continue;
-    int32_t u = E->a[e], v = E->b[e];
-    if (!(sides[u] & sides[v])) FAIL(V_GAP_EDGE, u, v, u, v);
-    border[u] = border[v] = 1;
-  }
-  for (int k = 0; k < 4; ++k)
-    if (!(corners & (1 << k))) FAIL(V_NO_CORNER, k % 3 ? width : 0, k > 1 ? height : 0);
-
-  // Tiling: angle sums per vertex, then the total area (summed compensated, as C++ sums it in
-  // long double).
-  double *angles = MAKE(double, nv), total = 0, lost = 0;
-  for (int32_t h = 0; h < nh; ++h) {
-    int32_t u = t[h], v = t[next3(h)], w = t[prev3(h)];
-    double ux = p[2 * v] - p[2 * u], uy = p[2 * v + 1] - p[2 * u + 1], vx = p[2 * w] - p[2 * u], vy = p[2 * w + 1] - p[2 * u + 1];
-    angles[u] += js_atan2(ux * vy - uy * vx, ux * vx + uy * vy);
-  }
-  for (int32_t f = 0; f < nt; ++f) {
-    double s = area[f], sum = total + s;
-    lost += __builtin_fabs(total) >= __builtin_fabs(s) ? total - sum + s : s - sum + total;
-    total = sum;
-  }
-  total += lost;
-  for (int32_t v = 0; v < nv; ++v) {
-    int corner = border[v] && sides[v] & 3 && sides[v] & 12, kind = corner ? 0 : border[v] ? 1 : 2;
-    double expected = corner ? PI / 2 : border[v] ? PI : 2 * PI;
-    if (__builtin_fabs(angles[v] - expected) > 1e-6) FAIL(V_ANGLES, angles[v] > expected ? W_OVERLAP : W_GAP, v, v, angles[v] / PI, W_CORNER + kind, expected / PI);
-  }
-  double image = width * height;
-  if (__builtin_fabs(total - image) > 1e-9 * image) FAIL(V_AREA, total, width * height, width, height);
+  double *angles = MAKE(double, nv);
+  if (object) {
+    // The boundary (counted in bytes, as C++ counts it), then the turns around each vertex.
+    if (!nt) FAIL(V_NO_TRIANGLES);
+    for (int32_t e = 0; e < E->numEdges; ++e)
+      if (E->g[e] < 0) border[E->a[e]]++, border[E->b[e]]++;
+    for (int32_t v = 0; v < nv; ++v)
+      if (border[v] != 0 && border[v] != 2) FAIL(V_BOUNDARY_EDGES, v, v, border[v]);
+    for (int32_t h = 0; h < nh; ++h) angles[t[h]] += corner_angle(p, t, h);
+    for (int32_t v = 0; v < nv; ++v)
+      if (border[v] ? !(angles[v] < 2 * PI - 1e-6) : __builtin_fabs(angles[v] - 2 * PI) > 1e-6) FAIL(V_TURNS, v, v, angles[v] / PI);
+  } else
+    check_frame(nv, p, nt, t, area, E, sides, border, angles, width, height);
   if (built) return 1;
 
   // Colors: each value belongs to one vertex and is used; across an edge that is not a tear, both
@@ -832,4 +858,23 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
       }
   }
   return 1;
+}
+
+// A level's rules (check_mesh), its messages prefixed "level L: ".
+EXPORT(check_level)
+int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
+                    int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
+                    const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built,
+                    int32_t level) {
+  message_level = level, message_prefix = 1, message_positions = p;
+  return check_mesh(nv, p, nc, c, nt, t, tc, ncreases, creases, nfeatures, ids, saliency, offsets, verts, width, height, built, 0);
+}
+
+// Object `index`'s mesh (check_mesh), its messages prefixed "object N: ".
+EXPORT(check_object)
+int32_t check_object(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
+                     int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
+                     const int32_t *offsets, const int32_t *verts, int32_t index) {
+  message_level = index, message_prefix = 2, message_positions = p;
+  return check_mesh(nv, p, nc, c, nt, t, tc, ncreases, creases, nfeatures, ids, saliency, offsets, verts, 0, 0, 0, 1);
 }

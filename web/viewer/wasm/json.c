@@ -356,6 +356,7 @@ typedef struct {
 } JsonLevel;
 typedef struct { int32_t level; float width, color[3], taper; Array points; } JsonStroke;
 typedef struct { const uint8_t *key; int32_t keyn; const uint8_t *value; int32_t valuen; } JsonEntry;
+typedef struct { int32_t level, visible; const uint8_t *name; int32_t namen; JsonLevel mesh; } JsonObject;
 typedef struct {
   int32_t width, height, num_levels;
   JsonLevel *levels;
@@ -363,7 +364,10 @@ typedef struct {
   JsonStroke *strokes;
   int32_t num_metadata;
   JsonEntry *metadata;
+  int32_t num_objects;
+  JsonObject *objects;
 } JsonImage;
+#define MAX_OBJECTS 4096
 
 // JSON.stringify of a value (format's), numbers as String().
 static void say_json(const Node *j, int nested) {
@@ -394,6 +398,42 @@ static void say_json(const Node *j, int nested) {
   } else say(j->kind == K_OBJ ? "{}" : j->kind == K_NULL ? "null" : j->kind == K_TRUE ? "true" : "false");
 }
 
+// A level object at p (a level's, or an object's mesh) into *level.
+static void json_level(const Node *j, const Path *p, JsonLevel *level) {
+  const Node *m = known(j, p, "vertices, colors, triangles, triangle_colors, creases, features, parent_vertices, collapses");
+  AT_KEY(ptc, p, "triangle_colors");
+  field(m, p, "vertices", F64, 2, "[x, y]", REQUIRED, &level->positions);
+  field(m, p, "colors", F32, 3, "[r, g, b]", REQUIRED, &level->colors);
+  field(m, p, "triangles", I32, 3, TRIANGLE, REQUIRED, &level->triangles);
+  if (field(m, p, "triangle_colors", I32, 3, TRIANGLE, 0, &level->triangle_colors) != 0) {
+    if (level->triangle_colors.n != level->triangles.n)
+      bad_start(&ptc), say_number(AS_INTEGER, level->triangle_colors.n / 3), say(" entries but there are "), say_number(AS_INTEGER, level->triangles.n / 3),
+        say(" triangles (one entry per triangle)"), say_fail();
+  } else if (level->colors.n / 3 != level->positions.n / 2) {
+    bad_start(p), say("\"triangle_colors\" is absent, so color i belongs to vertex i, but there are "), say_number(AS_INTEGER, level->positions.n / 2),
+      say(" vertices and "), say_number(AS_INTEGER, level->colors.n / 3), say(" colors"), say_fail();
+  } else level->triangle_colors = level->triangles; // a copy (wasm.ts copies each array out)
+  const Node *o;
+  field(m, p, "creases", I32, 2, "[a, b] (two vertex indices)", 0, &level->creases);
+  AT_KEY(pfe, p, "features");
+  if ((o = find(m, "features"))) {
+    const Node *fs = list(o, &pfe);
+    level->num_features = fs->n, level->feature_ids = NEW(int32_t, fs->n + 1), level->saliency = NEW(double, fs->n + 1);
+    level->feature_vertices = NEW(Array, fs->n + 1);
+    need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
+    int32_t k = 0;
+    for (const Node *f = fs->first; f; f = f->next, ++k) {
+      AT_INDEX(r, &pfe, k);
+      const Node *fo = known(f, &r, "id, vertices, saliency");
+      level->feature_ids[k] = (int32_t)field(fo, &r, "id", I32, 0, 0, REQUIRED, 0);
+      field(fo, &r, "vertices", I32, 0, 0, REQUIRED, &level->feature_vertices[k]);
+      level->saliency[k] = field(fo, &r, "saliency", F64, 0, 0, 0, 0);
+    }
+  }
+  field(m, p, "parent_vertices", I32, 0, 0, 0, &level->parents);
+  field(m, p, "collapses", I32, 2, "[removed, kept] (two vertex indices)", 0, &level->collapses);
+}
+
 EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
   b = bytes, len = n, i = depth = 0, table = 0, slots = used = 0;
   const Node *top = value();
@@ -406,8 +446,9 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
     bad_start(&pf), say("expected \"subvec\", got "), say_json(format, 0), say(" (this is not a subvec file)"), say_fail();
   AT_KEY(pv, 0, "version");
   double version = field(top, 0, "version", I32, 0, 0, REQUIRED, 0);
-  if (version != 1) bad_start(&pv), say("unsupported .svec.json version "), say_number(AS_INTEGER, version), say(" (this build reads 1)"), say_fail();
-  known(top, 0, "format, version, width, height, levels, strokes, metadata");
+  if (version != 1 && version != 2)
+    bad_start(&pv), say("unsupported .svec.json version "), say_number(AS_INTEGER, version), say(" (this build reads 1 and 2)"), say_fail();
+  known(top, 0, version == 1 ? "format, version, width, height, levels, strokes, metadata" : "format, version, width, height, levels, objects, strokes, metadata");
   JsonImage *image = (JsonImage *)need_memory(alloc(sizeof(JsonImage)));
   AT_KEY(pl, 0, "levels");
   image->width = (int32_t)field(top, 0, "width", I32, 0, 0, REQUIRED, 0), image->height = (int32_t)field(top, 0, "height", I32, 0, 0, REQUIRED, 0);
@@ -417,41 +458,34 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
   int32_t l = 0;
   for (const Node *j = items->first; j; j = j->next, ++l) {
     AT_INDEX(p, &pl, l);
-    const Node *m = known(j, &p, "vertices, colors, triangles, triangle_colors, creases, features, parent_vertices, collapses");
-    JsonLevel *level = &image->levels[l];
-    AT_KEY(ptc, &p, "triangle_colors");
-    field(m, &p, "vertices", F64, 2, "[x, y]", REQUIRED, &level->positions);
-    field(m, &p, "colors", F32, 3, "[r, g, b]", REQUIRED, &level->colors);
-    field(m, &p, "triangles", I32, 3, TRIANGLE, REQUIRED, &level->triangles);
-    if (field(m, &p, "triangle_colors", I32, 3, TRIANGLE, 0, &level->triangle_colors) != 0) {
-      if (level->triangle_colors.n != level->triangles.n)
-        bad_start(&ptc), say_number(AS_INTEGER, level->triangle_colors.n / 3), say(" entries but there are "), say_number(AS_INTEGER, level->triangles.n / 3),
-          say(" triangles (one entry per triangle)"), say_fail();
-    } else if (level->colors.n / 3 != level->positions.n / 2) {
-      bad_start(&p), say("\"triangle_colors\" is absent, so color i belongs to vertex i, but there are "), say_number(AS_INTEGER, level->positions.n / 2),
-        say(" vertices and "), say_number(AS_INTEGER, level->colors.n / 3), say(" colors"), say_fail();
-    } else level->triangle_colors = level->triangles; // a copy (wasm.ts copies each array out)
-    const Node *o;
-    field(m, &p, "creases", I32, 2, "[a, b] (two vertex indices)", 0, &level->creases);
-    AT_KEY(pfe, &p, "features");
-    if ((o = find(m, "features"))) {
-      const Node *fs = list(o, &pfe);
-      level->num_features = fs->n, level->feature_ids = NEW(int32_t, fs->n + 1), level->saliency = NEW(double, fs->n + 1);
-      level->feature_vertices = NEW(Array, fs->n + 1);
-      need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
-      int32_t k = 0;
-      for (const Node *f = fs->first; f; f = f->next, ++k) {
-        AT_INDEX(r, &pfe, k);
-        const Node *fo = known(f, &r, "id, vertices, saliency");
-        level->feature_ids[k] = (int32_t)field(fo, &r, "id", I32, 0, 0, REQUIRED, 0);
-        field(fo, &r, "vertices", I32, 0, 0, REQUIRED, &level->feature_vertices[k]);
-        level->saliency[k] = field(fo, &r, "saliency", F64, 0, 0, 0, 0);
-      }
-    }
-    field(m, &p, "parent_vertices", I32, 0, 0, 0, &level->parents);
-    field(m, &p, "collapses", I32, 2, "[removed, kept] (two vertex indices)", 0, &level->collapses);
+    json_level(j, &p, &image->levels[l]);
   }
   const Node *o;
+  AT_KEY(po, 0, "objects");
+  if ((o = find(top, "objects"))) {
+    const Node *os = list(o, &po);
+    if (os->n > MAX_OBJECTS) bad_start(&po), say_number(AS_INTEGER, os->n), say(" objects is over the limit of 4096"), say_fail();
+    image->num_objects = os->n, image->objects = (JsonObject *)need_memory(NEW(JsonObject, os->n + 1));
+    int32_t k = 0;
+    for (const Node *j = os->first; j; j = j->next, ++k) {
+      AT_INDEX(p, &po, k);
+      const Node *m = known(j, &p, "level, name, visible, mesh"), *x;
+      JsonObject *object = &image->objects[k];
+      object->level = (int32_t)field(m, &p, "level", I32, 0, 0, 0, 0), object->visible = 1;
+      AT_KEY(pn, &p, "name");
+      if ((x = find(m, "name"))) {
+        if (x->kind != K_STR) expected(&pn, "a string", x);
+        object->name = x->s, object->namen = x->n;
+      }
+      AT_KEY(pvi, &p, "visible");
+      if ((x = find(m, "visible"))) {
+        if (x->kind != K_TRUE && x->kind != K_FALSE) expected(&pvi, "true or false", x);
+        object->visible = x->kind == K_TRUE;
+      }
+      AT_KEY(pme, &p, "mesh");
+      json_level(need(m, &p, "mesh"), &pme, &object->mesh);
+    }
+  }
   AT_KEY(ps, 0, "strokes");
   if ((o = find(top, "strokes"))) {
     const Node *ss = list(o, &ps);
@@ -581,13 +615,36 @@ static Array string_of(const char *fmt, int32_t a) {
 
 static const char *const SECTIONS[] = {"connectivity", "split offsets", "positions", "features", "feature steps", "colors"};
 static const char *const COUNTS[] = {"vertices", "colors", "triangles", "creases", "features"};
-// what = "level l " + w
-static void level_name(const char *w, int32_t l) {
-  char fmt[32] = "level # ";
-  int32_t q = 8;
+// what = "level l " + w, or "object l " + w (mesh_prefix)
+static const char *mesh_prefix = "level # ";
+static void level_name(const char *w, int32_t l, int32_t k) {
+  char fmt[48];
+  int32_t q = 0;
+  for (const char *m = mesh_prefix; *m;) fmt[q++] = *m++;
   while (*w) fmt[q++] = *w++;
   fmt[q] = 0;
-  name(fmt, l, 0);
+  name(fmt, l, k);
+}
+
+static const double MIN[] = {16, 12, 24, 8, 16};
+// A mesh in the version-1 layout (a level's, or an object's), named by mesh_prefix and l.
+static void mesh_v1(JsonLevel *level, int32_t l) {
+  int32_t c[5];
+  for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l, 0), c[k] = count(MIN[k], MAX_ELEMENTS);
+  level_name("vertices", l, 0), level->positions = array(2.0 * c[0], 8);
+  level_name("colors", l, 0), level->colors = array(3.0 * c[1], 4);
+  level_name("triangles", l, 0), level->triangles = array(3.0 * c[2], 4);
+  level_name("triangle colors", l, 0), level->triangle_colors = array(3.0 * c[2], 4);
+  level_name("creases", l, 0), level->creases = array(2.0 * c[3], 4);
+  level->num_features = c[4], level->feature_ids = NEW(int32_t, c[4] + 1), level->saliency = NEW(double, c[4] + 1);
+  level->feature_vertices = NEW(Array, c[4] + 1);
+  need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
+  for (int32_t k = 0; k < c[4]; ++k) {
+    level_name("feature #", l, k);
+    level->feature_ids[k] = (int32_t)u32(), level->saliency[k] = f64();
+    level_name("feature # vertices", l, k);
+    level->feature_vertices[k] = array(count(4, MAX_ELEMENTS), 4);
+  }
 }
 
 // base + delta (a zigzag code) as a vertex index; both are checked before they are added.
@@ -598,8 +655,8 @@ static int32_t vertex_index(int32_t record, double base, double code) {
   return (int32_t)(base + delta);
 }
 
-EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t version) {
-  b = bytes, len = n, pos = what_count = 0;
+EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t version, int32_t flags) {
+  b = bytes, len = n, pos = what_count = 0, mesh_prefix = "level # ";
   JsonImage *image = (JsonImage *)need_memory(alloc(sizeof(JsonImage)));
   name("image size", 0, 0);
   int32_t width = image->width = (int32_t)u32(), height = image->height = (int32_t)u32();
@@ -612,7 +669,7 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
     JsonLevel *level = &image->levels[l];
     int32_t c[5];
     if (version > 1) {
-      for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l), c[k] = count(0, MAX_ELEMENTS);
+      for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l, 0), c[k] = count(0, MAX_ELEMENTS);
       name("level # precision", l, 0);
       int32_t pb = b[take(1)], cb = (int8_t)b[take(1)];
       if (pb > 12 || cb < -4 || cb > 12)
@@ -622,7 +679,7 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
       double ops = 3.0 * left();
       Section sections[6];
       for (int k = 0; k < (version == 2 ? 6 : 1); ++k) {
-        level_name(version == 2 ? SECTIONS[k] : "stream", l);
+        level_name(version == 2 ? SECTIONS[k] : "stream", l, 0);
         int32_t m = count(1, MAX_ELEMENTS * 64);
         sections[k] = (Section){b + take(m), m};
         int32_t expected = (2 * c[0] - 3 + 2) / 3;
@@ -644,22 +701,26 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
       level->compact = 1, level->num_edges = L[10], level->a = FIELD(11), level->b = FIELD(12), level->g = FIELD(14);
       continue;
     }
-    static const double MIN[] = {16, 12, 24, 8, 16};
-    for (int k = 0; k < 5; ++k) level_name(COUNTS[k], l), c[k] = count(MIN[k], MAX_ELEMENTS);
-    name("level # vertices", l, 0), level->positions = array(2.0 * c[0], 8);
-    name("level # colors", l, 0), level->colors = array(3.0 * c[1], 4);
-    name("level # triangles", l, 0), level->triangles = array(3.0 * c[2], 4);
-    name("level # triangle colors", l, 0), level->triangle_colors = array(3.0 * c[2], 4);
-    name("level # creases", l, 0), level->creases = array(2.0 * c[3], 4);
-    level->num_features = c[4], level->feature_ids = NEW(int32_t, c[4] + 1), level->saliency = NEW(double, c[4] + 1);
-    level->feature_vertices = NEW(Array, c[4] + 1);
-    need_memory(level->feature_ids), need_memory(level->saliency), need_memory(level->feature_vertices);
-    for (int32_t k = 0; k < c[4]; ++k) {
-      name("level # feature #", l, k);
-      level->feature_ids[k] = (int32_t)u32(), level->saliency[k] = f64();
-      name("level # feature # vertices", l, k);
-      level->feature_vertices[k] = array(count(4, MAX_ELEMENTS), 4);
+    mesh_v1(level, l);
+  }
+  // The objects (header flag 1): each one's level, visibility, name and a version-1 mesh.
+  if (flags & 1) {
+    name("objects", 0, 0);
+    int32_t no = image->num_objects = count(25, MAX_OBJECTS);
+    image->objects = (JsonObject *)need_memory(NEW(JsonObject, no + 1));
+    mesh_prefix = "object # ";
+    for (int32_t k = 0; k < no; ++k) {
+      JsonObject *object = &image->objects[k];
+      name("object # header", k, 0);
+      object->level = (int32_t)u32();
+      int32_t visible = object->visible = b[take(1)];
+      if (visible > 1)
+        say_start(), say("object "), say_number(AS_INTEGER, k), say(" visibility "), say_number(AS_INTEGER, visible), say(" is neither 0 nor 1"), say_fail();
+      Array s = string_of("object # name", k);
+      object->name = s.data, object->namen = s.n;
+      mesh_v1(&object->mesh, k);
     }
+    mesh_prefix = "level # ";
   }
   name("strokes", 0, 0);
   int32_t ns = image->num_strokes = count(28, MAX_ELEMENTS);
@@ -714,7 +775,7 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
 // The binary form's header and its zstd frame's header and blocks: the checks libzstd makes that
 // fzstd does not (window limit, dictionary, block sizes), and where the frame ends. Returns the
 // payload's size, the frame's end (after its checksum; infinite when the blocks run out), what a
-// raw block cut short gives, the frame descriptor and the version.
+// raw block cut short gives, the frame descriptor, the version and the flags.
 
 static void say_u64(uint64_t v) {
   char digits[20];
@@ -746,7 +807,7 @@ EXPORT(container) double *container(const uint8_t *file, int32_t n) {
   uint64_t size, frame, available = (uint64_t)(n - 32);
   __builtin_memcpy(&version, file + 8, 4), __builtin_memcpy(&flags, file + 12, 4), __builtin_memcpy(&size, file + 16, 8), __builtin_memcpy(&frame, file + 24, 8);
   if (version < 1 || version > 3) say_start(), say("unsupported .svec version "), say_number(AS_INTEGER, version), say(" (this build reads 1, 2 and 3)"), say_fail();
-  if (flags) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows none)"), say_fail();
+  if (flags & ~1u) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows 1: objects)"), say_fail();
   if (size > 1073741824) say_start(), say("declared payload of "), say_u64(size), say(" bytes is over the limit of 1073741824"), say_fail();
   if (frame > available)
     say_start(), say("truncated .svec file: the header declares a "), say_u64(frame), say("-byte zstd frame but only "), say_u64(available), say(" bytes follow"), say_fail();
@@ -775,7 +836,7 @@ EXPORT(container) double *container(const uint8_t *file, int32_t n) {
     end += 3 + (type == 1 ? 1 : bytes);
   }
   if (d & 4) end += 4;
-  double *out = (double *)need_memory(alloc(5 * sizeof(double)));
-  out[0] = expected, out[1] = end, out[2] = partial, out[3] = d, out[4] = version;
+  double *out = (double *)need_memory(alloc(6 * sizeof(double)));
+  out[0] = expected, out[1] = end, out[2] = partial, out[3] = d, out[4] = version, out[5] = flags;
   return out;
 }

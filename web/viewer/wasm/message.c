@@ -37,7 +37,7 @@ void say_fail(void) { js_fail(text, said); }
 // "%g", \5 a word, \6 chain (is feature, i): "feature i" or "crease i", \7 the same with the id
 // ("feature i (id d)"), \10 a vertex's position "(x, y)", \16 what a version 2 section read
 // (section, feature: the section's name, or "feature i" when i >= 0). \1 is the level's name
-// ("level L "), \2 the checks' prefix ("level L: ").
+// ("level L "), \2 the checks' prefix ("level L: ", or "object L: ").
 static const char *const TEMPLATES[] = {
   "out of memory: the image needs more than WebAssembly can hold",
   "\1stream: corrupt coded data (bad first bytes)",
@@ -95,12 +95,16 @@ static const char *const TEMPLATES[] = {
   "\2color \3 is used at vertex \3 (triangle \3) and at vertex \3 (triangle \3); a color value belongs to one vertex",
   "\2color \3 is used by no triangle corner",
   "\2edge (\3, \3) is not a tear but triangles \3 and \3 use different colors at vertex \3 (\3 and \3)",
+  "\2vertex \3 position \10 is more than 2^24 pixels away",
+  "\2has no triangles",
+  "\2vertex \3 \10 is on \3 boundary edges (an object's boundary is made of closed loops, two edges at each vertex)",
+  "\2triangles overlap around vertex \3 \10: their angles there sum to \4*pi",
 };
 static const char *const WORDS[] = {"connectivity", "split offsets", "positions", "features", "feature steps", "colors", "header",
                                     "overlap", "leave a gap", "an image corner", "a border vertex", "an interior vertex"};
 
 static void say_level(const char *end) {
-  say("level ");
+  say(message_prefix == 2 ? "object " : "level ");
   say_number(AS_INTEGER, message_level);
   say(end);
 }

@@ -8,8 +8,8 @@
 
 enum { AS_INTEGER = 0xfd, AS_G, AS_DUMP };
 
-// The level the messages name ("level L ", and "level L: " while `message_prefix`), and its
-// positions (for the messages that show a vertex's position).
+// The level the messages name ("level L ", and "level L: " while `message_prefix` is 1, "object
+// L: " while it is 2), and its positions (for the messages that show a vertex's position).
 extern int32_t message_level, message_prefix;
 extern const double *message_positions;
 
@@ -43,6 +43,8 @@ enum {
   // a level's validity rules (check_level)
   V_POSITION_NOT_FINITE, V_POSITION_OUTSIDE, V_COLOR_NOT_FINITE, V_TRIANGLE_COLOR, V_REPEATED_ID, V_SALIENCY,
   V_FLIPPED, V_UNUSED_VERTEX, V_GAP_EDGE, V_NO_CORNER, V_ANGLES, V_AREA, V_COLOR_OWNER, V_UNUSED_COLOR, V_COLOR_EDGE,
+  // an object's mesh (check_object)
+  V_POSITION_FAR, V_NO_TRIANGLES, V_BOUNDARY_EDGES, V_TURNS,
 };
 // Words of the templates' \5 (section names first, in decode.c's order).
 enum { W_OVERLAP = 7, W_GAP, W_CORNER };

@@ -43,7 +43,8 @@ static void tag(const int32_t *tri, const Topology *t, int32_t a, int32_t b, uin
 static double min3(double a, double b, double c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
 static double max3(double a, double b, double c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
 
-// buildTopology of subdivide.ts. Features are given as offsets (numFeatures + 1) into their vertices.
+// buildTopology of subdivide.ts. Features are given as offsets (numFeatures + 1) into their vertices;
+// width and height NaN (an object's mesh): no vertex is an image corner.
 EXPORT(topology)
 Topology *topology(int32_t nv, const double *p, int32_t nf, const int32_t *tri, int32_t numCreases, const int32_t *creaseEnds,
                    int32_t numFeatures, const int32_t *featureOffsets, const int32_t *featureVerts, double width, double height) {
@@ -98,7 +99,7 @@ Topology *topology(int32_t nv, const double *p, int32_t nf, const int32_t *tri, 
   }
   for (int32_t v = 0; v < nv; ++v) {
     double x = p[2 * v], y = p[2 * v + 1];
-    int imageCorner = (x == 0 || x == width) && (y == 0 || y == height);
+    int imageCorner = width >= 0 && (x == 0 || x == width) && (y == 0 || y == height);
     int c = creases[v], s = tears[v];
     corner[v] = imageCorner || endpoint[v] || !((c == 0 && s == 0) || (c == 2 && s == 0) || (s == 2 && c == 0));
   }

@@ -27,10 +27,21 @@ export interface Stroke {
     color: [number, number, number];
     taper: number;
 }
+/** An object (a layer, docs/format.md "Objects"): a control mesh of its own drawn over its level,
+ * in file order from the bottom, when visible. Its mesh need not tile the image: its boundary
+ * edges are creases, and what it covers is composited over the level. */
+export interface SvecObject {
+    level: number;
+    name: string;
+    visible: boolean;
+    mesh: Level;
+}
 export interface SvecImage {
     width: number;
     height: number;
     levels: Level[];
+    /** Drawn over their levels, bottom to top (empty for files without objects). */
+    objects: SvecObject[];
     strokes: Stroke[];
     metadata: Array<[string, string]>;
 }

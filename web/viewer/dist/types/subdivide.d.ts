@@ -17,6 +17,8 @@ export interface Topology {
     /** per face the bounding box (x0, y0, x1, y1) of the control points its limit patch depends on */
     ringBoxes: Float64Array;
 }
+/** The topology of a level of a `width` x `height` image; NaN for both: an object's mesh, which has
+ * no image corners (its boundary vertices are creases, as in MeshTopology::build with kNoFrame). */
 export declare function buildTopology(level: Level, width: number, height: number): Topology;
 /** The limit surface over the selected faces: one vertex per color value. */
 export interface Refined {

@@ -20,11 +20,14 @@ export interface Edges {
 /** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
  * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
  * by construction. */
-export declare function checkLevel(level: Level, width: number, height: number, l: number, built?: Edges): void;
-/** A .svec.json file's image (before validate()) and its pyramid records, or a SvecError. */
-export declare const readJson: (b: Uint8Array) => [SvecImage, PyramidRecord[], Edges[]];
-/** A .svec payload's image (before validate()), its pyramid records and the compact levels' edges, or a SvecError. */
-export declare const readPayload: (b: Uint8Array, version: number) => [SvecImage, PyramidRecord[], Edges[]];
+export declare const checkLevel: (level: Level, width: number, height: number, l: number, built?: Edges) => void;
+/** The same for object `index`'s mesh (docs/format.md, "Objects"): it need not tile the image. */
+export declare const checkObject: (mesh: Level, index: number) => void;
+/** A .svec.json file's image (before validate()), its pyramid records (and its objects'), or a SvecError. */
+export declare const readJson: (b: Uint8Array) => [SvecImage, PyramidRecord[], Edges[], PyramidRecord[]];
+/** A .svec payload's image (before validate()), its pyramid records, the compact levels' edges
+ * and its objects' records, or a SvecError. `flags`: the header's (1: the payload holds objects). */
+export declare const readPayload: (b: Uint8Array, version: number, flags: number) => [SvecImage, PyramidRecord[], Edges[], PyramidRecord[]];
 /** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
- * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version. */
+ * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version, the flags. */
 export declare const container: (b: Uint8Array) => Float64Array<ArrayBuffer>;
