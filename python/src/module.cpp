@@ -576,15 +576,23 @@ void def_edits(PyVectorImage& vi) {
           "points"_a, py::kw_only(), "kind"_a = "tear", "level"_a = 0)
       .def(
           "make_object",
-          [](VectorImage& v, std::array<double, 2> at, const std::string& name, int level) {
+          [](VectorImage& v, std::optional<std::array<double, 2>> at, std::optional<std::array<int, 4>> rect,
+             const std::string& name, int level) {
             subvec::EditOp op;
             op.kind = subvec::EditOp::Kind::kMakeObject;
-            op.at = point(at, "at");
+            if (at.has_value() == rect.has_value()) invalid("give at or rect (one of them)");
+            if (at) op.at = point(*at, "at");
+            if (rect) {
+              for (const int x : *rect) {
+                if (x < 0) invalid("rect must be [x, y, width, height] with values >= 0");
+              }
+              op.rect = *rect;
+            }
             op.object_name = name;
             op.level = level;
             return apply_op(v, op);
           },
-          "at"_a, py::kw_only(), "name"_a = "", "level"_a = 0)
+          "at"_a = py::none(), py::kw_only(), "rect"_a = py::none(), "name"_a = "", "level"_a = 0)
       .def(
           "move_object",
           [](VectorImage& v, int object, std::array<double, 2> translate, double rotate, double scale,

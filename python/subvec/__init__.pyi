@@ -128,9 +128,10 @@ class VectorImage:
     def add_feature(self, points: npt.ArrayLike, *, kind: Literal["tear", "crease"] = "tear",
                     level: int = 0) -> str:
         """A new tear (or crease) along the drawn polyline's C^2 fit; returns the log line."""
-    def make_object(self, at: _Point, *, name: str = "", level: int = 0) -> str:
-        """Makes an object of the innermost closed tear around `at` (its own mesh over a
-        completed background); returns the log line."""
+    def make_object(self, at: _Point | None = None, *, rect: tuple[int, int, int, int] | None = None,
+                    name: str = "", level: int = 0) -> str:
+        """Makes an object of the innermost closed tear around `at`, or of what `rect` (x, y, width,
+        height) frames (its own mesh over a completed background); returns the log line."""
     def move_object(self, object: int, *, translate: _Point = (0, 0), rotate: float = 0,
                     scale: float = 1, pivot: _Point | None = None) -> str:
         """Scales, rotates (degrees, clockwise on screen) and moves an object rigidly about

@@ -332,6 +332,14 @@ def test_objects():
         image.move_object(0, scale=0)
     with pytest.raises(ValueError, match="no closed feature of level 0 encloses"):
         image.make_object((3, 3))
+    with pytest.raises(ValueError, match="give at or rect"):
+        image.make_object()
+    # A rectangle framing the disk makes the same object as a click inside it.
+    framed = subvec.load(EXAMPLES / "01-disk.svec.json")
+    assert "frames" in framed.make_object(rect=(14, 14, 68, 68))
+    clicked = subvec.load(EXAMPLES / "01-disk.svec.json")
+    clicked.make_object((48, 48))
+    assert framed.objects == clicked.objects
 
 
 def test_color_selection_blend_and_transform():
