@@ -2,6 +2,7 @@
 #include "editor.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -32,6 +33,7 @@ struct Editor::View {
   bool preview = false;    // it holds a drag preview's positions, not the document's
   double scale = 1;        // canvas pixels per image pixel (ViewRequest::scale)
   uint64_t topology = 0;   // topology_key() of the level it refines
+  uint64_t objects = 0;    // objects_key() of the level's objects it draws
 };
 
 struct Editor::Session {
@@ -110,6 +112,23 @@ bool encode_moves(const std::vector<uint32_t>& indices, const std::vector<float>
 // A hash of what a view's refinement depends on besides positions and colors: the triangles,
 // their color corners, the creases and the feature chains. An edit that changes it (a feature
 // added or deleted, or the undo of one) makes the page fetch a new view.
+// A hash of the objects drawn over `level` (what an ObjectRange shows): their order, visibility,
+// positions, colors and triangles. An edit that changes it makes the page fetch a new view.
+uint64_t objects_key(const VectorImage& image, int level) {
+  uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](uint64_t v) { h = (h ^ v) * 1099511628211ull; };
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    const subvec::Object& object = image.objects[o];
+    if (object.level != level) continue;
+    mix(o), mix(object.visible);
+    for (const Vec2& p : object.mesh.positions) mix(std::bit_cast<uint64_t>(p.x)), mix(std::bit_cast<uint64_t>(p.y));
+    for (const Color& c : object.mesh.colors)
+      mix(std::bit_cast<uint32_t>(c.r)), mix(std::bit_cast<uint32_t>(c.g)), mix(std::bit_cast<uint32_t>(c.b));
+    for (const subvec::Tri& t : object.mesh.triangles) mix(uint64_t(t[0])), mix(uint64_t(t[1])), mix(uint64_t(t[2]));
+  }
+  return h;
+}
+
 uint64_t topology_key(const ControlMesh& mesh) {
   uint64_t h = 1469598103934665603ull;
   const auto mix = [&h](int64_t v) { h = (h ^ static_cast<uint64_t>(v)) * 1099511628211ull; };
@@ -326,6 +345,25 @@ ViewMesh Editor::view(const std::string& session_id, const ViewRequest& request)
     }
     v->limit = subvec::view_mesh(image_, options);
     v->topology = topology_key(image_.levels[request.level]);
+    v->objects = objects_key(image_, request.level);
+    // The objects over the level, unwelded per corner.
+    for (const subvec::ObjectView& o : subvec::object_views(image_, options)) {
+      const subvec::RefinedMesh& r = o.refined;
+      ViewMesh::ObjectRange range;
+      range.object = o.object;
+      range.first = static_cast<uint32_t>(v->mesh.object_positions.size() / 2);
+      for (size_t t = 0; t < r.triangles.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+          const size_t rv = static_cast<size_t>(r.triangles[t][k]), rc = static_cast<size_t>(r.triangle_colors[t][k]);
+          v->mesh.object_positions.push_back(r.positions[2 * rv]);
+          v->mesh.object_positions.push_back(r.positions[2 * rv + 1]);
+          for (int c = 0; c < 3; ++c) v->mesh.object_colors.push_back(to_byte(r.colors[3 * rc + c]));
+          v->mesh.object_colors.push_back(255);
+        }
+      }
+      range.count = static_cast<uint32_t>(v->mesh.object_positions.size() / 2) - range.first;
+      v->mesh.objects.push_back(range);
+    }
   } catch (const Error& e) {
     const ErrorCode code = e.code();
     throw RequestError(code == ErrorCode::kInvalidArgument ? kBadRequest
@@ -414,8 +452,9 @@ Delta Editor::delta_locked(Session& session, const std::vector<Vec2>* preview,
   if (!session.view) return delta;
   View& v = *session.view;
   const ControlMesh& mesh = image_.levels[v.mesh.level];
-  if (v.topology != topology_key(mesh)) {
-    // The view refines another mesh: the page fetches a new view and the control mesh.
+  if (v.topology != topology_key(mesh) || v.objects != objects_key(image_, v.mesh.level)) {
+    // The view refines another mesh, or its objects changed: the page fetches a new view and the
+    // control mesh.
     delta.view_id = v.mesh.id;
     delta.reload = true;
     session.view.reset();
@@ -802,9 +841,13 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(op.level);
-  if (op.kind != EditOp::Kind::kColor && op.kind != EditOp::Kind::kMoveVertices &&
-      op.kind != EditOp::Kind::kAddFeature && op.kind != EditOp::Kind::kDeleteFeature) {
-    throw RequestError(kBadRequest, "not a color edit, a move of control points or a feature edit");
+  using K = EditOp::Kind;
+  const bool object_edit = op.kind == K::kMakeObject || op.kind == K::kMoveObject ||
+                           op.kind == K::kHideObject || op.kind == K::kShowObject ||
+                           op.kind == K::kOrderObject;
+  if (op.kind != K::kColor && op.kind != K::kMoveVertices && op.kind != K::kAddFeature &&
+      op.kind != K::kDeleteFeature && !object_edit) {
+    throw RequestError(kBadRequest, "not a color edit, a move of control points, a feature edit or an object edit");
   }
   VectorImage edited = image_;
   std::vector<std::string> lines;
@@ -813,7 +856,7 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   } catch (const Error& e) {
     refuse_edit(Error(e.code(), without_op_prefix(e.what())));
   }
-  if (op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature) {
+  if (op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature || object_edit) {
     log = lines.empty() ? edit_label(op) : without_op_prefix(lines.front());
     session.drag.reset();
     commit_locked(std::move(edited), edit_label(op), session);

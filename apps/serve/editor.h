@@ -87,6 +87,17 @@ struct ViewMesh {
   std::vector<uint32_t> triangles;  // #T x 3 GL vertex indices
   std::vector<uint32_t> coarse_triangles;  // the view one level coarser, same GL vertices (RefinedMesh)
   std::vector<uint32_t> tear_lines; // pairs of GL vertex indices along the feature curves
+  // The visible objects of the level (subvec::object_views), drawn over it bottom to top: one GL
+  // vertex per triangle corner, three per triangle, object after object. Not changed by deltas:
+  // an edit of an object reloads the view.
+  struct ObjectRange {
+    int object = 0;          // index in VectorImage::objects
+    uint32_t first = 0;      // first GL vertex (of object_positions / 2)
+    uint32_t count = 0;      // GL vertices (3 per triangle)
+  };
+  std::vector<ObjectRange> objects;
+  std::vector<float> object_positions;  // x, y per GL vertex
+  std::vector<uint8_t> object_colors;   // RGBA8 per GL vertex
   int num_gl_vertices() const { return static_cast<int>(positions.size() / 2); }
 };
 

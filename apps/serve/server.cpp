@@ -20,6 +20,7 @@
 
 #include "assets.h"
 #include "editor.h"
+#include "subvec/mesh/validate.h"
 #include "subvec/core/error.h"
 #include "subvec/export/export.h"
 #include "subvec/io/image_io.h"
@@ -623,7 +624,14 @@ void EditorServer::Impl::document_routes() {
     f.add("triangles", m.triangles);
     f.add("coarse_triangles", m.coarse_triangles);
     f.add("tear_lines", m.tear_lines);
+    f.add("object_positions", m.object_positions);
+    f.add("object_colors", m.object_colors);
+    json objects = json::array();
+    for (const ViewMesh::ObjectRange& o : m.objects) {
+      objects.push_back({{"object", o.object}, {"first", o.first}, {"count", o.count}});
+    }
     const std::string body = f.finish({{"view", m.id},
+                                       {"objects", objects},
                                        {"level", m.level},
                                        {"depth", m.depth},
                                        {"partial", m.partial},
@@ -773,6 +781,70 @@ void EditorServer::Impl::edit_routes() {
     const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
     res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
                     "application/octet-stream");
+  });
+
+  // Objects (edit/objects.h, issue 26): made from a rectangle (or a click inside a closed feature),
+  // moved, hidden or shown, reordered. Each is one edit; the page's view reloads.
+  const auto object_edit = [this](httplib::Response& res, subvec::EditOp op, const json& j) {
+    op.level = small_int(j, "level", 0);
+    std::shared_ptr<Editor> doc = ready_editor();
+    std::string log;
+    const Delta d = doc->apply(text(j, "session"), integer(j, "version"), op, log);
+    res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}), "application/octet-stream");
+  };
+  const auto object_index = [](const json& j, const char* key) {
+    const int64_t o = integer(j, key, -1);
+    if (o < 0 || o >= subvec::Limits::kMaxObjects) {
+      throw RequestError(kBadRequest, std::string("\"") + key + "\" must be an object index, 0 to " +
+                                          std::to_string(subvec::Limits::kMaxObjects - 1));
+    }
+    return static_cast<int>(o);
+  };
+  server.Post("/api/object/make", [this, object_edit](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kMakeObject;
+    if (j.contains("rect")) {
+      const json& r = j["rect"];
+      if (!r.is_array() || r.size() != 4 || !std::all_of(r.begin(), r.end(), [](const json& x) {
+            return x.is_number_integer() && x.get<int64_t>() >= 0 && x.get<int64_t>() <= subvec::Limits::kMaxDimension;
+          })) {
+        throw RequestError(kBadRequest, "\"rect\" must be [x, y, width, height] (whole pixels >= 0)");
+      }
+      op.rect = std::array<int, 4>{r[0].get<int>(), r[1].get<int>(), r[2].get<int>(), r[3].get<int>()};
+    } else {
+      op.at = point(j, "at");
+    }
+    if (j.contains("name")) op.object_name = text(j, "name");
+    object_edit(res, op, j);
+  });
+  server.Post("/api/object/move", [this, object_edit, object_index](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kMoveObject;
+    op.object = object_index(j, "object");
+    op.translate = j.contains("translate") ? point(j, "translate") : Vec2{};
+    op.rotate = number(j, "rotate", 0.0);
+    op.scale = number(j, "scale", 1.0);
+    if (!(op.scale > 0)) throw RequestError(kBadRequest, "\"scale\" must be a positive number");
+    object_edit(res, op, j);
+  });
+  server.Post("/api/object/visible", [this, object_edit, object_index](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.object = object_index(j, "object");
+    const json& visible = field(j, "visible");
+    if (!visible.is_boolean()) throw RequestError(kBadRequest, "\"visible\" must be true or false");
+    op.kind = visible.get<bool>() ? subvec::EditOp::Kind::kShowObject : subvec::EditOp::Kind::kHideObject;
+    object_edit(res, op, j);
+  });
+  server.Post("/api/object/order", [this, object_edit, object_index](const httplib::Request& req, httplib::Response& res) {
+    const json j = body_json(req);
+    subvec::EditOp op;
+    op.kind = subvec::EditOp::Kind::kOrderObject;
+    op.object = object_index(j, "object");
+    op.position = object_index(j, "to");
+    object_edit(res, op, j);
   });
 
   // A nudge of the points tool's selection (the arrow keys): a move of control vertices.

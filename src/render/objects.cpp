@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/parallel_p.h"
 #include "subvec/mesh/validate.h"
+#include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
 
 namespace subvec::detail {
@@ -80,3 +82,25 @@ void draw_objects(const VectorImage& image, int level, const ViewTransform& view
 }
 
 }  // namespace subvec::detail
+
+namespace subvec {
+
+std::vector<ObjectView> object_views(const VectorImage& image, const RenderOptions& options) {
+  const ViewFaces view = view_faces(image, options);
+  std::vector<ObjectView> out;
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    const Object& object = image.objects[o];
+    if (object.level != options.level || !object.visible) continue;
+    const MeshTopology topology = validate_object(object, image.width, image.height,
+                                                  static_cast<int>(image.levels.size()), static_cast<int>(o));
+    ObjectView v;
+    v.object = static_cast<int>(o);
+    const Subdivision subdivision(object.mesh, topology, view.depth);
+    subdivision.evaluate_once(object.mesh.positions, object.mesh.colors, v.refined,
+                              detail::resolve_threads(options.threads));
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+}  // namespace subvec

@@ -242,6 +242,11 @@ export class Renderer {
   private strokeVao: WebGLVertexArrayObject;
   private strokePos: WebGLBuffer;
   private strokeColor: WebGLBuffer;
+  private objectVao: WebGLVertexArrayObject;
+  private objectPos: WebGLBuffer;
+  private objectColor: WebGLBuffer;
+  /** The objects over the level: one vertex per triangle corner, object after object (CPU copy). */
+  objectPositions = new Float32Array(0);
   private tearCount = 0;
   private allPoints = false;  // every control point drawn (the points tool is on)
   private strokeVertexCount = 0;
@@ -320,6 +325,33 @@ export class Renderer {
     this.strokePos = gl.createBuffer()!;
     this.strokeColor = gl.createBuffer()!;
     this.strokeVao = vao(this.strokePos, this.strokeColor, null);
+    this.objectPos = gl.createBuffer()!;
+    this.objectColor = gl.createBuffer()!;
+    this.objectVao = vao(this.objectPos, this.objectColor, null);
+  }
+
+  // The objects drawn over the level (subvec serve's view: three vertices per triangle).
+  setObjects(positions: Float32Array, colors: Uint8Array) {
+    const gl = this.gl;
+    this.objectPositions = new Float32Array(positions);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.objectPos);
+    gl.bufferData(gl.ARRAY_BUFFER, this.objectPositions, gl.DYNAMIC_DRAW);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.objectColor);
+    gl.bufferData(gl.ARRAY_BUFFER, colors, gl.STATIC_DRAW);
+    this.shown = null;
+  }
+
+  // Shows vertices [first, first + count) of the objects moved by (dx, dy) from `rest` (a move's
+  // preview).
+  offsetObject(rest: Float32Array, first: number, count: number, dx: number, dy: number) {
+    for (let g = first; g < first + count; ++g) {
+      this.objectPositions[2 * g] = rest[2 * g] + dx;
+      this.objectPositions[2 * g + 1] = rest[2 * g + 1] + dy;
+    }
+    const gl = this.gl;
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.objectPos);
+    gl.bufferData(gl.ARRAY_BUFFER, this.objectPositions, gl.DYNAMIC_DRAW);
+    this.shown = null;
   }
 
   // A new view: GL vertex positions and colors, its triangles and, when it has a coarser level,
@@ -610,6 +642,10 @@ export class Renderer {
       }
     } else if (set) {
       gl.drawElements(gl.TRIANGLES, set.count, gl.UNSIGNED_INT, 0);
+    }
+    if (this.objectPositions.length > 0) {
+      gl.bindVertexArray(this.objectVao);
+      gl.drawArrays(gl.TRIANGLES, 0, this.objectPositions.length / 2);
     }
     if (this.strokeVertexCount > 0) {
       gl.enable(gl.BLEND);

@@ -11,7 +11,7 @@
 import { ApiError, Frame, decodeMoves, getJson, postFrame, postJson } from './api';
 import { Renderer, Transform, softwareWebGL } from './gl';
 
-type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points' | 'pen';
+type Tool = 'pan' | 'select' | 'drag' | 'move' | 'color' | 'points' | 'pen' | 'object';
 
 const TOOL_HELP: Record<Tool, string> = {
   pan: 'Pan: drag to move the view. The wheel zooms at the cursor with every tool; the image is re-refined for the new zoom when you stop.',
@@ -20,6 +20,7 @@ const TOOL_HELP: Record<Tool, string> = {
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
   points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Alt: draw a lasso; Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
   pen: 'Pen: press and drag to draw a new feature; on release it becomes a tear along the smooth curve (a C² B-spline) through what you drew, and the image does not change until you edit one side (Shift held on release: a crease, continuous color with a corner in it). End near where you started to close it. Where it crosses a feature, or ends within 2 px of one, the two meet at a junction. Delete removes the feature the Select tool picked.',
+  object: 'Object: drag a rectangle round something to make it an object — the closed feature it frames, or what GrabCut finds in it — with its own mesh over a background completed under it. Press on an object and drag to move it. X hides the selected object or shows it again. Undo takes any of it back.',
   color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
@@ -62,6 +63,12 @@ const state = {
   box: null as null | { pointer: number; from: [number, number]; to: [number, number]; add: boolean; lasso: [number, number][] | null },
   pen: null as null | { pointer: number; points: [number, number][] },  // a pen stroke (canvas pixels)
   picked: null as null | [number, number],  // where the Select tool last picked a feature
+  // The view's objects (their GL vertex ranges, bottom to top), the one the object tool selected,
+  // and a rectangle or a move it is drawing.
+  objects: [] as { object: number; first: number; count: number }[],
+  objectSel: -1,
+  objectBox: null as null | { pointer: number; from: [number, number]; to: [number, number] },
+  objectMove: null as null | { pointer: number; object: number; first: number; count: number; start: [number, number]; rest: Float32Array; d: [number, number] },
   reload: false,  // an edit changed the level's topology: fetch the view and control mesh again
 };
 
@@ -251,6 +258,8 @@ async function fetchView(): Promise<void> {
   if (!frame.header.unchanged) {
     renderer.setMesh(frame.f32.positions, frame.u8.colors, frame.u32.triangles, frame.u32.coarse_triangles,
       frame.u32.tear_lines);
+    renderer.setObjects(frame.f32.object_positions ?? new Float32Array(0), frame.u8.object_colors ?? new Uint8Array(0));
+    state.objects = frame.header.objects ?? [];
   }
   state.view = {
     id: frame.header.view, depth: frame.header.depth, partial: frame.header.partial,
@@ -1006,6 +1015,117 @@ async function deletePicked() {
   });
 }
 
+// ---- the object tool (issue 26) ----------------------------------------------------------------
+
+// The topmost object of the view under image point p, or null.
+function objectAt(p: [number, number]) {
+  const q = renderer.objectPositions;
+  for (let i = state.objects.length - 1; i >= 0; --i) {
+    const o = state.objects[i];
+    for (let g = o.first; g < o.first + o.count; g += 3) {
+      const ax = q[2 * g], ay = q[2 * g + 1], bx = q[2 * g + 2], by = q[2 * g + 3], cx = q[2 * g + 4], cy = q[2 * g + 5];
+      const d1 = (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax);
+      const d2 = (cx - bx) * (p[1] - by) - (cy - by) * (p[0] - bx);
+      const d3 = (ax - cx) * (p[1] - cy) - (ay - cy) * (p[0] - cx);
+      if ((d1 >= 0 && d2 >= 0 && d3 >= 0) || (d1 <= 0 && d2 <= 0 && d3 <= 0)) return o;
+    }
+  }
+  return null;
+}
+function objectDown(e: PointerEvent) {
+  const at = toImage(canvasPoint(e));
+  const o = objectAt(at);
+  canvas.setPointerCapture(e.pointerId);
+  if (o) {
+    state.objectSel = o.object;
+    state.objectMove = { pointer: e.pointerId, object: o.object, first: o.first, count: o.count, start: at,
+      rest: new Float32Array(renderer.objectPositions), d: [0, 0] };
+    status(`object ${o.object} selected: drag to move it, X hides it`);
+    return;
+  }
+  state.objectBox = { pointer: e.pointerId, from: canvasPoint(e), to: canvasPoint(e) };
+  drawObjectBox();
+}
+function objectMoveTo(e: PointerEvent) {
+  const m = state.objectMove;
+  if (m && e.pointerId === m.pointer) {
+    const at = toImage(canvasPoint(e));
+    m.d = [at[0] - m.start[0], at[1] - m.start[1]];
+    renderer.offsetObject(m.rest, m.first, m.count, m.d[0], m.d[1]);
+    redraw();
+    return true;
+  }
+  const b = state.objectBox;
+  if (b && e.pointerId === b.pointer) {
+    b.to = canvasPoint(e);
+    drawObjectBox();
+    return true;
+  }
+  return false;
+}
+function drawObjectBox() {
+  const box = $('box'), b = state.objectBox;
+  box.hidden = !b;
+  if (!b) return;
+  const dpr = window.devicePixelRatio || 1;
+  const [x0, x1] = [b.from[0], b.to[0]].sort((a, c) => a - c), [y0, y1] = [b.from[1], b.to[1]].sort((a, c) => a - c);
+  Object.assign(box.style, { left: `${x0 / dpr}px`, top: `${y0 / dpr}px`, width: `${(x1 - x0) / dpr}px`, height: `${(y1 - y0) / dpr}px` });
+}
+function objectEnd(e: PointerEvent | null, cancel = false) {
+  const m = state.objectMove;
+  if (m && (!e || e.pointerId === m.pointer)) {
+    if (e && !cancel) objectMoveTo(e);
+    state.objectMove = null;
+    const [dx, dy] = m.d;
+    if (cancel || Math.hypot(dx, dy) < 0.5) {
+      renderer.offsetObject(m.rest, m.first, m.count, 0, 0);
+      redraw();
+      if (cancel) status('move cancelled');
+      return true;
+    }
+    void edit(async () => {
+      const f = await postFrame('/api/object/move', {
+        session: state.session, version: state.version, level: state.level, object: m.object, translate: [dx, dy],
+      });
+      applyDelta(f);
+      status(f.header.log);
+    });
+    return true;
+  }
+  const b = state.objectBox;
+  if (b && (!e || e.pointerId === b.pointer)) {
+    if (e && !cancel) b.to = canvasPoint(e);
+    state.objectBox = null;
+    drawObjectBox();
+    if (cancel || !state.doc) return true;
+    const p = toImage(b.from), q = toImage(b.to);
+    const x0 = Math.max(0, Math.floor(Math.min(p[0], q[0]))), y0 = Math.max(0, Math.floor(Math.min(p[1], q[1])));
+    const x1 = Math.min(state.doc.width, Math.ceil(Math.max(p[0], q[0]))), y1 = Math.min(state.doc.height, Math.ceil(Math.max(p[1], q[1])));
+    if (x1 - x0 < 4 || y1 - y0 < 4) { status('drag a rectangle round what should become an object'); return true; }
+    void edit(async () => {
+      const f = await postFrame('/api/object/make', {
+        session: state.session, version: state.version, level: state.level, rect: [x0, y0, x1 - x0, y1 - y0],
+      });
+      applyDelta(f);
+      status(f.header.log);
+    });
+    return true;
+  }
+  return false;
+}
+async function toggleObject() {
+  const o = state.objectSel;
+  if (o < 0) { status('select an object with the Object tool (O) first, then press X'); return; }
+  const shown = state.objects.some((r) => r.object === o);
+  await edit(async () => {
+    const f = await postFrame('/api/object/visible', {
+      session: state.session, version: state.version, level: state.level, object: o, visible: !shown,
+    });
+    applyDelta(f);
+    status(f.header.log);
+  });
+}
+
 // ---- input ---------------------------------------------------------------------------------
 
 canvas.addEventListener('pointerdown', (e) => {
@@ -1028,6 +1148,7 @@ canvas.addEventListener('pointerdown', (e) => {
   else if (state.tool === 'color') void doColor(at, e.timeStamp || performance.now());
   else if (state.tool === 'points') pointsDown(e);
   else if (state.tool === 'pen') penDown(e);
+  else if (state.tool === 'object') objectDown(e);
   else void dragStart(e);
 });
 canvas.addEventListener('pointermove', (e) => {
@@ -1049,6 +1170,7 @@ canvas.addEventListener('pointermove', (e) => {
     penMove(e);
     return;
   }
+  if (objectMoveTo(e)) return;
   if (state.box && e.pointerId === state.box.pointer) {
     state.box.to = canvasPoint(e);
     state.box.lasso?.push(state.box.to);
@@ -1070,16 +1192,19 @@ const release = (e: PointerEvent) => {
     penEnd(e);
     return;
   }
+  if (objectEnd(e)) return;
   dragEnd(e);
 };
 canvas.addEventListener('pointerup', release);
-canvas.addEventListener('pointercancel', (e) => { state.pan = null; boxEnd(e, true); penEnd(e, true); dragEnd(e, true); });
+canvas.addEventListener('pointercancel', (e) => { state.pan = null; boxEnd(e, true); penEnd(e, true); objectEnd(e, true); dragEnd(e, true); });
 // A capture lost without a pointerup (the browser took it away): the drag ends there, so that its
 // task, which holds the queue, cannot wait for a release that never comes.
 canvas.addEventListener('lostpointercapture', (e) => {
   if (state.drag && e.pointerId === state.drag.pointer) dragEnd(e);
   if (state.box && e.pointerId === state.box.pointer) boxEnd(e);
   if (state.pen && e.pointerId === state.pen.pointer) penEnd(e);
+  if ((state.objectMove && e.pointerId === state.objectMove.pointer) ||
+      (state.objectBox && e.pointerId === state.objectBox.pointer)) objectEnd(e);
 });
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
 canvas.addEventListener('wheel', (e) => {
@@ -1117,7 +1242,8 @@ window.addEventListener('keydown', (e) => {
   }
   if (key === 'r') { recolorPoints(); return; }
   if (key === 'escape' && state.tool === 'points' && !state.drag && state.selection.length) { setSelection([]); status('selection cleared'); return; }
-  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points', n: 'pen' };
+  const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points', n: 'pen', o: 'object' };
+  if (key === 'x' && state.tool === 'object') { void toggleObject(); return; }
   if (tools[key]) { setTool(tools[key]); return; }
   if (key === 'f') { toggleRadio('pick'); return; }
   if (key === 'b') { toggleRadio('mode'); return; }
@@ -1130,6 +1256,7 @@ window.addEventListener('keydown', (e) => {
   if (key === ']') { void setLevel(state.level + 1); return; }
   if ((key === 'delete' || key === 'backspace') && state.tool === 'select') { e.preventDefault(); void deletePicked(); return; }
   if (key === 'escape' && state.pen) { penEnd(null, true); return; }
+  if (key === 'escape' && (state.objectMove || state.objectBox)) { objectEnd(null, true); return; }
   if (key === 'escape' && state.drag) dragEnd(null, true);
 });
 window.addEventListener('keyup', (e) => {

@@ -132,6 +132,15 @@ struct ViewMesh {
 // Errors as render(). `options.threads` evaluates; overlay, antialias and backend are not used.
 ViewMesh view_mesh(const VectorImage& image, const RenderOptions& options);
 
+// The visible objects of options.level (mesh/vector_image.h), bottom to top, each refined whole to
+// the depth render() draws them at for `options` (view_faces' depth) and pushed to the limit: for
+// a front end that draws them itself over the level's view.
+struct ObjectView {
+  int object = 0;  // index in VectorImage::objects
+  RefinedMesh refined;
+};
+std::vector<ObjectView> object_views(const VectorImage& image, const RenderOptions& options);
+
 // Draws the image as described by `options`; RGB, or RGBA when the window leaves the image. On
 // the CPU a view of over 2^20 refined triangles is drawn in tiles (render_strips(), the same
 // bytes), so that its memory is the output's and a bounded refinement, not the whole view's.

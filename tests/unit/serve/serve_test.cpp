@@ -383,6 +383,56 @@ TEST(ServeEditor, ViewIsUnweldedAtTearsAndColorDeltasAreSparse) {
 // The pen tool's edits (issue 25): a feature added and deleted through the editor equals `subvec
 // edit`'s, each changes the topology, so the delta tells the page to fetch a new view, and undo
 // and redo across them do the same.
+// Objects (issue 26): each object edit reloads the view, which carries the objects' triangles;
+// a level edit afterwards is a plain delta again; undo takes an object edit back.
+TEST(ServeEditor, ObjectEditsReloadTheViewWithTheObjects) {
+  const VectorImage original = disk();
+  Editor editor(original);
+  const std::string s = editor.new_session();
+  EXPECT_TRUE(editor.view(s, {0, 2}).objects.empty());
+  subvec::EditOp make;
+  make.kind = subvec::EditOp::Kind::kMakeObject;
+  make.rect = std::array<int, 4>{12, 12, 72, 72};
+  std::string log;
+  Delta d = editor.apply(s, 1, make, log);
+  EXPECT_TRUE(d.reload);
+  EXPECT_NE(log.find("object 0 made of what [12, 12, 72, 72] frames"), std::string::npos) << log;
+  ViewMesh v = editor.view(s, {0, 2});
+  ASSERT_EQ(v.objects.size(), 1u);
+  EXPECT_EQ(v.objects[0].first, 0u);
+  EXPECT_EQ(v.objects[0].count * 2, v.object_positions.size());
+  EXPECT_EQ(v.object_colors.size(), 2 * v.object_positions.size());
+  d = editor.apply(s, 2, color_op({5, 5}, {0, 255, 0}), log);  // the background: a plain delta
+  EXPECT_FALSE(d.reload);
+  subvec::EditOp move;
+  move.kind = subvec::EditOp::Kind::kMoveObject;
+  move.object = 0;
+  move.translate = {10, 0};
+  d = editor.apply(s, 3, move, log);
+  EXPECT_TRUE(d.reload);
+  v = editor.view(s, {0, 2});
+  subvec::EditOp hide;
+  hide.kind = subvec::EditOp::Kind::kHideObject;
+  hide.object = 0;
+  d = editor.apply(s, 4, hide, log);
+  EXPECT_TRUE(d.reload);
+  EXPECT_TRUE(editor.view(s, {0, 2}).objects.empty());
+  std::string label;
+  d = editor.undo(s, 5, label);
+  EXPECT_TRUE(d.reload);
+  EXPECT_EQ(label, "object 0 hidden");
+  EXPECT_EQ(editor.view(s, {0, 2}).objects.size(), 1u);
+  // A move of an object that is not there is refused by name.
+  move.object = 3;
+  try {
+    editor.apply(s, 6, move, log);
+    ADD_FAILURE() << "no error";
+  } catch (const RequestError& e) {
+    EXPECT_EQ(e.status(), kUnprocessable);
+    EXPECT_NE(std::string(e.what()).find("object 3 is out of range (the image has 1 object)"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ServeEditor, FeatureEditsReloadTheViewAndUndo) {
   const VectorImage original = disk();
   Editor editor(original);
