@@ -405,6 +405,16 @@ MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<in
   return result;
 }
 
+// The area of a closed feature's control polygon, square pixels.
+double polygon_area(const ControlMesh& mesh, const Feature& feature) {
+  double twice = 0;
+  for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
+    const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
+    twice += a.x * b.y - b.x * a.y;
+  }
+  return std::abs(twice) / 2;
+}
+
 void check_level_index(const VectorImage& image, int level) {
   if (level < 0 || level >= static_cast<int>(image.levels.size())) {
     invalid("level " + std::to_string(level) + " is out of range (" +
@@ -446,17 +456,15 @@ MakeObjectResult make_object_in_rect(VectorImage& image, int level, const PixelR
   for (int f = 0; f < static_cast<int>(mesh.features.size()); ++f) {
     const Feature& feature = mesh.features[f];
     if (!feature.closed()) continue;
-    bool within = true;
-    double twice_area = 0;
-    for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
-      const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
-      within = within && a.x >= rect.x && a.x <= rect.x + rect.width && a.y >= rect.y && a.y <= rect.y + rect.height;
-      twice_area += a.x * b.y - b.x * a.y;
-    }
-    if (within && (best < 0 || std::abs(twice_area) > best_area)) best = f, best_area = std::abs(twice_area);
+    const bool within = std::all_of(feature.vertices.begin(), feature.vertices.end(), [&](int32_t v) {
+      const Vec2 a = mesh.positions[v];
+      return a.x >= rect.x && a.x <= rect.x + rect.width && a.y >= rect.y && a.y <= rect.y + rect.height;
+    });
+    const double a = polygon_area(mesh, feature);
+    if (within && (best < 0 || a > best_area)) best = f, best_area = a;
   }
   // It must be what the rectangle frames, not a detail inside it: a fifth of its area at least.
-  if (best >= 0 && best_area / 2 < kFramedShare * double(rect.width) * double(rect.height)) best = -1;
+  if (best >= 0 && best_area < kFramedShare * double(rect.width) * double(rect.height)) best = -1;
   if (best >= 0) return make_object(image, level, best, name);
 
   // GrabCut on the level as drawn (without its objects), then its boundary cut in as a tear.
@@ -515,14 +523,12 @@ int closed_feature_around(const ControlMesh& mesh, Vec2 p) {
   for (int f = 0; f < static_cast<int>(mesh.features.size()); ++f) {
     const Feature& feature = mesh.features[f];
     if (!feature.closed()) continue;
-    bool inside = false;
-    double twice_area = 0;
+    bool inside = false;  // crossings of a ray to the right of p
     for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
       const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
-      twice_area += a.x * b.y - b.x * a.y;
       if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
     }
-    const double area = std::abs(twice_area) / 2;
+    const double area = polygon_area(mesh, feature);
     if (inside && (best < 0 || area < best_area)) best = f, best_area = area;
   }
   return best;

@@ -416,6 +416,11 @@ TEST(Objects, FilesKeepThem) {
   const VectorImage back = parse_svec_json(json);
   EXPECT_EQ(to_svec_json(back), json);
   EXPECT_EQ(draw(back).pixels, drawn.pixels);
+  // The default (compact) .svec: saved, read and saved again, the same bytes and the same render.
+  const std::vector<uint8_t> once = to_svec_binary(image);
+  const VectorImage read1 = parse_svec_binary(once);
+  EXPECT_EQ(to_svec_binary(read1), once);
+  EXPECT_EQ(draw(parse_svec_binary(to_svec_binary(read1))).pixels, draw(read1).pixels);
   // Without objects a file is what it always was: JSON version 1, no binary flag.
   VectorImage plain = small_image();
   EXPECT_NE(to_svec_json(plain).find("\"version\": 1"), std::string::npos);
