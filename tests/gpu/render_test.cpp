@@ -12,6 +12,7 @@
 #include <string>
 
 #include "render/gpu/gpu_p.h"
+#include "subvec/edit/objects.h"
 #include "subvec/core/error.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
@@ -119,6 +120,16 @@ TEST(GpuRender, WideOutputsAreDrawnInTiles) {
   o.window = Window{0, 0, 128, 6};
   o.width = 4500;
   expect_match(image, o, "02-open-tear, 4500 wide");
+}
+
+// Objects (edit/objects.h) are composited over the GPU's frame by the CPU's rasterizer: the frame
+// equals the CPU's as for a level.
+TEST(GpuRender, ObjectsMatchTheCpu) {
+  REQUIRE_GPU();
+  VectorImage image = read_svec(source_dir() / "examples" / "01-disk.svec.json");
+  make_object(image, 0, 0, "disk");
+  transform_object(image, 0, {.translate = {20, -5}, .rotate_degrees = 15, .scale = 0.8});
+  expect_match_in_views(image, "01-disk, the disk an object, moved");
 }
 
 TEST(GpuRender, MatchesTheCpuOnTheSyntheticImage) {
