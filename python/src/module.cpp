@@ -373,7 +373,7 @@ const subvec::ControlMesh& mesh_of(const VectorImage& image, const subvec::EditO
 
 subvec::EditSelect parse_select(const std::string& s) {
   if (const std::optional<subvec::EditSelect> e = subvec::edit_select_from_name(s)) return *e;
-  invalid("select must be 'vertex', 'feature', 'region' or 'vertices', got '" + s + "'");
+  invalid("select must be 'vertex', 'feature', 'region', 'vertices' or 'all', got '" + s + "'");
 }
 
 // A color selection's reach: radius None is 0 for a vertex or feature and no cap for a region;

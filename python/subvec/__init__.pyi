@@ -119,7 +119,7 @@ class VectorImage:
     def move_feature(self, at: _Point, *, translate: _Point = (0, 0), rotate: float = 0.0,
                      region: float = 0.0, level: int = 0, object: int | None = None) -> str: ...
     def recolor(self, at: _Point | None, color: _Color, *, mode: Literal["blend", "transform"] = "blend",
-                select: Literal["vertex", "feature", "region", "vertices"] = "vertex",
+                select: Literal["vertex", "feature", "region", "vertices", "all"] = "vertex",
                 radius: float | None = None, tolerance: float | None = None,
                 vertices: npt.ArrayLike | None = None,
                 amount: float = 0.5, level: int = 0, object: int | None = None) -> str: ...

@@ -282,6 +282,7 @@ std::optional<EditSelect> edit_select_from_name(std::string_view name) {
   if (name == "feature") return EditSelect::kFeature;
   if (name == "region") return EditSelect::kRegion;
   if (name == "vertices") return EditSelect::kVertices;
+  if (name == "all") return EditSelect::kAll;
   return std::nullopt;
 }
 
@@ -354,6 +355,13 @@ ColorSelection select_vertices_colors(const ControlMesh& mesh, std::span<const i
   return s;
 }
 
+ColorSelection select_all_colors(const ControlMesh& mesh, const MeshTopology& topology, Vec2 at) {
+  ColorSelection s = select_vertex_colors(mesh, topology, at, 0);
+  s.colors.resize(mesh.colors.size());
+  for (size_t c = 0; c < s.colors.size(); ++c) s.colors[c] = static_cast<int32_t>(c);
+  return s;
+}
+
 ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topology,
                              EditSelect select, Vec2 at, double radius, double tolerance,
                              std::span<const int32_t> vertices) {
@@ -361,6 +369,7 @@ ColorSelection select_colors(const ControlMesh& mesh, const MeshTopology& topolo
     case EditSelect::kVertex: return select_vertex_colors(mesh, topology, at, radius);
     case EditSelect::kFeature: return select_feature_colors(mesh, topology, at, radius);
     case EditSelect::kVertices: return select_vertices_colors(mesh, vertices);
+    case EditSelect::kAll: return select_all_colors(mesh, topology, at);
     case EditSelect::kRegion: break;
   }
   return select_region_colors(mesh, at, radius, tolerance);

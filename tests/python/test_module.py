@@ -215,7 +215,7 @@ def test_region_selection_is_a_fill_that_the_tolerance_bounds():
     assert set(capped) <= set(wide) and capped.size < wide.size
     with pytest.raises(subvec.InvalidArgumentError, match="tolerance applies to select='region'"):
         image.select_colors((223, 262), select="vertex", tolerance=10)
-    with pytest.raises(subvec.InvalidArgumentError, match="'vertex', 'feature', 'region' or 'vertices'"):
+    with pytest.raises(subvec.InvalidArgumentError, match="'vertex', 'feature', 'region', 'vertices' or 'all'"):
         image.select_colors((223, 262), select="blob")
     with pytest.raises(subvec.InvalidArgumentError, match='grabs a "vertex" or a "feature"'):
         image.drag((111, 126), (104, 104), select="region")

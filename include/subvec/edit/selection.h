@@ -40,13 +40,13 @@ namespace subvec {
 // What a click selects: the nearest control vertex, the nearest feature, or the region around the
 // click (color edits and the editor's Select tool; drags take a vertex or a feature).
 // kVertices: a list of control vertices the user selected (the editor's direct handles).
-enum class EditSelect { kVertex, kFeature, kRegion, kVertices };
+enum class EditSelect { kVertex, kFeature, kRegion, kVertices, kAll };
 
-// "vertex", "feature", "region" or "vertices"; nullopt for any other name. kEditSelectNames lists
-// them for error messages.
+// "vertex", "feature", "region", "vertices" or "all"; nullopt for any other name.
+// kEditSelectNames lists them for error messages.
 std::optional<EditSelect> edit_select_from_name(std::string_view name);
 inline constexpr std::string_view kEditSelectNames =
-    R"("vertex", "feature", "region" or "vertices")";
+    R"("vertex", "feature", "region", "vertices" or "all")";
 // What a drag grabs: a vertex or a feature.
 inline constexpr bool drag_grabs(EditSelect s) {
   return s == EditSelect::kVertex || s == EditSelect::kFeature;
@@ -124,6 +124,10 @@ inline constexpr double default_color_radius(EditSelect s) {
 ColorSelection select_region_colors(const ControlMesh& mesh, Vec2 at,
                                     double radius = std::numeric_limits<double>::infinity(),
                                     double tolerance = kDefaultRegionTolerance);
+
+// Every color value of the mesh (an object's, recolored whole), the seed being the nearest vertex
+// to `at` and its color value on the side of `at`.
+ColorSelection select_all_colors(const ControlMesh& mesh, const MeshTopology& topology, Vec2 at);
 
 // Every color value of the given control vertices (all sides of a vertex on a tear): color editing
 // per control point. The seed is the first vertex and its first value. Throws

@@ -475,6 +475,16 @@ TEST(Objects, EditsReachInsideAnObject) {
   EXPECT_NE(image.objects[0].mesh.colors, before.objects[0].mesh.colors);
   EXPECT_EQ(image.levels[0].positions, before.levels[0].positions);
   EXPECT_EQ(image.levels[0].colors, before.levels[0].colors);
+  // Recolored whole: a TRANSFORM over every color value of the object, the level's untouched.
+  const std::vector<Color> object_colors = image.objects[0].mesh.colors;
+  const std::vector<EditOp> whole = parse_edit_ops(
+      "[{\"op\": \"color\", \"mode\": \"blend\", \"object\": 0, \"select\": \"all\", \"at\": [" +
+      std::to_string(c.x) + ", " + std::to_string(c.y) + "], \"color\": [255, 255, 255], \"amount\": 0.5}]");
+  apply_edit_ops(image, whole);
+  for (size_t k = 0; k < object_colors.size(); ++k) {
+    EXPECT_NEAR(image.objects[0].mesh.colors[k].r, 0.5f * object_colors[k].r + 127.5f, 1e-3);
+  }
+  EXPECT_EQ(image.levels[0].colors, before.levels[0].colors);
   // An object's mesh has no frame: its boundary vertices move freely (none is pinned to a side).
   const std::vector<EditOp> far = parse_edit_ops(
       "[{\"op\": \"move-vertices\", \"object\": 0, \"vertices\": [0], \"translate\": [-30, 0]}]");

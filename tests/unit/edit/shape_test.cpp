@@ -220,7 +220,7 @@ TEST(EditOps, RegionFillsParseAndApply) {
   refused(R"([{"op":"drag","from":[1,1],"to":[2,2],"select":"region"}])",
           "expected \"vertex\" or \"feature\", got \"region\"");
   refused(R"([{"op":"color","mode":"blend","at":[1,1],"select":"blob","color":[0,0,0]}])",
-          "expected \"vertex\", \"feature\", \"region\" or \"vertices\", got \"blob\"");
+          "expected \"vertex\", \"feature\", \"region\", \"vertices\" or \"all\", got \"blob\"");
 }
 
 // Direct handles: "move-vertices" moves the listed control points by exactly the translation
