@@ -827,6 +827,7 @@ void EditorServer::Impl::edit_routes() {
     op.rotate = number(j, "rotate", 0.0);
     op.scale = number(j, "scale", 1.0);
     if (!(op.scale > 0)) throw RequestError(kBadRequest, "\"scale\" must be a positive number");
+    if (j.contains("pivot")) op.pivot = point(j, "pivot");
     object_edit(res, op, j);
   });
   server.Post("/api/object/visible", [this, object_edit, object_index](const httplib::Request& req, httplib::Response& res) {

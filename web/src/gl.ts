@@ -341,12 +341,15 @@ export class Renderer {
     this.shown = null;
   }
 
-  // Shows vertices [first, first + count) of the objects moved by (dx, dy) from `rest` (a move's
-  // preview).
-  offsetObject(rest: Float32Array, first: number, count: number, dx: number, dy: number) {
+  // Shows vertices [first, first + count) of the objects as `rest` scaled by s and turned by
+  // `degrees` (clockwise on screen) about `pivot`, then moved by (dx, dy): a move's preview.
+  offsetObject(rest: Float32Array, first: number, count: number, dx: number, dy: number,
+               pivot: [number, number] = [0, 0], degrees = 0, s = 1) {
+    const a = (degrees * Math.PI) / 180, c = s * Math.cos(a), sn = s * Math.sin(a);
     for (let g = first; g < first + count; ++g) {
-      this.objectPositions[2 * g] = rest[2 * g] + dx;
-      this.objectPositions[2 * g + 1] = rest[2 * g + 1] + dy;
+      const x = rest[2 * g] - pivot[0], y = rest[2 * g + 1] - pivot[1];
+      this.objectPositions[2 * g] = pivot[0] + c * x - sn * y + dx;
+      this.objectPositions[2 * g + 1] = pivot[1] + sn * x + c * y + dy;
     }
     const gl = this.gl;
     gl.bindBuffer(gl.ARRAY_BUFFER, this.objectPos);

@@ -20,7 +20,7 @@ const TOOL_HELP: Record<Tool, string> = {
   move: 'Move feature: press near a feature and drag to translate the whole feature; hold Shift while dragging to rotate it about its center instead. The mesh around it follows as rigidly as possible.',
   points: 'Points: the control points, as handles. Click one to select it (Shift adds or removes), drag a box around several (Alt: draw a lasso; Shift adds), then drag any selected point or nudge with the arrow keys (Shift: 10 px) to move them; the mesh around follows as rigidly as possible ("region" sets how far). R recolors the selected points with the picked color. Esc clears the selection.',
   pen: 'Pen: press and drag to draw a new feature; on release it becomes a tear along the smooth curve (a C² B-spline) through what you drew, and the image does not change until you edit one side (Shift held on release: a crease, continuous color with a corner in it). End near where you started to close it. Where it crosses a feature, or ends within 2 px of one, the two meet at a junction. Delete removes the feature the Select tool picked.',
-  object: 'Object: drag a rectangle round something to make it an object — the closed feature it frames, or what GrabCut finds in it — with its own mesh over a background completed under it. Press on an object and drag to move it. X hides the selected object or shows it again. Undo takes any of it back.',
+  object: 'Object: drag a rectangle round something to make it an object — the closed feature it frames, or what GrabCut finds in it — with its own mesh over a background completed under it. Press on an object and drag to move it; Shift+drag turns it and Alt+drag scales it about its centre. X hides the selected object or shows it again. Undo takes any of it back.',
   color: 'Color: click to recolor with the picked color; the white points show what a click changes. With "region" picked, the fill spreads from the click to the colors within "tolerance" of the clicked one, never across a tear (and within the radius, if capped); with "feature" or "vertex", the clicked side of the nearest one grown by the radius. BLEND mixes towards the color by "amount"; TRANSFORM maps the clicked color onto the new one and keeps the shading.',
 };
 
@@ -68,7 +68,9 @@ const state = {
   objects: [] as { object: number; first: number; count: number }[],
   objectSel: -1,
   objectBox: null as null | { pointer: number; from: [number, number]; to: [number, number] },
-  objectMove: null as null | { pointer: number; object: number; first: number; count: number; start: [number, number]; rest: Float32Array; d: [number, number] },
+  // A move, or with Shift a turn and with Alt a scaling, about the object's centre.
+  objectMove: null as null | { pointer: number; object: number; first: number; count: number; start: [number, number];
+    rest: Float32Array; d: [number, number]; mode: 'move' | 'rotate' | 'scale'; pivot: [number, number]; angle: number; scale: number },
   reload: false,  // an edit changed the level's topology: fetch the view and control mesh again
 };
 
@@ -1037,10 +1039,18 @@ function objectDown(e: PointerEvent) {
   const o = objectAt(at);
   canvas.setPointerCapture(e.pointerId);
   if (o) {
+    // The pivot of a turn or a scaling: the centre of the object's drawn bounding box.
+    const q = renderer.objectPositions;
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (let g = o.first; g < o.first + o.count; ++g) {
+      x0 = Math.min(x0, q[2 * g]); x1 = Math.max(x1, q[2 * g]);
+      y0 = Math.min(y0, q[2 * g + 1]); y1 = Math.max(y1, q[2 * g + 1]);
+    }
     state.objectSel = o.object;
     state.objectMove = { pointer: e.pointerId, object: o.object, first: o.first, count: o.count, start: at,
-      rest: new Float32Array(renderer.objectPositions), d: [0, 0] };
-    status(`object ${o.object} selected: drag to move it, X hides it`);
+      rest: new Float32Array(q), d: [0, 0], mode: e.shiftKey ? 'rotate' : e.altKey ? 'scale' : 'move',
+      pivot: [(x0 + x1) / 2, (y0 + y1) / 2], angle: 0, scale: 1 };
+    status(`object ${o.object} selected: drag to move it (Shift: turn, Alt: scale), X hides it`);
     return;
   }
   state.objectBox = { pointer: e.pointerId, from: canvasPoint(e), to: canvasPoint(e) };
@@ -1050,8 +1060,16 @@ function objectMoveTo(e: PointerEvent) {
   const m = state.objectMove;
   if (m && e.pointerId === m.pointer) {
     const at = toImage(canvasPoint(e));
-    m.d = [at[0] - m.start[0], at[1] - m.start[1]];
-    renderer.offsetObject(m.rest, m.first, m.count, m.d[0], m.d[1]);
+    const [px, py] = m.pivot;
+    if (m.mode === 'move') {
+      m.d = [at[0] - m.start[0], at[1] - m.start[1]];
+    } else if (m.mode === 'rotate') {
+      m.angle = ((Math.atan2(at[1] - py, at[0] - px) - Math.atan2(m.start[1] - py, m.start[0] - px)) * 180) / Math.PI;
+    } else {
+      const r0 = Math.hypot(m.start[0] - px, m.start[1] - py), r1 = Math.hypot(at[0] - px, at[1] - py);
+      m.scale = r0 > 1 ? Math.min(20, Math.max(0.05, r1 / r0)) : 1;
+    }
+    renderer.offsetObject(m.rest, m.first, m.count, m.d[0], m.d[1], m.pivot, m.angle, m.scale);
     redraw();
     return true;
   }
@@ -1077,15 +1095,18 @@ function objectEnd(e: PointerEvent | null, cancel = false) {
     if (e && !cancel) objectMoveTo(e);
     state.objectMove = null;
     const [dx, dy] = m.d;
-    if (cancel || Math.hypot(dx, dy) < 0.5) {
+    const still = m.mode === 'move' ? Math.hypot(dx, dy) < 0.5 : m.mode === 'rotate' ? Math.abs(m.angle) < 0.1 : Math.abs(m.scale - 1) < 1e-3;
+    if (cancel || still) {
       renderer.offsetObject(m.rest, m.first, m.count, 0, 0);
       redraw();
       if (cancel) status('move cancelled');
       return true;
     }
+    const change = m.mode === 'move' ? { translate: [dx, dy] }
+      : m.mode === 'rotate' ? { rotate: m.angle, pivot: m.pivot } : { scale: m.scale, pivot: m.pivot };
     void edit(async () => {
       const f = await postFrame('/api/object/move', {
-        session: state.session, version: state.version, level: state.level, object: m.object, translate: [dx, dy],
+        session: state.session, version: state.version, level: state.level, object: m.object, ...change,
       });
       applyDelta(f);
       status(f.header.log);

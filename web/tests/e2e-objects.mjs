@@ -57,6 +57,13 @@ try {
   check('move: the background shows where it was', !red(uncovered), `${uncovered}`);
   check('move: it covers the right', red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
 
+  // Shift+drag turns it about its centre (a quarter turn: the move is kept, the disk stays round).
+  await page.keyboard.down('Shift');
+  await drag([68, 30], [86, 48]);
+  await page.keyboard.up('Shift');
+  check('turn: rotated', /rotated by (8\d|9\d)(\.\d+)? degrees/.test(await status()), await status());
+  check('turn: still over the right', red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
+
   // X hides it (it stays selected); undo shows it again.
   await page.keyboard.press('x');
   await idle(page);
