@@ -224,6 +224,9 @@ DocumentInfo Editor::info(const std::string& session) const {
     level.mean_edge = mesh.triangles.empty() ? 0 : sum / (3.0 * mesh.num_triangles());
     info.levels.push_back(level);
   }
+  for (const subvec::Object& o : image_.objects) {
+    info.objects.push_back({o.level, o.name, o.visible, o.mesh.num_vertices()});
+  }
   // A session's tab counts its own steps (an unknown session: none of them).
   const auto mine = [&](const std::vector<HistoryStep>& steps) {
     if (session.empty()) return static_cast<int>(steps.size());

@@ -149,6 +149,13 @@ struct DocumentInfo {
     double mean_edge = 0;  // mean control edge length, pixels
   };
   std::vector<Level> levels;
+  struct ObjectEntry {
+    int level = 0;
+    std::string name;
+    bool visible = true;
+    int vertices = 0;
+  };
+  std::vector<ObjectEntry> objects;  // bottom to top
   int undo = 0, redo = 0;
   int strokes = 0;
   int bands = 0;  // detail bands of the level pyramid (0: no pyramid, nothing to filter)

@@ -540,6 +540,10 @@ void EditorServer::Impl::document_routes() {
                         {"features", l.features},
                         {"mean_edge", l.mean_edge}});
     }
+    json objects = json::array();
+    for (const auto& o : info.objects) {
+      objects.push_back({{"level", o.level}, {"name", o.name}, {"visible", o.visible}, {"vertices", o.vertices}});
+    }
     json save = nullptr;
     if (options.output) save = options.output->string();
     send_json(res, {{"name", name()},
@@ -548,6 +552,7 @@ void EditorServer::Impl::document_routes() {
                     {"width", info.width},
                     {"height", info.height},
                     {"levels", levels},
+                    {"objects", objects},
                     {"undo", info.undo},
                     {"redo", info.redo},
                     {"strokes", info.strokes},

@@ -32,6 +32,7 @@ interface LevelInfo { vertices: number; triangles: number; colors: number; featu
 interface DocInfo {
   name: string; stem: string; version: number; width: number; height: number; levels: LevelInfo[];
   undo: number; redo: number; strokes: number; save_to: string | null;
+  objects: { level: number; name: string; visible: boolean; vertices: number }[];
   filter: {
     available: boolean; bands: number; reason: string;
     current: null | { eta: number[]; geometry: boolean; color: boolean };
@@ -340,6 +341,7 @@ async function loadDocument() {
     ? `Save writes ${doc.save_to}. Downloads are made from the current state.`
     : 'Save downloads the .svec (start the server with -o OUT.svec to save in place).';
   updateHistoryButtons();
+  showObjects(doc);
 }
 
 function describeLevel() {
@@ -375,6 +377,49 @@ async function refreshCounts() {
   }
   updateHistoryButtons();
   showFilter(doc);
+  showObjects(doc);
+}
+
+// The Objects panel: the level's objects, top first, each with its visibility and its place in
+// the drawing order.
+function showObjects(doc: DocInfo) {
+  const list = $('object-list');
+  list.replaceChildren();
+  const objects = (doc.objects ?? []).map((o, i) => ({ ...o, index: i })).filter((o) => o.level === state.level);
+  $('objects-empty').hidden = objects.length > 0;
+  const count = (doc.objects ?? []).length;
+  for (const o of objects.reverse()) {
+    const li = document.createElement('li');
+    li.dataset.object = String(o.index);
+    li.classList.toggle('selected', o.index === state.objectSel);
+    const shown = document.createElement('input');
+    shown.type = 'checkbox';
+    shown.checked = o.visible;
+    shown.title = 'shown';
+    shown.addEventListener('change', () => void objectEdit('/api/object/visible', { object: o.index, visible: shown.checked }));
+    const label = document.createElement('span');
+    label.textContent = `${o.name || 'object ' + o.index} (${o.vertices} vertices)`;
+    label.addEventListener('click', () => { state.objectSel = o.index; showObjects(doc); status(`object ${o.index} selected`); });
+    const up = document.createElement('button');
+    up.textContent = '▲';
+    up.title = 'raise';
+    up.disabled = o.index + 1 >= count;
+    up.addEventListener('click', () => void objectEdit('/api/object/order', { object: o.index, to: o.index + 1 }));
+    const down = document.createElement('button');
+    down.textContent = '▼';
+    down.title = 'lower';
+    down.disabled = o.index === 0;
+    down.addEventListener('click', () => void objectEdit('/api/object/order', { object: o.index, to: o.index - 1 }));
+    li.append(shown, label, up, down);
+    list.append(li);
+  }
+}
+async function objectEdit(url: string, body: Record<string, unknown>) {
+  await edit(async () => {
+    const f = await postFrame(url, { session: state.session, version: state.version, level: state.level, ...body });
+    applyDelta(f);
+    status(f.header.log);
+  });
 }
 
 // Runs an edit inside a task: on a version conflict (another tab's edit) reloads from the server,

@@ -72,6 +72,16 @@ try {
   await idle(page);
   check('undo: shown again', red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
 
+  // The Objects panel lists it: its checkbox hides it and shows it again.
+  const box = page.locator('#object-list input[type=checkbox]');
+  check('panel: one object listed, shown', (await box.count()) === 1 && (await box.first().isChecked()));
+  await box.first().uncheck();
+  await idle(page);
+  check('panel: unchecked hides it', !red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
+  await page.locator('#object-list input[type=checkbox]').first().check();
+  await idle(page);
+  check('panel: checked shows it', red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
+
   // Save in place: version 2 with one visible object, moved right.
   await page.keyboard.press('Control+s');
   await page.waitForFunction(() => /saved/.test(document.getElementById('status').textContent));
