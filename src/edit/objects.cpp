@@ -17,9 +17,9 @@
 #include "mesh/collapse_engine_p.h"
 #include "mesh/coarsen_p.h"
 #include "subvec/core/error.h"
+#include "subvec/edit/feature_edit.h"
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/validate.h"
-#include "subvec/edit/feature_edit.h"
 #include "subvec/render/renderer.h"
 
 namespace subvec {
@@ -209,9 +209,10 @@ int simplify_hole(coarsen_detail::Coarsener& c, const std::vector<uint8_t>& hole
 // (a curve vertex's row over its neighbours in the hole), minimizes
 //   sum over the hole's vertices and the curve's of |(L c)_v|^2
 //   + kCurveWeight * sum over the curve of |c_v - o_v|^2
-// where o_v is the mean of v's colors outside: a thin plate whose edge follows the colors around
-// the hole, and bends away from them only where they jump along the curve (what the fill could
-// not follow smoothly). Sets the colors of the hole's corners.
+// where o_v is the mean color of v's outside neighbours off the curve (past the colors that
+// fitted the tear's edge): a thin plate whose edge follows the colors around the hole, and bends
+// away from them where they jump along the curve (below: the pull is robust). Sets the colors of
+// the hole's corners.
 constexpr double kCurveWeight = 1.0;
 constexpr double kCurveRobust = 8.0;
 constexpr int kCurveIterations = 5;

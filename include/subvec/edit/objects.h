@@ -9,10 +9,10 @@
 //  - the level keeps the rest, and under the object a background is completed. The region's
 //    triangles stay (without their features and creases) and are simplified to the level's mean
 //    vertex density by half-edge collapses; their colors are the smoothest fill from the ring
-//    around the hole: the minimizer of the squared uniform Laplacian over the hole's vertices and
-//    the curve's, with the colors outside fixed (biharmonic), and the curve's inner colors set to
-//    the outer ones so the fill meets its surroundings without a step. The closed curve stays a
-//    tear of the level, so nothing outside the hole changes.
+//    around the hole: a thin plate (the squared uniform Laplacian over the hole's vertices and the
+//    curve's, biharmonic) whose values on the curve are pulled to the colors just outside it, a
+//    control edge off the tear, robustly, so that a stray color on the rim does not bend the
+//    fill. The closed curve stays a tear of the level, so nothing outside the hole changes.
 // A feature that crosses the curve at one of its vertices is split there, each side's part going
 // to its side.
 //
