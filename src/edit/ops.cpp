@@ -456,11 +456,8 @@ std::string apply_object_op(VectorImage& image, const EditOp& op, const std::str
         const int f = closed_feature_around(mesh, op.at);
         if (f < 0) refuse(where, "no closed feature of level " + std::to_string(op.level) + " encloses " + point(op.at));
         const std::string feature = feature_name(mesh, f);
+        // make_object drops the next level's pyramid link itself.
         const MakeObjectResult r = make_object(image, op.level, f, op.object_name);
-        if (op.level + 1 < static_cast<int>(image.levels.size())) {
-          image.levels[op.level + 1].parent_vertices.clear();
-          image.levels[op.level + 1].collapses.clear();
-        }
         return object_name(r.object) + " made of the region inside " + feature + ": " +
                std::to_string(r.object_vertices) + " vertices, " + std::to_string(r.features_moved) +
                (r.features_moved == 1 ? " feature" : " features") + " inside; the background under it has " +
