@@ -480,20 +480,16 @@ std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const Exp
                                              Shading shading, ExportReport& report) {
   const double scale = check_export_options(image, options);
   std::vector<ObjectMesh> out;
-  for (size_t o = 0; o < image.objects.size(); ++o) {
-    const Object& object = image.objects[o];
-    if (object.level != options.level || !object.visible) continue;
-    const MeshTopology topology = validate_object(object, image.width, image.height,
-                                                  static_cast<int>(image.levels.size()), static_cast<int>(o));
+  for (const ObjectTopology& o : visible_objects(image, options.level)) {
     ExportReport part;
-    RefinedMesh mesh = export_mesh_of(object.mesh, topology, scale, options, shading, part);
+    RefinedMesh mesh = export_mesh_of(image.objects[o.object].mesh, o.topology, scale, options, shading, part);
     report.depth = std::max(report.depth, part.depth);
     report.min_depth = std::min(report.min_depth, part.min_depth);
     report.triangles += part.triangles;
     report.max_position_error = std::max(report.max_position_error, part.max_position_error);
     report.max_color_error = std::max(report.max_color_error, part.max_color_error);
     ++report.objects;
-    out.push_back({static_cast<int>(o), std::move(mesh)});
+    out.push_back({o.object, std::move(mesh)});
   }
   return out;
 }

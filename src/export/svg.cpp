@@ -239,14 +239,11 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
   report.patches = mesh.num_triangles();
   paths = "<g>\n" + paths + "</g>\n";
   // Each object a group of its own patches over the level, bottom to top.
-  for (size_t o = 0; o < image.objects.size(); ++o) {
-    const Object& object = image.objects[o];
-    if (object.level != options.level || !object.visible) continue;
-    const MeshTopology t = validate_object(object, image.width, image.height,
-                                           static_cast<int>(image.levels.size()), static_cast<int>(o));
+  for (const ObjectTopology& o : visible_objects(image, options.level)) {
+    const Object& object = image.objects[o.object];
     std::string group;
-    mesh_patches(object.mesh, t, decimals, "o" + std::to_string(o) + "m", defs, group);
-    paths += "<g id=\"object-" + std::to_string(o) + "\"><title>" + xml_text(object.name) + "</title>\n" +
+    mesh_patches(object.mesh, o.topology, decimals, "o" + std::to_string(o.object) + "m", defs, group);
+    paths += "<g id=\"object-" + std::to_string(o.object) + "\"><title>" + xml_text(object.name) + "</title>\n" +
              group + "</g>\n";
     report.patches += object.mesh.num_triangles();
     ++report.objects;

@@ -489,6 +489,18 @@ MeshTopology validate_object(const Object& object, int width, int height, int nu
   return LevelValidator(object.mesh, width, height, prefix).run();
 }
 
+std::vector<ObjectTopology> visible_objects(const VectorImage& image, int level) {
+  std::vector<ObjectTopology> out;
+  for (size_t o = 0; o < image.objects.size(); ++o) {
+    const Object& object = image.objects[o];
+    if (object.level != level || !object.visible) continue;
+    out.push_back({static_cast<int>(o), validate_object(object, image.width, image.height,
+                                                        static_cast<int>(image.levels.size()),
+                                                        static_cast<int>(o))});
+  }
+  return out;
+}
+
 void validate(const VectorImage& image) {
   for (const auto& [name, value] : {std::pair{"width", image.width}, {"height", image.height}}) {
     if (value < 1)

@@ -88,14 +88,11 @@ namespace subvec {
 std::vector<ObjectView> object_views(const VectorImage& image, const RenderOptions& options) {
   const ViewFaces view = view_faces(image, options);
   std::vector<ObjectView> out;
-  for (size_t o = 0; o < image.objects.size(); ++o) {
-    const Object& object = image.objects[o];
-    if (object.level != options.level || !object.visible) continue;
-    const MeshTopology topology = validate_object(object, image.width, image.height,
-                                                  static_cast<int>(image.levels.size()), static_cast<int>(o));
+  for (const ObjectTopology& o : visible_objects(image, options.level)) {
+    const Object& object = image.objects[o.object];
     ObjectView v;
-    v.object = static_cast<int>(o);
-    const Subdivision subdivision(object.mesh, topology, view.depth);
+    v.object = o.object;
+    const Subdivision subdivision(object.mesh, o.topology, view.depth);
     subdivision.evaluate_once(object.mesh.positions, object.mesh.colors, v.refined,
                               detail::resolve_threads(options.threads));
     out.push_back(std::move(v));

@@ -38,9 +38,9 @@
 #include "core/messages_p.h"
 #include "core/parallel_p.h"
 #include "render/gpu/gpu_p.h"
+#include "render/objects_p.h"
 #include "render/raster_p.h"
 #include "render/renderer_p.h"
-#include "render/objects_p.h"
 #include "render/strokes_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/validate.h"
@@ -327,13 +327,13 @@ struct RefineCache {
   bool on_gpu = false;  // limit values live on the GPU (refined holds no values then)
 };
 
-// Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
 // Whether any visible object is drawn over `level`.
 bool has_objects(const VectorImage& image, int level) {
   return std::any_of(image.objects.begin(), image.objects.end(),
                      [&](const Object& o) { return o.level == level && o.visible; });
 }
 
+// Cuts the refined triangles into blocks (runs of one control face, at most 64 triangles) and
 // bounds each block's vertices.
 void update_blocks(const RefinedMesh& r, std::vector<detail::TriangleBlock>& blocks, int threads) {
   constexpr int32_t kBlock = 64;

@@ -1,6 +1,8 @@
 // Validation of a vector image: everything a reader, an editor or a renderer relies on.
 #pragma once
 
+#include <vector>
+
 #include "subvec/mesh/topology.h"
 #include "subvec/mesh/vector_image.h"
 
@@ -32,6 +34,14 @@ MeshTopology validate_level(const ControlMesh& mesh, int width, int height, int 
 // exactly two boundary edges), the triangles around each interior vertex make one full turn, and
 // positions may leave the image (within +-2^24 px). Messages start with "object N: ".
 MeshTopology validate_object(const Object& object, int width, int height, int num_levels, int index);
+
+// The visible objects drawn over `level`, bottom to top, each checked by validate_object: their
+// indices in image.objects and their topologies. What every drawing of the objects starts from.
+struct ObjectTopology {
+  int object = 0;
+  MeshTopology topology;
+};
+std::vector<ObjectTopology> visible_objects(const VectorImage& image, int level);
 
 // Checks the whole image: size, levels (at least one), every level, objects and strokes.
 void validate(const VectorImage& image);
