@@ -1061,7 +1061,21 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   // colors; inside it, where there is no data, the membrane alone sets them.
   constexpr double kMembrane = 1e-3;
   const double edge = mean_edge_near(mesh_in, polygon);
-  auto band_for = [&](double j) { return std::max({kBandEdges * edge, j / (2 * kRampSlope), 2.0}); };
+  // The band leaves data to hold the colors: it is at most a third of the image's smaller side
+  // wide, and inside a closed curve at most a third of the curve's extent, so that a core of what
+  // the curve bounds keeps its colors (outside, the ramp takes the width it needs). Unbounded,
+  // deleting the outline of examples/01-disk, a jump of 200 on a coarse 96-pixel image, made the
+  // band the whole image, and the membrane alone set every color: the picture went flat.
+  const double image_cap = std::min(width, height) / 3.0;
+  double inside_cap = image_cap;
+  if (gone.closed()) {
+    double x0 = polygon[0].x, x1 = x0, y0 = polygon[0].y, y1 = y0;
+    for (const Vec2& p : polygon) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+    inside_cap = std::max(2.0, std::max(x1 - x0, y1 - y0) / 3);
+  }
+  auto band_for = [&](double j) {
+    return std::max(2.0, std::min(image_cap, std::max(kBandEdges * edge, j / (2 * kRampSlope))));
+  };
   const double widest = band_for(*std::max_element(jump.begin(), jump.end()));
   const int rings = std::min(16, 2 + static_cast<int>(std::ceil(widest / std::max(edge, 1.0))));
   std::vector<uint8_t> seeds(mesh.num_vertices(), 0);
@@ -1076,12 +1090,32 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   const std::vector<Vec2> curve = sample_bspline(polygon, closed, kPerSpan);
   std::vector<uint8_t> band(size_t(width) * height, 0);
   const size_t n = polygon.size();
+  // Whether a point is inside the closed curve (crossings of a ray to its right).
+  auto inside_curve = [&](Vec2 p) {
+    bool inside = false;
+    for (size_t i = 0, k = curve.size() - 1; i < curve.size(); k = i++) {
+      const Vec2 a = curve[k], b = curve[i];
+      if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
+    }
+    return inside;
+  };
   for (size_t i = 0; i + 1 < curve.size(); ++i) {
     const size_t span = i / kPerSpan;
     const double t = double(i % kPerSpan) / kPerSpan;
     const double j = (1 - t) * jump[span % n] + t * jump[(span + 1) % n];
-    detail::for_pixels_near_segment(curve[i].x, curve[i].y, curve[i + 1].x, curve[i + 1].y, band_for(j), width,
-                                    height, [&](int x, int y) { band[size_t(y) * width + x] = 1; });
+    const double w = band_for(j);
+    detail::for_pixels_near_segment(curve[i].x, curve[i].y, curve[i + 1].x, curve[i + 1].y, w, width, height,
+                                    [&](int x, int y) {
+                                      const size_t k = size_t(y) * width + x;
+                                      if (band[k]) return;
+                                      if (closed && w > inside_cap) {
+                                        const Vec2 c{x + 0.5, y + 0.5};
+                                        if (inside_curve(c) &&
+                                            detail::segment_distance(c, curve[i], curve[i + 1]) > inside_cap)
+                                          return;
+                                      }
+                                      band[k] = 1;
+                                    });
   }
   // The band stops at the tears that stay: its control faces are those reached from the feature
   // without crossing a sharp edge, within the widest band (and two edges) of the curve.
