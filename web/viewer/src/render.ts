@@ -2,7 +2,8 @@
 // (src/render/renderer.cpp): the same view plan (visible faces from ring boxes, the depth rule in
 // output pixels), the same refinement (subdivide.ts), Gouraud-shaded limit triangles, then the
 // level's visible objects (src/render/objects.cpp: each refined at the level's depth, its boundary
-// a crease, drawn over the level in file order), then the strokes. Tears, the image border and the
+// a crease, drawn over the level in file order, each with its strokes over it), then the
+// strokes. Tears, the image border and the
 // objects' boundaries are anti-aliased by the canvas's 4x multisampling (the C++ rasterizer
 // supersamples those pixels 4 x 4): an object drawn opaque over the level's samples composites
 // with its coverage, as the C++ renderer's layer with alpha = coverage does; strokes by their
@@ -12,7 +13,7 @@
 //
 // A view reuses the last refinement when it needs the same level and depth and a subset of its
 // faces: zooming in within one depth, and panning within the refined region, only redraw.
-import { SvecError, type SvecImage } from './image';
+import { SvecError, type Stroke, type SvecImage } from './image';
 import { adaptiveIndices, buildTopology, refine, uniformIndices, type Refined, type Topology } from './wasm';
 import { strokeChords, type ViewTransform } from './strokes';
 
@@ -280,23 +281,26 @@ export class SubvecRenderer {
     const view: ViewTransform = { x0: w.x0, y0: w.y0, sx: width / (w.x1 - w.x0), sy: height / (w.y1 - w.y0), width, height };
 
     const t0 = performance.now();
-    const cache = this.#plan(image, w, view);
-    const meshes = [...(cache ? [cache] : []), ...this.#planObjects(image, w, view)];
+    const cache = this.#plan(image, w, view), layers = this.#planObjects(image, w, view);
+    const meshes = [cache, ...layers.map(([c]) => c)].filter((c): c is Cache => !!c);
     const t1 = performance.now();
     this.stats.refineMs = meshes.length ? t1 - t0 : 0;
     this.stats.triangles = meshes.reduce((n, c) => n + c.numIndices / 3, 0);
-    if (meshes.length) {
+    // The level, then each object and its strokes, then the image's strokes. (The mesh program is
+    // set again for each mesh: strokes between them use others.)
+    const draw = (c: Cache | null) => {
+      if (!c) return;
       if (!this.#meshLinked) this.#meshLinked = !!linked(gl, this.#mesh);
       gl.useProgram(this.#mesh);
       gl.uniform4f(gl.getUniformLocation(this.#mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
       gl.uniform2f(gl.getUniformLocation(this.#mesh, 'size'), width, height);
-      for (const c of meshes) {
-        gl.bindVertexArray(c.vao);
-        gl.drawElements(gl.TRIANGLES, c.numIndices, gl.UNSIGNED_INT, 0);
-      }
+      gl.bindVertexArray(c.vao);
+      gl.drawElements(gl.TRIANGLES, c.numIndices, gl.UNSIGNED_INT, 0);
       gl.bindVertexArray(null);
-    }
-    this.#drawStrokes(image, view);
+    };
+    draw(cache);
+    for (const [c, strokes] of layers) draw(c), this.#drawStrokes(strokes, view);
+    this.#drawStrokes(image.strokes, view);
     this.stats.drawMs = performance.now() - t1;
   }
 
@@ -338,16 +342,17 @@ export class SubvecRenderer {
   // 2.5-pixel edges, fewer steps past the triangle budget): an object's boundary is drawn by its
   // chords, which the viewer's coarser depth for the level would show as facets; the adaptive
   // triangles keep only what the tolerances need. Their topology has no image corners (width and
-  // height NaN): the boundary is all crease.
-  #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache[] {
-    const out: Cache[] = [];
+  // height NaN): the boundary is all crease. Each with its strokes, also when none of its faces is
+  // in view (null).
+  #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Array<[Cache | null, Stroke[]]> {
+    const out: Array<[Cache | null, Stroke[]]> = [];
     image.objects.forEach((object, i) => {
       if (object.level !== this.#level || !object.visible) return;
       const topo = (this.#objectTopologies[i] ??= buildTopology(object.mesh, NaN, NaN));
       const [visible] = visibleFaces(topo, w, view);
       let depth = this.#objectDepth;
       while (depth > 0 && visible.length * 4 ** depth > MAX_TRIANGLES) --depth;
-      if (visible.length) out.push((this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)));
+      out.push([visible.length ? (this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)) : null, object.strokes]);
     });
     return out;
   }
@@ -407,10 +412,10 @@ export class SubvecRenderer {
     this.#objectCaches = [];
   }
 
-  // Each stroke of the level: its coverage (the maximum over its chords) into a texture, then
-  // composited over the frame, in file order.
-  #drawStrokes(image: SvecImage, view: ViewTransform): void {
-    const strokes = image.strokes.filter((s) => s.level === this.#level && s.points.length >= 4);
+  // Each of the strokes of the level (the image's, or an object's): its coverage (the maximum over
+  // its chords) into a texture, then composited over the frame, in file order.
+  #drawStrokes(all: Stroke[], view: ViewTransform): void {
+    const strokes = all.filter((s) => s.level === this.#level && s.points.length >= 4);
     if (strokes.length === 0) return;
     const gl = this.#gl;
     const target = this.#coverageTarget(view.width, view.height);
