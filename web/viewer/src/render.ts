@@ -54,10 +54,10 @@ export function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom:
   return k;
 }
 
-// The shaders' text ships in the bundle, so it has no comments or indentation. view: the window's
-// origin (image pixels) and output pixels per image pixel; size: the output in pixels.
-const MESH_VS = `#version 300 es
-layout(location = 0) in vec2 position;
+// The shaders' text ships in the bundle, so it has no comments or indentation (and the build,
+// vite.config.ts, takes out the rest of its blanks); compile() puts the version line first. view:
+// the window's origin (image pixels) and output pixels per image pixel; size: the output in pixels.
+const MESH_VS = `layout(location = 0) in vec2 position;
 layout(location = 1) in vec3 color;
 uniform vec4 view;
 uniform vec2 size;
@@ -67,16 +67,14 @@ vec2 o = (position - view.xy) * view.zw;
 gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
 shade = color;
 }`;
-const MESH_FS = `#version 300 es
-precision highp float;
+const MESH_FS = `precision highp float;
 in vec3 shade;
 out vec4 outColor;
 void main() { outColor = vec4(clamp(shade / 255.0, 0.0, 1.0), 1.0); }`;
 
 // One instanced quad per chord, covering the chord's capsule plus a pixel: ends x0, y0, x1, y1 and
 // p, the pixel centre, in output pixels, y down.
-const CHORD_VS = `#version 300 es
-layout(location = 0) in vec2 corner;
+const CHORD_VS = `layout(location = 0) in vec2 corner;
 layout(location = 1) in vec4 ends;
 layout(location = 2) in vec2 radii;
 uniform vec2 size;
@@ -90,8 +88,7 @@ gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0)
 vEnds = ends;
 vRadii = radii;
 }`;
-const CHORD_FS = `#version 300 es
-precision highp float;
+const CHORD_FS = `precision highp float;
 in vec4 vEnds;
 in vec2 vRadii;
 uniform vec2 size;
@@ -105,11 +102,9 @@ float dist = length(p - (a + u * d)), r = mix(vRadii.x, vRadii.y, u);
 coverage = vec4(clamp(min(dist + r, 0.5) - max(dist - r, -0.5), 0.0, 1.0));
 }`;
 // Source-over of one stroke's color with its coverage (premultiplied output).
-const COMPOSITE_VS = `#version 300 es
-layout(location = 0) in vec2 corner;
+const COMPOSITE_VS = `layout(location = 0) in vec2 corner;
 void main() { gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0); }`;
-const COMPOSITE_FS = `#version 300 es
-precision highp float;
+const COMPOSITE_FS = `precision highp float;
 uniform sampler2D coverage;
 uniform vec3 color;
 out vec4 outColor;
@@ -125,7 +120,7 @@ function compile(gl: WebGL2RenderingContext, vs: string, fs: string): WebGLProgr
   for (const [type, source] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]] as const) {
     const shader = gl.createShader(type);
     if (!shader) throw new SvecError('WebGL2: cannot create a shader');
-    gl.shaderSource(shader, source);
+    gl.shaderSource(shader, `#version 300 es\n${source}`);
     gl.compileShader(shader);
     gl.attachShader(program, shader);
     gl.deleteShader(shader);
@@ -141,9 +136,11 @@ function linked(gl: WebGL2RenderingContext, program: WebGLProgram): WebGLProgram
   return program;
 }
 
+/** Whether w is a window: finite, x0 < x1 and y0 < y1. */
+export const validWindow = (w: ViewWindow): boolean => [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
+
 function checkWindow(w: ViewWindow): void {
-  const ok = [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
-  if (!ok) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
+  if (!validWindow(w)) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
 }
 
 // The refinement of the last view of a mesh (the level's, or an object's), on the GPU.
@@ -225,23 +222,27 @@ export class SubvecRenderer {
   // One empty draw in the mesh's state, so that the GPU process prepares its pipeline (software
   // GL compiles the shaders to machine code there) while the page decodes and refines the file.
   #warmUp(): void {
-    const gl = this.#gl;
-    const vao = gl.createVertexArray(), vertices = gl.createBuffer(), indices = gl.createBuffer();
-    gl.bindVertexArray(vao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
-    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(15), gl.STATIC_DRAW);
-    gl.enableVertexAttribArray(0);
-    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
-    gl.enableVertexAttribArray(1);
-    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
+    const gl = this.#gl, mesh = this.#meshArrays(new Float32Array(15));
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array([0, 1, 2]), gl.STATIC_DRAW);
     gl.useProgram(this.#mesh);
     gl.drawElements(gl.TRIANGLES, 3, gl.UNSIGNED_INT, 0);  // a degenerate triangle: no pixels
     gl.bindVertexArray(null);
-    gl.deleteVertexArray(vao);
-    gl.deleteBuffer(vertices);
-    gl.deleteBuffer(indices);
+    this.#drop(mesh);
+  }
+
+  // A vertex array over `vertices` (x, y, r, g, b each) and an index buffer, left bound.
+  #meshArrays(vertices: Float32Array): Pick<Cache, 'vao' | 'buffers'> {
+    const gl = this.#gl;
+    const vao = gl.createVertexArray()!, buffers = [gl.createBuffer()!, gl.createBuffer()!];
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, buffers[0]);
+    gl.bufferData(gl.ARRAY_BUFFER, vertices, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
+    gl.enableVertexAttribArray(1);
+    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers[1]);
+    return { vao, buffers };
   }
 
   /** Shows `image` (already validated by decode/load) at `level`. */
@@ -371,20 +372,9 @@ export class SubvecRenderer {
   }
 
   #upload(key: number, topo: Topology, faces: Int32Array | null, depth: number): Cache {
-    const gl = this.#gl;
-    const refined = refine(topo, faces, depth);
-    const vao = gl.createVertexArray()!;
-    const vertices = gl.createBuffer()!, indices = gl.createBuffer()!;
-    gl.bindVertexArray(vao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
-    gl.bufferData(gl.ARRAY_BUFFER, refined.vertices, gl.STATIC_DRAW);
-    gl.enableVertexAttribArray(0);
-    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
-    gl.enableVertexAttribArray(1);
-    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
-    gl.bindVertexArray(null);
-    return { level: key, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
+    const refined = refine(topo, faces, depth), mesh = this.#meshArrays(refined.vertices);
+    this.#gl.bindVertexArray(null);
+    return { level: key, depth, faces, refined, scale: NaN, numIndices: 0, ...mesh };
   }
 
   // The triangles to draw at this scale: each face as deep as it needs (the position tolerance is
@@ -400,7 +390,7 @@ export class SubvecRenderer {
     cache.numIndices = indices.length;
   }
 
-  #drop(cache: Cache | null | undefined): void {
+  #drop(cache: Pick<Cache, 'vao' | 'buffers'> | null | undefined): void {
     if (!cache) return;
     this.#gl.deleteVertexArray(cache.vao);
     for (const b of cache.buffers) this.#gl.deleteBuffer(b);

@@ -235,7 +235,7 @@ type Get = <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T;
 
 // wasm/image.h's JsonImage, JsonLevel, JsonObject, JsonStroke, JsonEntry (32-bit fields; an
 // Array is n, then a pointer), read back after wasm/validate.c has checked them.
-function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): SvecImage {
+function image(at: number, get: Get, i32: (at: number) => number): SvecImage {
   const f = (p: number, k: number) => i32(p + 4 * k);
   const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
   const text = (p: number, k: number) => utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
@@ -244,10 +244,7 @@ function image(at: number, get: Get, i32: (at: number) => number, binary: boolea
     return {
       positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles: ints(p, 4),
       triangleColors: ints(p, 6), creases: ints(p, 8),
-      features: Array.from({ length: nf }, (_, k): Feature => {
-        const id = f(f(p, 15), k), vertices = ints(f(p, 17) + 8 * k, 0);
-        return binary ? { id, saliency: saliency[k], vertices } : { id, vertices, saliency: saliency[k] };
-      }),
+      features: Array.from({ length: nf }, (_, k): Feature => ({ id: f(f(p, 15), k), saliency: saliency[k], vertices: ints(f(p, 17) + 8 * k, 0) })),
     };
   };
   const strokes = (p: number) => Array.from({ length: f(p, 0) }, (_, k): Stroke => {
@@ -264,12 +261,12 @@ function image(at: number, get: Get, i32: (at: number) => number, binary: boolea
 }
 
 /** A .svec.json file's image, validated, or a SvecError. */
-export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), (at, get, i32) => image(at, get, i32, false));
+export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), image);
 
 /** A .svec payload's image, validated, or a SvecError. `flags`: the header's (1: the payload
  * holds objects, 2: and their strokes). */
 export const readPayload = (b: Uint8Array, version: number, flags: number) =>
-  call((put, m) => m.payload(put(b), b.length, version, flags), (at, get, i32) => image(at, get, i32, true));
+  call((put, m) => m.payload(put(b), b.length, version, flags), image);
 
 /** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
  * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version, the flags. */
