@@ -309,11 +309,7 @@ export class SubvecRenderer {
   dispose(): void {
     this.#dropCache();
     const gl = this.#gl;
-    if (this.#coverage) {
-      gl.deleteTexture(this.#coverage.texture);
-      gl.deleteFramebuffer(this.#coverage.framebuffer);
-      this.#coverage = null;
-    }
+    this.#dropCoverage();
     gl.deleteProgram(this.#mesh);
     if (this.#strokePrograms) {
       gl.deleteProgram(this.#strokePrograms.chord);
@@ -470,13 +466,18 @@ export class SubvecRenderer {
     return this.#strokePrograms;
   }
 
+  #dropCoverage(): void {
+    if (this.#coverage) {
+      this.#gl.deleteTexture(this.#coverage.texture);
+      this.#gl.deleteFramebuffer(this.#coverage.framebuffer);
+    }
+    this.#coverage = null;
+  }
+
   #coverageTarget(width: number, height: number) {
     const gl = this.#gl;
     if (this.#coverage && this.#coverage.width === width && this.#coverage.height === height) return this.#coverage;
-    if (this.#coverage) {
-      gl.deleteTexture(this.#coverage.texture);
-      gl.deleteFramebuffer(this.#coverage.framebuffer);
-    }
+    this.#dropCoverage();
     const texture = gl.createTexture()!;
     gl.bindTexture(gl.TEXTURE_2D, texture);
     gl.texStorage2D(gl.TEXTURE_2D, 1, gl.R8, width, height);

@@ -11,7 +11,7 @@ import { Decompress } from 'fzstd';
 import type { Feature, Level, Stroke, SvecImage, SvecObject } from './image';
 import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
-import { WASM, WASM_BYTES } from './wasm-binary';
+import { WASM, WASM_BYTES, WASM_SIZE } from './wasm-binary';
 
 export { uniformIndices, type Refined, type Topology } from './subdivide';
 
@@ -33,8 +33,8 @@ interface Exports {
 let instance: Exports | null = null;
 const MAX_KEPT = 64 * 2 ** 20; // an arena grown past this is dropped after the call
 
-// The module's bytes: base 116 (wasm/build: 7 characters, 1 to 126 without 7 to 13, escape, '
-// and \, per 6 bytes, big-endian) of its zstd frame.
+// The module's bytes (WASM_SIZE of them): base 116 (wasm/build: 7 characters, 1 to 126 without 7
+// to 13, escape, ' and \, per 6 bytes, big-endian) of its zstd frame.
 function unpack(): Uint8Array<ArrayBuffer> {
   const packed = new Uint8Array((WASM.length / 7) * 6);
   for (let i = 0, o = 0; i < WASM.length; o += 6) {
@@ -45,10 +45,9 @@ function unpack(): Uint8Array<ArrayBuffer> {
     }
     for (let k = o + 6; k-- > o; v = Math.floor(v / 256)) packed[k] = v % 256;
   }
-  const parts: Uint8Array[] = [];
-  new Decompress((part) => parts.push(part)).push(packed.subarray(0, WASM_BYTES), true);
-  const bytes = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  parts.reduce((at, p) => (bytes.set(p, at), at + p.length), 0);
+  const bytes = new Uint8Array(WASM_SIZE);
+  let at = 0;
+  new Decompress((part) => (bytes.set(part, at), (at += part.length))).push(packed.subarray(0, WASM_BYTES), true);
   return bytes;
 }
 

@@ -803,7 +803,7 @@ EXPORT(container) double *container(const uint8_t *file, int32_t n) {
   __builtin_memcpy(&version, file + 8, 4), __builtin_memcpy(&flags, file + 12, 4), __builtin_memcpy(&size, file + 16, 8), __builtin_memcpy(&frame, file + 24, 8);
   if (version < 1 || version > 3) say_start(), say("unsupported .svec version "), say_number(AS_INTEGER, version), say(" (this build reads 1, 2 and 3)"), say_fail();
   if (flags & ~3u) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows 1: objects, 2: object strokes)"), say_fail();
-  if (flags == 2) say_start(), say(".svec flag 2 (object strokes) without flag 1 (objects)"), say_fail();
+  if (flags == 2) say_start(), say(".svec flag 2 (object strokes) is set without flag 1 (objects)"), say_fail();
   if (size > 1073741824) say_start(), say("declared payload of "), say_u64(size), say(" bytes is over the limit of 1073741824"), say_fail();
   if (frame > available)
     say_start(), say("truncated .svec file: the header declares a "), say_u64(frame), say("-byte zstd frame but only "), say_u64(available), say(" bytes follow"), say_fail();
