@@ -37,6 +37,7 @@ struct StylizeArgs {
   bool threshold_given = false;
   uint64_t seed = 1;
   double probability = 0.3;
+  int object = -1;  // -1: the level's own mesh
 };
 
 // Parses "X,Y,W,H" (W, H > 0); returns an error message, or "" and fills `r`.
@@ -88,6 +89,7 @@ void run_stylize(const StylizeArgs& a) {
   if (a.threshold_given) options.threshold = a.threshold;
   options.seed = a.seed;
   options.probability = a.probability;
+  if (a.object >= 0) options.object = a.object;
   const int num_levels = static_cast<int>(image.levels.size());
   if (a.level >= num_levels) {
     throw Error(ErrorCode::kInvalidArgument,
@@ -157,10 +159,16 @@ void add_edit_commands(CLI::App& app) {
       ->add_option("--probability", sa.probability,
                    "Chance that a feature below the threshold gets a stroke (default 0.3)")
       ->check(CLI::Range(0.0, 1.0));
+  stylize
+      ->add_option("--object", sa.object,
+                   "Stroke the features of object N (its strokes move with it; --level is then "
+                   "the object's)")
+      ->check(CLI::NonNegativeNumber);
   stylize->footer(
       "Examples:\n"
       "  subvec stylize apple.svec -o styled.svec\n"
-      "  subvec stylize apple.svec -o styled.svec --roi 100,80,300,300 --threshold 150 --seed 7");
+      "  subvec stylize apple.svec -o styled.svec --roi 100,80,300,300 --threshold 150 --seed 7\n"
+      "  subvec stylize moved.svec -o styled.svec --object 0");
   stylize->callback([threshold] {
     sa.threshold_given = threshold->count() > 0;
     run_stylize(sa);

@@ -299,7 +299,8 @@ void run_info(const std::string& input, bool json) {
                               {"visible", o.visible},
                               {"vertices", o.mesh.num_vertices()},
                               {"triangles", o.mesh.num_triangles()},
-                              {"features", o.mesh.features.size()}});
+                              {"features", o.mesh.features.size()},
+                              {"strokes", o.strokes.size()}});
     }
     j["strokes"] = image.strokes.size();
     j["metadata"] = nlohmann::ordered_json::object();
@@ -330,11 +331,11 @@ void run_info(const std::string& input, bool json) {
                 l.colors, l.features, l.tear_edges, l.crease_edges, l.corners);
   }
   if (image.objects.empty()) return;
-  std::printf("\n  object  level  vertices  triangles  features  visible  name\n");
+  std::printf("\n  object  level  vertices  triangles  features  strokes  visible  name\n");
   for (size_t i = 0; i < image.objects.size(); ++i) {
     const subvec::Object& o = image.objects[i];
-    std::printf("  %6zu  %5d  %8d  %9d  %8zu  %7s  %s\n", i, o.level, o.mesh.num_vertices(),
-                o.mesh.num_triangles(), o.mesh.features.size(), o.visible ? "yes" : "no",
+    std::printf("  %6zu  %5d  %8d  %9d  %8zu  %7zu  %7s  %s\n", i, o.level, o.mesh.num_vertices(),
+                o.mesh.num_triangles(), o.mesh.features.size(), o.strokes.size(), o.visible ? "yes" : "no",
                 one_line(o.name).c_str());
   }
 }

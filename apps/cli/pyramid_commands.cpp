@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "subvec/core/error.h"
@@ -37,6 +38,7 @@ struct FilterArgs {
   std::string input, output, eta_levels;
   double eta = 1;
   bool geometry = false, color = false;
+  int object = -1;  // -1: the levels
 };
 
 void run_filter(const FilterArgs& a, bool eta_given) {
@@ -44,13 +46,16 @@ void run_filter(const FilterArgs& a, bool eta_given) {
   const subvec::VectorImage image = subvec::read_svec(a.input);
   std::vector<double> etas = {a.eta};
   if (!eta_given && !a.eta_levels.empty()) parse_numbers(a.eta_levels, etas);  // validated by CLI11
-  const int bands = static_cast<int>(image.levels.size()) - 1;
+  std::optional<int> object;
+  if (a.object >= 0) object = a.object;
+  const int bands = subvec::filter_bands(image, object);
   if (bands >= 1 && static_cast<int>(etas.size()) > bands) {
     throw Error(ErrorCode::kInvalidArgument, "--eta-levels has " + std::to_string(etas.size()) +
                                                  " values but '" + a.input + "' has " +
                                                  std::to_string(bands) + (bands == 1 ? " band" : " bands"));
   }
   subvec::FilterOptions options;
+  options.object = object;
   // Colors by default (the image's frequencies live there); --geometry-eta adds or, alone, selects
   // the positions.
   const bool color = a.color || !a.geometry;
@@ -65,8 +70,9 @@ void run_filter(const FilterArgs& a, bool eta_given) {
     std::snprintf(buf, sizeof buf, "%s%g", i ? "," : "", etas[i]);
     list += buf;
   }
-  std::printf("%s -> %s: %d bands, eta %s on %s%s\n", a.input.c_str(), a.output.c_str(), report.bands,
-              list.c_str(), a.geometry && color ? "geometry and color" : a.geometry ? "geometry" : "color",
+  const std::string what = object ? " of object " + std::to_string(*object) : "";
+  std::printf("%s -> %s: %d bands%s, eta %s on %s%s\n", a.input.c_str(), a.output.c_str(), report.bands,
+              what.c_str(), list.c_str(), a.geometry && color ? "geometry and color" : a.geometry ? "geometry" : "color",
               report.restored_vertices > 0
                   ? (", " + std::to_string(report.restored_vertices) + " vertices held back from folding").c_str()
                   : "");
@@ -98,12 +104,17 @@ void add_pyramid_commands(CLI::App& app) {
   filter->add_flag("--geometry-eta", fa.geometry,
                    "Scale the position details (alone: positions only; with --color-eta: both)");
   filter->add_flag("--color-eta", fa.color, "Scale the color details (the default when neither flag is given)");
+  filter
+      ->add_option("--object", fa.object,
+                   "Filter object N alone, through a pyramid made from its own mesh (at least 2 bands)")
+      ->check(CLI::NonNegativeNumber);
   filter->footer(
       "Examples:\n"
       "  subvec filter photo.svec -o smooth.svec --eta 0.3            # low-pass\n"
       "  subvec filter photo.svec -o sharp.svec --eta 1.8             # enhance color detail\n"
       "  subvec filter photo.svec -o calm.svec --eta 0.5 --geometry-eta --color-eta  # both\n"
-      "  subvec filter photo.svec -o band.svec --eta-levels 0.2,1      # damp the finest band only");
+      "  subvec filter photo.svec -o band.svec --eta-levels 0.2,1      # damp the finest band only\n"
+      "  subvec filter moved.svec -o soft.svec --eta 0.3 --object 0     # one object");
   filter->callback([eta] { run_filter(fa, eta->count() > 0); });
 }
 

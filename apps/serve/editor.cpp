@@ -59,6 +59,12 @@ struct Editor::Session {
 
 namespace {
 
+// Whether any object carries strokes (the page then reloads the strokes after object edits).
+bool has_object_strokes(const VectorImage& image) {
+  return std::any_of(image.objects.begin(), image.objects.end(),
+                     [](const subvec::Object& o) { return !o.strokes.empty(); });
+}
+
 uint8_t to_byte(float v) {
   if (!(v > 0)) return 0;
   if (v >= 255) return 255;
@@ -225,7 +231,7 @@ DocumentInfo Editor::info(const std::string& session) const {
     info.levels.push_back(level);
   }
   for (const subvec::Object& o : image_.objects) {
-    info.objects.push_back({o.level, o.name, o.visible, o.mesh.num_vertices()});
+    info.objects.push_back({o.level, o.name, o.visible, o.mesh.num_vertices(), static_cast<int>(o.strokes.size())});
   }
   // A session's tab counts its own steps (an unknown session: none of them).
   const auto mine = [&](const std::vector<HistoryStep>& steps) {
@@ -240,7 +246,7 @@ DocumentInfo Editor::info(const std::string& session) const {
   info.undo = mine(undo_);
   info.redo = mine(redo_);
   info.strokes = static_cast<int>(image_.strokes.size());
-  info.bands = subvec::has_pyramid(image_) ? static_cast<int>(image_.levels.size()) - 1 : 0;
+  info.bands = subvec::filter_bands(image_);  // 0 for one level
   if (filter_version_ == version_) info.filter = filter_;
   return info;
 }
@@ -559,7 +565,16 @@ std::vector<StrokeGeometry> Editor::strokes(int level) const {
   std::lock_guard lock(mutex_);
   check_level_locked(level);
   std::vector<StrokeGeometry> out;
-  for (const subvec::Stroke& s : image_.strokes) {
+  // The visible objects' strokes (bottom to top), then the level's, which the renderer draws
+  // last. (Where objects overlap, the renderer draws an object's strokes under the objects above
+  // it; the page draws every stroke over every object.)
+  std::vector<const subvec::Stroke*> strokes;
+  for (const subvec::Object& o : image_.objects)
+    if (o.level == level && o.visible)
+      for (const subvec::Stroke& s : o.strokes) strokes.push_back(&s);
+  for (const subvec::Stroke& s : image_.strokes) strokes.push_back(&s);
+  for (const subvec::Stroke* stroke : strokes) {
+    const subvec::Stroke& s = *stroke;
     if (s.level != level || s.points.size() < 2) continue;
     const std::vector<Vec2> line = subvec::sample_bspline(s.points, false, 8);
     std::vector<double> at(line.size(), 0);
@@ -818,9 +833,10 @@ Delta Editor::drag_end(const std::string& session_id, int64_t version, Vec2 to, 
       refuse_edit(Error(e.code(), without_op_prefix(e.what())));
     }
   }
-  // The level's strokes moved with it (apply_edit_ops carries them along).
-  const bool strokes_moved = std::any_of(edited.strokes.begin(), edited.strokes.end(),
-                                         [&](const subvec::Stroke& s) { return s.level == op.level; });
+  // The level's strokes (or the object's) moved with it (apply_edit_ops carries them along).
+  const bool strokes_moved = op.in_object ? !edited.objects[op.object].strokes.empty()
+                                          : std::any_of(edited.strokes.begin(), edited.strokes.end(),
+                                                        [&](const subvec::Stroke& s) { return s.level == op.level; });
   commit_locked(std::move(edited), edit_label(op), session);
   return delta_locked(session, nullptr, strokes_moved);
 }
@@ -862,8 +878,10 @@ Delta Editor::apply(const std::string& session_id, int64_t version, const EditOp
   if (op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature || object_edit) {
     log = lines.empty() ? edit_label(op) : without_op_prefix(lines.front());
     session.drag.reset();
+    // An object's strokes move, hide and reorder with it (and making one takes the level's).
+    const bool strokes_changed = object_edit && (has_object_strokes(image_) || has_object_strokes(edited));
     commit_locked(std::move(edited), edit_label(op), session);
-    return delta_locked(session, nullptr, false);
+    return delta_locked(session, nullptr, strokes_changed);
   }
   if (op.kind == EditOp::Kind::kMoveVertices) {  // an arrow-key nudge
     const auto px = [](double v) { return std::to_string(std::lround(v)); };
@@ -904,14 +922,15 @@ double Editor::suggested_region(int level, const std::vector<int32_t>& vertices)
 }
 
 Delta Editor::stylize(const std::string& session_id, int64_t version, int level,
-                      std::optional<double> threshold, uint64_t seed, double probability,
-                      std::string& log) {
+                      std::optional<int> object, std::optional<double> threshold, uint64_t seed,
+                      double probability, std::string& log) {
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
   check_level_locked(level);
   subvec::StylizeOptions options;
   options.level = level;
+  options.object = object;
   options.threshold = threshold;
   options.seed = seed;
   options.probability = probability;
@@ -936,13 +955,18 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
   std::lock_guard lock(mutex_);
   Session& session = session_locked(session_id);
   check_version_locked(version);
-  const bool continues = filter_version_ == version_;
+  // A slider's next value filters the image it started from, while it filters the same thing.
+  const bool continues = filter_version_ == version_ && filter_.object == request.object;
   const VectorImage& base = continues ? filter_base_ : image_;
-  if (!subvec::has_pyramid(base)) {
+  if (request.object && (*request.object < 0 || *request.object >= static_cast<int>(base.objects.size()))) {
+    throw RequestError(kBadRequest, "\"object\" " + std::to_string(*request.object) + " is out of range (" +
+                                        std::to_string(base.objects.size()) + " objects)");
+  }
+  if (!request.object && base.levels.size() < 2) {
     throw RequestError(kUnprocessable, "this image has no level pyramid to filter (make one with "
                                        "subvec vectorize --levels 2 or more)");
   }
-  const int bands = static_cast<int>(base.levels.size()) - 1;
+  const int bands = subvec::filter_bands(base, request.object);
   if (request.eta.empty() || static_cast<int>(request.eta.size()) > bands) {
     throw RequestError(kBadRequest, "\"eta\" must have 1 to " + std::to_string(bands) +
                                         " values (one per band)");
@@ -961,6 +985,7 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
     filtered = base;
   } else {
     subvec::FilterOptions options;
+    options.object = request.object;
     if (request.geometry) options.geometry_eta = request.eta;
     if (request.color) options.color_eta = request.eta;
     try {
@@ -976,7 +1001,8 @@ Delta Editor::filter(const std::string& session_id, int64_t version, const Filte
   filter_ = request;
   session.drag.reset();
   log = identity ? "filter off: the image before filtering"
-                 : "filtered " + std::to_string(bands) + (bands == 1 ? " band" : " bands") + " on " +
+                 : "filtered " + std::to_string(bands) + (bands == 1 ? " band" : " bands") +
+                       (request.object ? " of object " + std::to_string(*request.object) : std::string()) + " on " +
                        (request.geometry && request.color ? "geometry and color"
                         : request.geometry              ? "geometry"
                                                         : "color") +
@@ -1009,7 +1035,8 @@ Delta Editor::step_history(const std::string& session_id, int64_t version,
                                       " waits: the last edit was made in another window, which can undo it");
   }
   // Strokes move with shape edits, so any may differ: the page reloads them when there are any.
-  const bool strokes_changed = !from.back().image.strokes.empty() || !image_.strokes.empty();
+  const bool strokes_changed = !from.back().image.strokes.empty() || !image_.strokes.empty() ||
+                               has_object_strokes(from.back().image) || has_object_strokes(image_);
   label = from.back().label;
   to.push_back({std::move(image_), label, session.tab});
   image_ = std::move(from.back().image);

@@ -139,6 +139,7 @@ struct StrokeGeometry {
 struct FilterRequest {
   std::vector<double> eta;
   bool geometry = false, color = true;
+  std::optional<int> object;  // filter this object alone (FilterOptions::object)
 };
 
 struct DocumentInfo {
@@ -154,6 +155,7 @@ struct DocumentInfo {
     std::string name;
     bool visible = true;
     int vertices = 0;
+    int strokes = 0;  // its own (Object::strokes)
   };
   std::vector<ObjectEntry> objects;  // bottom to top
   int undo = 0, redo = 0;
@@ -247,8 +249,9 @@ class Editor {
               std::string& log);
   // The deformation's extent local to a selection of control vertices (suggested_drag_extent).
   double suggested_region(int level, const std::vector<int32_t>& vertices) const;
-  Delta stylize(const std::string& session, int64_t version, int level, std::optional<double> threshold,
-                uint64_t seed, double probability, std::string& log);
+  // Stylizes `level`, or `object`'s own features (apply_stylize).
+  Delta stylize(const std::string& session, int64_t version, int level, std::optional<int> object,
+                std::optional<double> threshold, uint64_t seed, double probability, std::string& log);
   // Filters the pyramid (subvec::filter). The sliders are absolute: a filter that directly follows
   // another (no edit, undo or redo between them) replaces it, i.e. filters the image the first one
   // started from, so eta = 1 everywhere gives that image back exactly. Each one is an undo step.

@@ -542,7 +542,8 @@ void EditorServer::Impl::document_routes() {
     }
     json objects = json::array();
     for (const auto& o : info.objects) {
-      objects.push_back({{"level", o.level}, {"name", o.name}, {"visible", o.visible}, {"vertices", o.vertices}});
+      objects.push_back({{"level", o.level}, {"name", o.name}, {"visible", o.visible}, {"vertices", o.vertices},
+                         {"strokes", o.strokes}});
     }
     json save = nullptr;
     if (options.output) save = options.output->string();
@@ -881,8 +882,10 @@ void EditorServer::Impl::edit_routes() {
     if (seed < 0) throw RequestError(kBadRequest, "\"seed\" must be >= 0");
     std::shared_ptr<Editor> doc = ready_editor();
     std::string log;
+    std::optional<int> object;
+    if (j.contains("object") && !j["object"].is_null()) object = small_int(j, "object", 0);
     const Delta d = doc->stylize(text(j, "session"), integer(j, "version"),
-                                    small_int(j, "level", 0), threshold,
+                                    small_int(j, "level", 0), object, threshold,
                                     static_cast<uint64_t>(seed), number(j, "probability", 0.3), log);
     res.set_content(delta_frame(d, {{"version", doc->version()}, {"log", log}}),
                     "application/octet-stream");
@@ -916,6 +919,7 @@ void EditorServer::Impl::edit_routes() {
     }
     request.geometry = flag(j, "geometry", false);
     request.color = flag(j, "color", true);
+    if (j.contains("object") && !j["object"].is_null()) request.object = small_int(j, "object", 0);
     std::shared_ptr<Editor> doc = ready_editor();
     std::string log;
     const Delta d = doc->filter(text(j, "session"), integer(j, "version"), request, log);

@@ -249,7 +249,7 @@ py::list object_list(const VectorImage& image) {
   for (const subvec::Object& o : image.objects) {
     objects.append(py::dict("level"_a = o.level, "name"_a = o.name, "visible"_a = o.visible,
                             "vertices"_a = o.mesh.num_vertices(), "triangles"_a = o.mesh.num_triangles(),
-                            "features"_a = o.mesh.features.size()));
+                            "features"_a = o.mesh.features.size(), "strokes"_a = o.strokes.size()));
   }
   return objects;
 }
@@ -750,15 +750,17 @@ void def_edit_parts(PyVectorImage& vi) {
 
 // Stylization, saliency, subdivision, the pyramid's filter and pickling.
 void def_analysis(PyVectorImage& vi) {
-  // Stylization (edit/stylize.h, apply_stylize): replaces the level's strokes in the region with
-  // new ones and reports what it did.
+  // Stylization (edit/stylize.h, apply_stylize): replaces the level's strokes (or, with `object`,
+  // that object's) in the region with new ones and reports what it did.
   vi.def(
           "stylize",
           [](VectorImage& v, int level, std::optional<std::array<double, 4>> roi,
-             std::optional<double> threshold, uint64_t seed, double probability) {
+             std::optional<double> threshold, uint64_t seed, double probability, std::optional<int> object) {
             check_level(v, level);
+            if (object) object_index(v, *object);
             subvec::StylizeOptions options;
             options.level = level;
+            options.object = object;
             if (roi) options.roi = subvec::Rect{(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]};
             options.threshold = threshold;
             options.seed = seed;
@@ -773,7 +775,7 @@ void def_analysis(PyVectorImage& vi) {
                             "strokes"_a = report.strokes, "replaced"_a = report.replaced);
           },
           py::kw_only(), "level"_a = 0, "roi"_a = py::none(), "threshold"_a = py::none(),
-          "seed"_a = 1, "probability"_a = 0.3)
+          "seed"_a = 1, "probability"_a = 0.3, "object"_a = py::none())
       .def(
           "saliency",
           [](const VectorImage& v, int level) {
@@ -816,19 +818,23 @@ void def_analysis(PyVectorImage& vi) {
                 "color_stencils"_a = csr(sub->color_stencils()));
           },
           py::kw_only(), "level"_a = 0, "depth"_a = 3, "limit"_a = true)
-      // Levels of abstraction (pyramid/pyramid.h): a new image with every level filtered.
+      // Levels of abstraction (pyramid/pyramid.h): a new image with every level (or one object)
+      // filtered.
       .def_property_readonly("has_pyramid", [](const VectorImage& v) { return subvec::has_pyramid(v); })
       .def(
           "filter",
-          [](const VectorImage& v, std::vector<double> geometry_eta, std::vector<double> color_eta) {
+          [](const VectorImage& v, std::vector<double> geometry_eta, std::vector<double> color_eta,
+             std::optional<int> object) {
+            if (object) object_index(v, *object);
             subvec::FilterOptions options;
             options.geometry_eta = std::move(geometry_eta);
             options.color_eta = std::move(color_eta);
+            options.object = object;
             py::gil_scoped_release release;
             return subvec::filter(v, options);
           },
           py::kw_only(), "geometry_eta"_a = std::vector<double>{},
-          "color_eta"_a = std::vector<double>{})
+          "color_eta"_a = std::vector<double>{}, "object"_a = py::none())
       .def(py::pickle(
           [](const VectorImage& v) {
             subvec::SvecWriteOptions options;

@@ -166,45 +166,6 @@ ControlMesh object_mesh(const ControlMesh& mesh, const MeshTopology& topology,
   return o;
 }
 
-// Removes interior vertices of the hole (`hole_vertex`) by half-edge collapses, shortest edge
-// first, until `target` of them remain or none can go. Returns how many went.
-int simplify_hole(coarsen_detail::Coarsener& c, const std::vector<uint8_t>& hole_vertex, int target) {
-  const int nv = c.num_vertices();
-  int remaining = 0;
-  for (int v = 0; v < nv; ++v) remaining += hole_vertex[v];
-  detail::CollapseQueue queue;
-  std::vector<uint32_t> version(nv, 0);
-  auto plan = [&](int32_t u, int32_t v) {
-    if (!hole_vertex[u]) return;
-    const Vec2 a = c.positions()[u], b = c.positions()[v];
-    queue.push(detail::make_entry((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y), u, v,
-                                  version[u], version[v]));
-  };
-  std::vector<int32_t> ring, ring2;
-  for (int32_t v = 0; v < nv; ++v) {
-    if (!hole_vertex[v]) continue;
-    c.neighbours(v, ring);
-    for (const int32_t w : ring) plan(v, w);
-  }
-  int removed = 0;
-  const auto more = [&] { return remaining > target; };
-  const auto live = [&](const detail::Entry& e) { return detail::entry_live(e, c.vertex_alive(), version); };
-  const auto step = [&](const detail::Entry& e) {
-    const int32_t u = e.remove(), v = e.keep;
-    if (!c.can_collapse(u, v, 0.0)) return;
-    c.neighbours(u, ring);
-    c.collapse(u, v);
-    --remaining, ++removed;
-    for (const int32_t w : ring) ++version[w];
-    for (const int32_t w : ring) {
-      c.neighbours(w, ring2);
-      for (const int32_t x : ring2) plan(w, x), plan(x, w);
-    }
-  };
-  detail::run_collapses(queue, nullptr, more, live, step);
-  return removed;
-}
-
 // The smoothest fill of the hole's colors. With L the uniform Laplacian of the hole's triangles
 // (a curve vertex's row over its neighbours in the hole), minimizes
 //   sum over the hole's vertices and the curve's of |(L c)_v|^2
@@ -309,6 +270,28 @@ void fill_hole_colors(ControlMesh& mesh, const std::vector<uint8_t>& hole_face) 
   }
 }
 
+// Whether p is inside the closed polygon through `points` (last joined to first; a repeated first
+// point adds nothing), by the crossings of a ray to its right.
+bool inside_polygon(std::span<const Vec2> points, Vec2 p) {
+  bool inside = false;
+  for (size_t i = 0, j = points.size() - 1; i < points.size(); j = i++) {
+    const Vec2 a = points[j], b = points[i];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
+  }
+  return inside;
+}
+
+// Whether p lies on the closed polygon through `points` (within 1e-6 px).
+bool on_polygon(std::span<const Vec2> points, Vec2 p) {
+  for (size_t i = 0, j = points.size() - 1; i < points.size(); j = i++) {
+    const Vec2 a = points[j], b = points[i];
+    const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+    const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+    if (std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y) <= 1e-6) return true;
+  }
+  return false;
+}
+
 Object& object_at(VectorImage& image, int object) {
   if (object < 0 || object >= static_cast<int>(image.objects.size())) {
     invalid("object " + std::to_string(object) + " is out of range (" +
@@ -329,6 +312,8 @@ MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<in
   const ControlMesh& mesh = image.levels[level];
   const std::vector<uint8_t> inside = inside_faces(mesh, topology, cycle, what);
   const std::vector<uint8_t> on_curve = cycle_edges(topology, cycle);
+  std::vector<Vec2> curve;
+  for (const int32_t v : cycle) curve.push_back(mesh.positions[v]);
 
   int32_t next_id = 0;
   for (const Feature& f : mesh.features) next_id = std::max(next_id, f.id + 1);
@@ -380,7 +365,7 @@ MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<in
   std::vector<int32_t> kept;
   for (const Feature& f : back.features) kept.push_back(f.id);
   coarsen_detail::Coarsener coarsener(back, image.width, image.height, kept);
-  result.removed = simplify_hole(coarsener, hole_vertex, target);
+  result.removed = static_cast<int>(coarsen_detail::collapse_shortest_first(coarsener, hole_vertex, target).size());
   std::vector<int32_t> parents, color_merged;
   back = coarsener.result(parents, color_merged);
   // The hole's faces after the collapses: those inside the curve (whose vertices all stay),
@@ -393,9 +378,22 @@ MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<in
   fill_hole_colors(back, hole);
   for (const int32_t p : parents) result.fill_vertices += hole_vertex[p];
 
+  // The level's strokes on the object (at least half their points inside the curve or on it: the
+  // curve's own stroke outlines the object) go with it.
+  std::vector<Stroke> strokes;
+  for (const Stroke& stroke : image.strokes) {
+    size_t in_curve = 0;
+    if (stroke.level == level) {
+      for (const Vec2& p : stroke.points) in_curve += inside_polygon(curve, p) || on_polygon(curve, p);
+    }
+    (2 * in_curve >= stroke.points.size() && in_curve > 0 ? object.strokes : strokes).push_back(stroke);
+  }
+  result.strokes_moved = static_cast<int>(object.strokes.size());
+
   validate_level(back, image.width, image.height, level);
   validate_object(object, image.width, image.height, static_cast<int>(image.levels.size()),
                   static_cast<int>(image.objects.size()));
+  image.strokes = std::move(strokes);
   image.levels[level] = std::move(back);
   if (level + 1 < static_cast<int>(image.levels.size())) {
     image.levels[level + 1].parent_vertices.clear();
@@ -524,11 +522,9 @@ int closed_feature_around(const ControlMesh& mesh, Vec2 p) {
   for (int f = 0; f < static_cast<int>(mesh.features.size()); ++f) {
     const Feature& feature = mesh.features[f];
     if (!feature.closed()) continue;
-    bool inside = false;  // crossings of a ray to the right of p
-    for (size_t i = 0; i + 1 < feature.vertices.size(); ++i) {
-      const Vec2 a = mesh.positions[feature.vertices[i]], b = mesh.positions[feature.vertices[i + 1]];
-      if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
-    }
+    std::vector<Vec2> polygon;
+    for (const int32_t v : feature.vertices) polygon.push_back(mesh.positions[v]);
+    const bool inside = inside_polygon(polygon, p);
     const double area = polygon_area(mesh, feature);
     if (inside && (best < 0 || area < best_area)) best = f, best_area = area;
   }
@@ -556,16 +552,20 @@ void transform_object(VectorImage& image, int object, const ObjectTransform& tra
   detail::check_positive("scale", transform.scale);
   const double angle = transform.rotate_degrees * std::numbers::pi / 180;
   const double c = transform.scale * std::cos(angle), s = transform.scale * std::sin(angle);
-  std::vector<Vec2> moved = o.mesh.positions;
-  for (Vec2& p : moved) {
+  auto move = [&](Vec2& p) {
     const double x = p.x - pivot.x, y = p.y - pivot.y;
     p = {pivot.x + c * x - s * y + transform.translate.x, pivot.y + s * x + c * y + transform.translate.y};
+  };
+  Object check = o;
+  for (Vec2& p : check.mesh.positions) move(p);
+  // Its strokes move with it, their widths scaled (a stroke is the same shape at any scale).
+  for (Stroke& stroke : check.strokes) {
+    for (Vec2& p : stroke.points) move(p);
+    stroke.width = static_cast<float>(stroke.width * transform.scale);
   }
   // A scale of 1e-300 or a translation of 1e30 is refused by the object's validation, unchanged.
-  Object check = o;
-  check.mesh.positions = moved;
   validate_object(check, image.width, image.height, static_cast<int>(image.levels.size()), object);
-  o.mesh.positions = std::move(moved);
+  o = std::move(check);
 }
 
 void set_object_visible(VectorImage& image, int object, bool visible) {

@@ -744,8 +744,30 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
     // Strokes on the level follow a shape edit (issue 29): each point keeps its place in its
     // control triangle. All of the level's points go through one call (one point-location grid).
     const bool topology_edit = op.kind == EditOp::Kind::kAddFeature || op.kind == EditOp::Kind::kDeleteFeature;
+    // (An object's strokes follow a shape edit inside it the same way.)
+    auto carry_strokes = [&](const ControlMesh& before, std::vector<Stroke>& strokes, int level) {
+      if (op.kind == EditOp::Kind::kColor || topology_edit) return;
+      int carried = 0;
+      std::vector<Vec2> points;
+      for (const Stroke& stroke : strokes) {
+        if (stroke.level != level) continue;
+        points.insert(points.end(), stroke.points.begin(), stroke.points.end());
+        ++carried;
+      }
+      if (carried == 0) return;
+      transport_points(before.positions, mesh.positions, mesh.triangles, points);
+      size_t next = 0;
+      for (Stroke& stroke : strokes) {
+        if (stroke.level != level) continue;
+        std::copy_n(points.begin() + long(next), stroke.points.size(), stroke.points.begin());
+        next += stroke.points.size();
+      }
+      done += "; " + std::to_string(carried) + (carried == 1 ? " stroke" : " strokes") + " carried along";
+    };
     if (op.in_object) {
-      image.objects[op.object].mesh = std::move(mesh);
+      Object& object = image.objects[op.object];
+      carry_strokes(object.mesh, object.strokes, object.level);
+      object.mesh = std::move(mesh);
       log.push_back(where + ": object " + std::to_string(op.object) + ": " + done);
       continue;
     }
@@ -754,25 +776,7 @@ std::vector<std::string> apply_edit_ops(VectorImage& image, std::span<const Edit
       image.levels[op.level + 1].parent_vertices.clear();
       image.levels[op.level + 1].collapses.clear();
     }
-    if (op.kind != EditOp::Kind::kColor && !topology_edit) {
-      int carried = 0;
-      std::vector<Vec2> points;
-      for (const Stroke& stroke : image.strokes) {
-        if (stroke.level != op.level) continue;
-        points.insert(points.end(), stroke.points.begin(), stroke.points.end());
-        ++carried;
-      }
-      if (carried > 0) {
-        transport_points(image.levels[op.level].positions, mesh.positions, mesh.triangles, points);
-        size_t next = 0;
-        for (Stroke& stroke : image.strokes) {
-          if (stroke.level != op.level) continue;
-          std::copy_n(points.begin() + long(next), stroke.points.size(), stroke.points.begin());
-          next += stroke.points.size();
-        }
-        done += "; " + std::to_string(carried) + (carried == 1 ? " stroke" : " strokes") + " carried along";
-      }
-    }
+    carry_strokes(image.levels[op.level], image.strokes, op.level);
     image.levels[op.level] = std::move(mesh);
     log.push_back(where + ": " + done);
   }

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
+#include <set>
 #include <string>
 
 #include "core/messages_p.h"
@@ -37,6 +39,20 @@ const ControlMesh& level_mesh(const VectorImage& image, int level) {
   return image.levels[level];
 }
 
+// The region of interest: the given one, else the whole image, or for an object the bounding box
+// of its control points and the image together (an object moved partly off the image keeps its
+// strokes there).
+Rect region(const VectorImage& image, const StylizeOptions& options) {
+  if (options.roi) return *options.roi;
+  double x0 = 0, y0 = 0, x1 = image.width, y1 = image.height;
+  if (options.object && *options.object >= 0 && *options.object < static_cast<int>(image.objects.size())) {
+    for (const Vec2& p : image.objects[*options.object].mesh.positions) {
+      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+    }
+  }
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
 // The limit curve of every feature, as polylines (one per piece).
 std::vector<std::vector<std::vector<Vec2>>> feature_curves(const ControlMesh& mesh,
                                                            const MeshTopology& topology) {
@@ -49,10 +65,52 @@ std::vector<std::vector<std::vector<Vec2>>> feature_curves(const ControlMesh& me
   return curves;
 }
 
-}  // namespace
+// The colors alone, at 1x: level `level` without strokes and, for object >= 0, that object over it.
+Image8 colors_raster(const VectorImage& image, int level, int object) {
+  VectorImage bare;
+  bare.width = image.width;
+  bare.height = image.height;
+  bare.levels = {image.levels[level]};
+  if (object >= 0) {
+    bare.objects = {image.objects[object]};
+    bare.objects[0].level = 0;
+    bare.objects[0].visible = true;
+    bare.objects[0].strokes.clear();
+  }
+  return render(bare, RenderOptions{});
+}
 
-std::vector<double> feature_saliency(const VectorImage& image, int level, double contrast_weight) {
-  const ControlMesh& mesh = level_mesh(image, level);
+// The control polygons of `mesh`'s boundary loops (an object's outline), each from its smallest
+// vertex, in the order of the triangles' boundary half-edges (a validated object: one outgoing
+// boundary half-edge per boundary vertex).
+std::vector<std::vector<Vec2>> outline_loops(const ControlMesh& mesh) {
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  for (const Tri& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  std::map<int32_t, int32_t> next;
+  for (const auto& [e, n] : directed)
+    if (!directed.count({e.second, e.first})) next[e.first] = e.second;
+  std::vector<std::vector<Vec2>> loops;
+  std::set<int32_t> seen;
+  for (const auto& [start, unused] : next) {
+    if (seen.count(start)) continue;
+    std::vector<Vec2> loop;
+    for (int32_t v = start; !seen.count(v) && next.count(v); v = next.at(v)) {
+      seen.insert(v);
+      loop.push_back(mesh.positions[v]);
+    }
+    if (loop.size() >= 3) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// Saliency of every feature of `mesh`, level `level`'s mesh (object < 0) or object `object`'s: the
+// stored value where non-zero, else eq. 2 measured on the colors alone (the level without strokes
+// and, for an object, that object over it), rendered at 1x. `topology` builds the mesh's topology
+// (validating it) when a saliency must be measured.
+template <class Topology>
+std::vector<double> mesh_saliency(const VectorImage& image, int level, int object, const ControlMesh& mesh,
+                                  Topology topology, double contrast_weight) {
   std::vector<double> saliency(mesh.features.size(), 0);
   bool unknown = false;
   for (size_t f = 0; f < mesh.features.size(); ++f) {
@@ -61,14 +119,8 @@ std::vector<double> feature_saliency(const VectorImage& image, int level, double
   }
   if (!unknown) return saliency;
 
-  const MeshTopology topology = validate_level(mesh, image.width, image.height, level);
-  const auto curves = feature_curves(mesh, topology);
-  // The colors alone: a copy of the level without strokes, rendered at 1x.
-  VectorImage bare;
-  bare.width = image.width;
-  bare.height = image.height;
-  bare.levels = {mesh};
-  const Image8 raster = render(bare, RenderOptions{});
+  const auto curves = feature_curves(mesh, topology());
+  const Image8 raster = colors_raster(image, level, object);
   for (size_t f = 0; f < mesh.features.size(); ++f) {
     if (saliency[f] != 0) continue;
     // Eq. 2 as vectorization measures it (vectorize/levels.h), per piece: lengths add, and the
@@ -84,10 +136,25 @@ std::vector<double> feature_saliency(const VectorImage& image, int level, double
   return saliency;
 }
 
+}  // namespace
+
+std::vector<double> feature_saliency(const VectorImage& image, int level, double contrast_weight) {
+  const ControlMesh& mesh = level_mesh(image, level);
+  return mesh_saliency(image, level, -1, mesh,
+                       [&] { return validate_level(mesh, image.width, image.height, level); },
+                       contrast_weight);
+}
+
 std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& options,
                             StylizeReport* report) {
-  const ControlMesh& mesh = level_mesh(image, options.level);
-  const Rect roi = options.roi.value_or(Rect{0, 0, double(image.width), double(image.height)});
+  const int object = options.object.value_or(-1);
+  if (options.object && (object < 0 || object >= static_cast<int>(image.objects.size()))) {
+    invalid("object " + std::to_string(object) + " is out of range (" + std::to_string(image.objects.size()) +
+            " objects)");
+  }
+  const int level = options.object ? image.objects[object].level : options.level;
+  const ControlMesh& mesh = options.object ? image.objects[object].mesh : level_mesh(image, level);
+  const Rect roi = region(image, options);
   if (!std::isfinite(roi.x) || !std::isfinite(roi.y) || !std::isfinite(roi.width) ||
       !std::isfinite(roi.height) || !(roi.width > 0) || !(roi.height > 0)) {
     invalid("the region " + num(roi.x) + "," + num(roi.y) + "," + num(roi.width) + "," +
@@ -107,15 +174,33 @@ std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& opti
     invalid("the threshold " + num(*options.threshold) + " is negative (saliency is 0 or more)");
   }
 
-  const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
-  const auto curves = feature_curves(mesh, topology);
-  const std::vector<double> saliency =
-      feature_saliency(image, options.level, options.contrast_weight);
+  const MeshTopology topology =
+      options.object ? validate_object(image.objects[object], image.width, image.height,
+                                       static_cast<int>(image.levels.size()), object)
+                     : validate_level(mesh, image.width, image.height, level);
+  auto curves = feature_curves(mesh, topology);
+  std::vector<double> saliency =
+      mesh_saliency(image, level, object, mesh, [&] { return topology; }, options.contrast_weight);
+  // What each stroke follows: the control points of each piece, and whether it is closed.
+  std::vector<std::vector<std::pair<std::vector<Vec2>, bool>>> controls(mesh.features.size());
+  for (size_t f = 0; f < mesh.features.size(); ++f)
+    for (const CurvePiece& piece : feature_pieces(topology, mesh.features[f]))
+      controls[f].push_back({piece_points(mesh, piece), piece.closed});
+  // An object's outline is stroked like a closed feature: it was one of the level's.
+  if (options.object) {
+    const Image8 raster = colors_raster(image, level, object);
+    for (std::vector<Vec2>& loop : outline_loops(mesh)) {
+      std::vector<Vec2> line = sample_bspline(loop, true, kSamplesPerSpan);
+      saliency.push_back(curve_saliency(line, raster, options.contrast_weight));
+      curves.push_back({std::move(line)});
+      controls.push_back({{std::move(loop), true}});
+    }
+  }
 
   // Features in the region: at least half of the curve inside it.
   std::vector<int> in_region;
-  std::vector<double> lengths(mesh.features.size(), 0);
-  for (size_t f = 0; f < mesh.features.size(); ++f) {
+  std::vector<double> lengths(curves.size(), 0);
+  for (size_t f = 0; f < curves.size(); ++f) {
     double inside = 0;
     for (const auto& line : curves[f]) {
       lengths[f] += polyline_length(line);
@@ -157,13 +242,13 @@ std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& opti
     if (!take) continue;
     const float width = options.min_width + (options.max_width - options.min_width) *
                                                 static_cast<float>(std::min(1.0, lengths[f] / full));
-    for (const CurvePiece& piece : feature_pieces(topology, mesh.features[f])) {
+    for (const auto& [points, closed] : controls[f]) {
       Stroke s;
-      s.level = options.level;
-      s.points = piece_points(mesh, piece);
+      s.level = level;
+      s.points = points;
       // A closed loop becomes a path from its first vertex around and back: it starts and ends at
       // that vertex (within the tapers) and follows the loop elsewhere.
-      if (piece.closed) s.points.push_back(s.points.front());
+      if (closed) s.points.push_back(s.points.front());
       s.width = width;
       s.color = options.color;
       s.taper = options.taper;
@@ -178,20 +263,21 @@ std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& opti
 StylizeReport apply_stylize(VectorImage& image, const StylizeOptions& options) {
   StylizeReport report;
   std::vector<Stroke> strokes = stylize(image, options, &report);
-  const Rect roi = options.roi.value_or(Rect{0, 0, double(image.width), double(image.height)});
+  const Rect roi = region(image, options);
+  const int level = options.object ? image.objects[*options.object].level : options.level;
+  std::vector<Stroke>& owned = options.object ? image.objects[*options.object].strokes : image.strokes;
   const auto in_region = [&](const Stroke& s) {
-    if (s.level != options.level) return false;
+    if (s.level != level) return false;
     size_t inside = 0;
     for (Vec2 p : s.points) {
       inside += p.x >= roi.x && p.x <= roi.x + roi.width && p.y >= roi.y && p.y <= roi.y + roi.height;
     }
     return 2 * inside >= s.points.size();
   };
-  const auto old = std::remove_if(image.strokes.begin(), image.strokes.end(), in_region);
-  report.replaced = static_cast<int>(image.strokes.end() - old);
-  image.strokes.erase(old, image.strokes.end());
-  image.strokes.insert(image.strokes.end(), std::make_move_iterator(strokes.begin()),
-                       std::make_move_iterator(strokes.end()));
+  const auto old = std::remove_if(owned.begin(), owned.end(), in_region);
+  report.replaced = static_cast<int>(owned.end() - old);
+  owned.erase(old, owned.end());
+  owned.insert(owned.end(), std::make_move_iterator(strokes.begin()), std::make_move_iterator(strokes.end()));
   return report;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -123,9 +124,10 @@ std::string hints(const RefinedMesh& mesh, const ExportOptions& options, double 
   return content;
 }
 
-std::string strokes(const VectorImage& image, const ExportOptions& options, ExportReport& report) {
+// The strokes of options.level (the image's, or an object's) as filled outlines.
+std::string strokes(std::span<const Stroke> list, const ExportOptions& options, ExportReport& report) {
   std::string content;
-  for (const Stroke& stroke : image.strokes) {
+  for (const Stroke& stroke : list) {
     if (stroke.level != options.level) continue;
     const std::vector<Vec2> outline = detail::stroke_outline(stroke);
     if (outline.empty()) continue;
@@ -337,7 +339,8 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
     object_shadings += " " + name + " " +
                        shading(stream(object.mesh, range, detail::make_strips(object.mesh), -1), -1, 0, range);
     content += "/Subvec_object_" + std::to_string(object.object) + " BMC q q " + clip + name + " sh Q\n" +
-               hints(object.mesh, options, s, r) + "Q EMC\n";
+               hints(object.mesh, options, s, r) + strokes(image.objects[object.object].strokes, options, r) +
+               "Q EMC\n";
   }
   if (!object_shadings.empty()) {
     if (!channels) {
@@ -346,7 +349,7 @@ std::string to_pdf(const VectorImage& image, const ExportOptions& options, Expor
       resources += " /Shading <<" + object_shadings + " >>";
     }
   }
-  content += strokes(image, options, r);
+  content += strokes(image.strokes, options, r);
   content += "Q\n";
 
   std::string pdf = assemble(image, w, h, s, resources, content, extra);

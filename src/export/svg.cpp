@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <unordered_map>
 
@@ -87,10 +88,10 @@ std::string header(const VectorImage& image, double scale, const std::string& at
   return svg;
 }
 
-// The image's strokes of `level` as filled outlines (export_p.h).
-std::string stroke_paths(const VectorImage& image, int level, int decimals, ExportReport& report) {
+// The strokes of `level` (the image's, or an object's) as filled outlines (export_p.h).
+std::string stroke_paths(std::span<const Stroke> strokes, int level, int decimals, ExportReport& report) {
   std::string out;
-  for (const Stroke& stroke : image.strokes) {
+  for (const Stroke& stroke : strokes) {
     if (stroke.level != level) continue;
     const std::vector<Vec2> outline = detail::stroke_outline(stroke);
     if (outline.empty()) continue;
@@ -244,7 +245,7 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
     std::string group;
     mesh_patches(object.mesh, o.topology, decimals, "o" + std::to_string(o.object) + "m", defs, group);
     paths += "<g id=\"object-" + std::to_string(o.object) + "\"><title>" + xml_text(object.name) + "</title>\n" +
-             group + "</g>\n";
+             group + stroke_paths(object.strokes, options.level, decimals + 1, report) + "</g>\n";
     report.patches += object.mesh.num_triangles();
     ++report.objects;
   }
@@ -253,7 +254,7 @@ std::string svg_mesh(const VectorImage& image, const ExportOptions& options, Exp
   // The template holds what every face's gradient shares.
   svg += "<defs>\n<meshgradient id=\"t\" gradientUnits=\"userSpaceOnUse\" type=\"bicubic\"/>\n" +
          defs + "</defs>\n" + paths;
-  svg += stroke_paths(image, options.level, decimals + 1, report);
+  svg += stroke_paths(image.strokes, options.level, decimals + 1, report);
   svg += "</svg>\n";
   report.bytes = static_cast<int64_t>(svg.size());
   return svg;
@@ -336,9 +337,10 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   // Each object a group over the level, bottom to top, named by its title.
   for (const detail::ObjectMesh& object : objects) {
     svg += "<g id=\"object-" + std::to_string(object.object) + "\"><title>" +
-           xml_text(image.objects[object.object].name) + "</title>\n" + draw(object.mesh) + "</g>\n";
+           xml_text(image.objects[object.object].name) + "</title>\n" + draw(object.mesh) +
+           stroke_paths(image.objects[object.object].strokes, options.level, decimals + 1, r) + "</g>\n";
   }
-  svg += stroke_paths(image, options.level, decimals + 1, r);
+  svg += stroke_paths(image.strokes, options.level, decimals + 1, r);
   svg += "</svg>\n";
   r.bytes = static_cast<int64_t>(svg.size());
   return svg;

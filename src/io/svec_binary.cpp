@@ -116,9 +116,9 @@ std::vector<uint8_t> encode_payload_compact(const VectorImage& image, uint32_t v
   return std::move(w.bytes);
 }
 
-void encode_trailer(ByteWriter& w, const VectorImage& image) {
-  w.count(image.strokes.size(), "strokes");
-  for (const Stroke& s : image.strokes) {
+void encode_strokes(ByteWriter& w, const std::vector<Stroke>& strokes) {
+  w.count(strokes.size(), "strokes");
+  for (const Stroke& s : strokes) {
     w.i32(s.level);
     w.f32(s.width);
     w.f32(s.color.r), w.f32(s.color.g), w.f32(s.color.b);
@@ -126,6 +126,27 @@ void encode_trailer(ByteWriter& w, const VectorImage& image) {
     w.count(s.points.size(), "stroke points");
     for (const Vec2& p : s.points) w.f64(p.x), w.f64(p.y);
   }
+}
+
+// Reads what encode_strokes wrote; `owner` names them in messages ("", "object 2 ").
+void decode_strokes(Cursor& in, std::vector<Stroke>& strokes, const std::string& owner) {
+  in.set_context(owner + "strokes");
+  strokes.resize(in.count(owner + "strokes", 28));
+  for (size_t i = 0; i < strokes.size(); ++i) {
+    Stroke& s = strokes[i];
+    const std::string what = owner + "stroke " + str(i);
+    in.set_context(what);
+    s.level = in.i32();
+    s.width = in.f32();
+    s.color.r = in.f32(), s.color.g = in.f32(), s.color.b = in.f32();
+    s.taper = in.f32();
+    s.points.resize(in.count(what + " points", 16));
+    for (Vec2& p : s.points) p.x = in.f64(), p.y = in.f64();
+  }
+}
+
+void encode_trailer(ByteWriter& w, const VectorImage& image) {
+  encode_strokes(w, image.strokes);
   w.count(image.metadata.size(), "metadata entries");
   for (const auto& [key, value] : image.metadata) {
     w.string(key);
@@ -168,8 +189,9 @@ void decode_mesh_v1(Cursor& in, ControlMesh& m, const std::string& level) {
   }
 }
 
-// The objects (flag kObjectsFlag): a count, then each object's level, visibility, name and mesh.
-void decode_objects(Cursor& in, VectorImage& image) {
+// The objects (flag kObjectsFlag): a count, then each object's level, visibility, name and mesh;
+// then, with kObjectStrokesFlag, each object's strokes.
+void decode_objects(Cursor& in, VectorImage& image, uint32_t flags) {
   in.set_context("objects");
   image.objects.resize(in.count("objects", 25, Limits::kMaxObjects));
   for (size_t o = 0; o < image.objects.size(); ++o) {
@@ -183,6 +205,16 @@ void decode_objects(Cursor& in, VectorImage& image) {
     object.name = in.string(what + "name");
     decode_mesh_v1(in, object.mesh, what);
   }
+  if (flags & kObjectStrokesFlag) {
+    for (size_t o = 0; o < image.objects.size(); ++o) decode_strokes(in, image.objects[o].strokes, "object " + str(o) + " ");
+  }
+}
+
+uint32_t header_flags(const VectorImage& image) {
+  if (image.objects.empty()) return 0;
+  const bool strokes = std::any_of(image.objects.begin(), image.objects.end(),
+                                   [](const Object& o) { return !o.strokes.empty(); });
+  return kObjectsFlag | (strokes ? kObjectStrokesFlag : 0);
 }
 
 void encode_objects(ByteWriter& w, const VectorImage& image) {
@@ -193,6 +225,9 @@ void encode_objects(ByteWriter& w, const VectorImage& image) {
     w.bytes.push_back(object.visible ? 1 : 0);
     w.string(object.name);
     encode_mesh_v1(w, object.mesh);
+  }
+  if (header_flags(image) & kObjectStrokesFlag) {
+    for (const Object& object : image.objects) encode_strokes(w, object.strokes);
   }
 }
 
@@ -212,29 +247,18 @@ VectorImage decode_payload(std::span<const uint8_t> payload, uint32_t version, u
     }
     for (size_t l = 0; l < num_levels; ++l)
       image.levels[l] = decode_compact_level(in, int(l), image.width, image.height, int(version));
-    if (flags & kObjectsFlag) decode_objects(in, image);
+    if (flags & kObjectsFlag) decode_objects(in, image, flags);
     decode_trailer(in, image);
     return image;
   }
   for (size_t l = 0; l < num_levels; ++l) decode_mesh_v1(in, image.levels[l], "level " + str(l) + " ");
-  if (flags & kObjectsFlag) decode_objects(in, image);
+  if (flags & kObjectsFlag) decode_objects(in, image, flags);
   decode_trailer(in, image);
   return image;
 }
 
 void decode_trailer(Cursor& in, VectorImage& image) {
-  image.strokes.resize(in.count("strokes", 28));
-  for (size_t i = 0; i < image.strokes.size(); ++i) {
-    Stroke& s = image.strokes[i];
-    const std::string what = "stroke " + str(i);
-    in.set_context(what);
-    s.level = in.i32();
-    s.width = in.f32();
-    s.color.r = in.f32(), s.color.g = in.f32(), s.color.b = in.f32();
-    s.taper = in.f32();
-    s.points.resize(in.count(what + " points", 16));
-    for (Vec2& p : s.points) p.x = in.f64(), p.y = in.f64();
-  }
+  decode_strokes(in, image.strokes, "");
   image.metadata.resize(in.count("metadata entries", 8));
   for (size_t i = 0; i < image.metadata.size(); ++i) {
     const std::string what = "metadata entry " + str(i);
@@ -427,9 +451,13 @@ VectorImage parse_svec_binary(std::span<const uint8_t> bytes) {
     fail("unsupported .svec version " + str(version) + " (this build reads " +
          str(kLosslessVersion) + ", " + str(kCompactVersion) + " and " + str(kCodedVersion) + ")");
   }
-  if ((flags & ~kObjectsFlag) != 0) {
+  if ((flags & ~(kObjectsFlag | kObjectStrokesFlag)) != 0) {
     fail("unsupported .svec flags " + str(flags) + " (this build knows " + str(kObjectsFlag) +
-         ": objects)");
+         ": objects, " + str(kObjectStrokesFlag) + ": object strokes)");
+  }
+  if ((flags & kObjectStrokesFlag) && !(flags & kObjectsFlag)) {
+    fail(".svec flag " + str(kObjectStrokesFlag) + " (object strokes) is set without flag " +
+         str(kObjectsFlag) + " (objects)");
   }
   if (payload_size > kMaxPayloadBytes) {
     fail("declared payload of " + str(payload_size) + " bytes is over the limit of " +
@@ -507,7 +535,7 @@ std::vector<uint8_t> to_svec_binary(const VectorImage& image, const SvecWriteOpt
   ByteWriter w;
   w.bytes.assign(kMagic.begin(), kMagic.end());
   w.u32(version);
-  w.u32(image.objects.empty() ? 0 : kObjectsFlag);  // flags
+  w.u32(header_flags(image));
   w.u64(payload.size());
   w.u64(frame.size());
   w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());

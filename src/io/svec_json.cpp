@@ -313,9 +313,11 @@ ControlMesh level_at(const Json& j, const Path& path) {
   return m;
 }
 
+Stroke stroke_at(const Json& j, const Path& path);
+
 Object object_at_path(const Json& j, const Path& path) {
   object_at(j, path);
-  check_keys(j, path, {"level", "name", "visible", "mesh"});
+  check_keys(j, path, {"level", "name", "visible", "mesh", "strokes"});
   Object o;
   if (const Json* l = find(j, "level")) o.level = int_at(*l, path.member("level"));
   if (const Json* n = find(j, "name")) {
@@ -327,6 +329,7 @@ Object object_at_path(const Json& j, const Path& path) {
     o.visible = v->get<bool>();
   }
   o.mesh = level_at(require(j, path, "mesh"), path.member("mesh"));
+  if (const Json* s = find(j, "strokes")) o.strokes = list_at<Stroke>(*s, path.member("strokes"), stroke_at);
   return o;
 }
 
@@ -542,6 +545,22 @@ void write_level(JsonWriter& w, const ControlMesh& m, bool last, int base = 0, c
   w.line(base + 2, last ? "}" : "},");
 }
 
+// A "strokes" member at `indent`, its entries one deeper.
+void write_strokes(JsonWriter& w, const std::vector<Stroke>& strokes, int indent, bool last) {
+  w.line(indent, "\"strokes\": [");
+  for (size_t i = 0; i < strokes.size(); ++i) {
+    const Stroke& s = strokes[i];
+    w.line(indent + 1, "{");
+    w.line(indent + 2, "\"level\": " + std::to_string(s.level) + ",");
+    w.line(indent + 2, "\"width\": " + format_float(s.width) + ",");
+    w.line(indent + 2, "\"color\": " + color_text(s.color) + ",");
+    w.line(indent + 2, "\"taper\": " + format_float(s.taper) + ",");
+    w.list(indent + 2, "points", texts(s.points, vec2_text), false);
+    w.line(indent + 1, i + 1 < strokes.size() ? "}," : "}");
+  }
+  w.line(indent, last ? "]" : "],");
+}
+
 }  // namespace
 
 VectorImage parse_svec_json(std::string_view text) {
@@ -596,25 +615,13 @@ std::string to_svec_json(const VectorImage& image) {
       w.line(3, "\"level\": " + std::to_string(o.level) + ",");
       w.line(3, "\"name\": " + string_text(o.name) + ",");
       w.line(3, std::string("\"visible\": ") + (o.visible ? "true" : "false") + ",");
-      write_level(w, o.mesh, true, 1, "mesh");
+      write_level(w, o.mesh, o.strokes.empty(), 1, "mesh");
+      if (!o.strokes.empty()) write_strokes(w, o.strokes, 3, true);
       w.line(2, k + 1 < image.objects.size() ? "}," : "}");
     }
     w.line(1, more_after_objects ? "]," : "]");
   }
-  if (!image.strokes.empty()) {
-    w.line(1, "\"strokes\": [");
-    for (size_t i = 0; i < image.strokes.size(); ++i) {
-      const Stroke& s = image.strokes[i];
-      w.line(2, "{");
-      w.line(3, "\"level\": " + std::to_string(s.level) + ",");
-      w.line(3, "\"width\": " + format_float(s.width) + ",");
-      w.line(3, "\"color\": " + color_text(s.color) + ",");
-      w.line(3, "\"taper\": " + format_float(s.taper) + ",");
-      w.list(3, "points", texts(s.points, vec2_text), false);
-      w.line(2, i + 1 < image.strokes.size() ? "}," : "}");
-    }
-    w.line(1, image.metadata.empty() ? "]" : "],");
-  }
+  if (!image.strokes.empty()) write_strokes(w, image.strokes, 1, image.metadata.empty());
   if (!image.metadata.empty()) {
     w.line(1, "\"metadata\": {");
     for (size_t i = 0; i < image.metadata.size(); ++i) {

@@ -16,6 +16,8 @@ inline constexpr uint32_t kCodedVersion = 3;     // version 2's content, range-c
 // Header flag: the payload holds objects (mesh/vector_image.h) after its levels. Files without
 // objects have no flag and are byte for byte what builds before objects wrote.
 inline constexpr uint32_t kObjectsFlag = 1;
+// Header flag: the objects carry strokes (only with kObjectsFlag).
+inline constexpr uint32_t kObjectStrokesFlag = 2;
 inline constexpr size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8;
 inline constexpr uint64_t kMaxPayloadBytes = uint64_t{1} << 30;  // 1 GiB uncompressed
 inline constexpr int kZstdLevel = 9;

@@ -66,7 +66,9 @@ Coarsener::Coarsener(const ControlMesh& fine, int width, int height, const std::
   sides_.assign(nv, 0);
   kind_.assign(nv, Kind::kSmooth);
   for (int v = 0; v < nv; ++v) {
-    sides_[v] = detail::image_sides(pos_[v], width, height);
+    // An object's mesh (MeshTopology::kNoFrame) has no image sides: its boundary vertices are
+    // corners, kept by every coarsening.
+    sides_[v] = width < 0 ? 0 : detail::image_sides(pos_[v], width, height);
     switch (topo.vertex_tags[v]) {
       case VertexTag::kSmooth: kind_[v] = Kind::kSmooth; break;
       case VertexTag::kTear: kind_[v] = Kind::kTear; break;
@@ -251,6 +253,44 @@ ControlMesh Coarsener::result(std::vector<int32_t>& parents, std::vector<int32_t
   for (size_t v = 0; v < vmap.size(); ++v)
     if (vmap[v] >= 0) parents.push_back(static_cast<int32_t>(v));
   return out;
+}
+
+std::vector<EdgeVerts> collapse_shortest_first(Coarsener& c, const std::vector<uint8_t>& removable, int target) {
+  const int nv = c.num_vertices();
+  int remaining = 0;
+  for (int v = 0; v < nv; ++v) remaining += removable[v] && c.alive(v);
+  detail::CollapseQueue queue;
+  std::vector<uint32_t> version(nv, 0);
+  auto plan = [&](int32_t u, int32_t v) {
+    if (!removable[u]) return;
+    const Vec2 a = c.positions()[u], b = c.positions()[v];
+    queue.push(detail::make_entry((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y), u, v,
+                                  version[u], version[v]));
+  };
+  std::vector<int32_t> ring, ring2;
+  for (int32_t v = 0; v < nv; ++v) {
+    if (!removable[v] || !c.alive(v)) continue;
+    c.neighbours(v, ring);
+    for (const int32_t w : ring) plan(v, w);
+  }
+  std::vector<EdgeVerts> made;
+  const auto more = [&] { return remaining > target; };
+  const auto live = [&](const detail::Entry& e) { return detail::entry_live(e, c.vertex_alive(), version); };
+  const auto step = [&](const detail::Entry& e) {
+    const int32_t u = e.remove(), v = e.keep;
+    if (!c.can_collapse(u, v, 0.0)) return;
+    c.neighbours(u, ring);
+    c.collapse(u, v);
+    made.push_back({u, v});
+    --remaining;
+    for (const int32_t w : ring) ++version[w];
+    for (const int32_t w : ring) {
+      c.neighbours(w, ring2);
+      for (const int32_t x : ring2) plan(w, x), plan(x, w);
+    }
+  };
+  detail::run_collapses(queue, nullptr, more, live, step);
+  return made;
 }
 
 }  // namespace subvec::coarsen_detail

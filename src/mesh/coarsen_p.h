@@ -100,4 +100,9 @@ class Coarsener {
   int alive_count_ = 0;
 };
 
+// Removes the live vertices marked in `removable` by half-edge collapses, shortest edge first,
+// until `target` of them remain or none can go (can_collapse, with chains held exactly). Returns
+// the collapses made, (removed, kept), in order: the record a pyramid replays.
+std::vector<EdgeVerts> collapse_shortest_first(Coarsener& c, const std::vector<uint8_t>& removable, int target);
+
 }  // namespace subvec::coarsen_detail

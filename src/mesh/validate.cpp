@@ -403,8 +403,9 @@ class LevelValidator {
   const bool object_ = false;
 };
 
-void validate_stroke(const Stroke& stroke, size_t index, int num_levels) {
-  const std::string prefix = "stroke " + str(int64_t(index)) + ": ";
+// `owner`: "" for the image's strokes, "object N " for an object's.
+void validate_stroke(const Stroke& stroke, size_t index, int num_levels, const std::string& owner = {}) {
+  const std::string prefix = owner + "stroke " + str(int64_t(index)) + ": ";
   auto fail = [&](const std::string& message, ErrorCode code = ErrorCode::kInvalidMesh) {
     throw Error(code, prefix + message);
   };
@@ -486,7 +487,21 @@ MeshTopology validate_object(const Object& object, int width, int height, int nu
   if (!object.mesh.parent_vertices.empty() || !object.mesh.collapses.empty()) {
     throw Error(ErrorCode::kInvalidMesh, prefix + "an object has no parent vertices or collapses");
   }
-  return LevelValidator(object.mesh, width, height, prefix).run();
+  MeshTopology topology = LevelValidator(object.mesh, width, height, prefix).run();
+  if (static_cast<int64_t>(object.strokes.size()) > Limits::kMaxElements) {
+    throw Error(ErrorCode::kLimit, prefix + str(int64_t(object.strokes.size())) +
+                                       " strokes is over the limit of " + str(Limits::kMaxElements));
+  }
+  for (size_t s = 0; s < object.strokes.size(); ++s) {
+    const Stroke& stroke = object.strokes[s];
+    validate_stroke(stroke, s, num_levels, "object " + str(index) + " ");
+    if (stroke.level != object.level) {
+      throw Error(ErrorCode::kInvalidMesh, prefix + "stroke " + str(int64_t(s)) + ": level " +
+                                               str(stroke.level) + " is not the object's level " +
+                                               str(object.level));
+    }
+  }
+  return topology;
 }
 
 std::vector<ObjectTopology> visible_objects(const VectorImage& image, int level) {

@@ -178,8 +178,9 @@ Band analyze(const ControlMesh& fine, const ControlMesh& coarse, int width, int 
   for (int v = 0; v < nv; ++v) {
     b.kinds[v] = c.kind(v);
     const Vec2 p = fine.positions[v];
-    b.sides[v] = static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) | (p.x == width ? 4 : 0) |
-                                      (p.y == height ? 8 : 0));
+    // (An object's mesh, MeshTopology::kNoFrame, has no sides: its boundary vertices stay.)
+    b.sides[v] = width < 0 ? 0 : static_cast<uint8_t>((p.x == 0 ? 1 : 0) | (p.y == 0 ? 2 : 0) |
+                                                      (p.x == width ? 4 : 0) | (p.y == height ? 8 : 0));
   }
   b.keep = feature_keep(fine, kept_ids);
   b.color_keep.assign(fine.colors.size(), 0);
@@ -412,6 +413,57 @@ void reconstruct(const Band& b, const ControlMesh& coarse, double eta_g, double 
   fine.positions = pos;
 }
 
+// A pyramid of `mesh` made from itself: `bands` coarser meshes (fewer when nothing more can go),
+// each made from the one before by removing half of its smooth vertices, shortest edge first
+// (coarsen_detail::collapse_shortest_first), with its record. Boundary, crease, corner and tear
+// vertices all stay, so the outline and the features are the fine mesh's at every eta; a coarser
+// mesh's colors are its vertices' own (no refit: the details carry the rest).
+std::vector<ControlMesh> own_pyramid(const ControlMesh& mesh, int width, int height, int bands) {
+  std::vector<ControlMesh> levels{mesh};
+  levels[0].parent_vertices.clear();
+  levels[0].collapses.clear();
+  std::vector<int32_t> ids;
+  for (const Feature& f : mesh.features) ids.push_back(f.id);
+  for (int b = 1; b <= bands; ++b) {
+    const ControlMesh& fine = levels.back();
+    Coarsener c(fine, width, height, ids);
+    std::vector<uint8_t> removable(fine.num_vertices(), 0);
+    int smooth = 0;
+    for (int v = 0; v < fine.num_vertices(); ++v) smooth += removable[v] = c.kind(v) == Kind::kSmooth;
+    std::vector<EdgeVerts> made = coarsen_detail::collapse_shortest_first(c, removable, smooth / 2);
+    if (made.empty()) break;
+    std::vector<int32_t> parents, color_merged;
+    ControlMesh coarse = c.result(parents, color_merged);
+    coarse.parent_vertices = std::move(parents);
+    coarse.collapses = std::move(made);
+    levels.push_back(std::move(coarse));
+  }
+  return levels;
+}
+
+// Reconstructs out[b - 1] from out[b] for the bands of `levels` (a pyramid: each level above 0
+// with its record), coarsest first; band b takes the etas of band first_band + b - 1.
+void filter_levels(const std::vector<ControlMesh>& levels, std::vector<ControlMesh>& out, int width,
+                   int height, const FilterOptions& options, int first_band, FilterReport& r) {
+  for (int band = static_cast<int>(levels.size()) - 1; band >= 1; --band) {
+    const int eta_band = first_band + band - 1;
+    const Band b = analyze(levels[band - 1], levels[band], width, height, eta_band);
+    reconstruct(b, out[band], eta_at(options.geometry_eta, eta_band), eta_at(options.color_eta, eta_band),
+                out[band - 1], width, height, r);
+  }
+}
+
+// A mesh filtered through its own pyramid (own_pyramid) of `bands` bands from first_band on.
+ControlMesh filter_own(const ControlMesh& mesh, int width, int height, int bands, const FilterOptions& options,
+                       int first_band, FilterReport& r) {
+  const std::vector<ControlMesh> levels = own_pyramid(mesh, width, height, bands);
+  std::vector<ControlMesh> out = levels;
+  filter_levels(levels, out, width, height, options, first_band, r);
+  out[0].parent_vertices = mesh.parent_vertices;
+  out[0].collapses = mesh.collapses;
+  return std::move(out[0]);
+}
+
 }  // namespace
 
 bool has_pyramid(const VectorImage& image) {
@@ -421,13 +473,22 @@ bool has_pyramid(const VectorImage& image) {
   return true;
 }
 
-VectorImage filter(const VectorImage& image, const FilterOptions& options, FilterReport* report) {
-  if (!has_pyramid(image)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                image.levels.size() < 2 ? "the image has one level: a pyramid needs levels built by vectorize --levels"
-                                        : "a level of the image has no pyramid record");
-  }
+int filter_bands(const VectorImage& image, std::optional<int> object) {
   const int bands = static_cast<int>(image.levels.size()) - 1;
+  return object ? std::max(bands, kObjectBands) : bands;
+}
+
+VectorImage filter(const VectorImage& image, const FilterOptions& options, FilterReport* report) {
+  if (options.object && (*options.object < 0 || *options.object >= static_cast<int>(image.objects.size()))) {
+    throw Error(ErrorCode::kInvalidArgument, "object " + std::to_string(*options.object) +
+                                                 " is out of range (" + std::to_string(image.objects.size()) +
+                                                 " objects)");
+  }
+  if (!options.object && image.levels.size() < 2) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "the image has one level: a pyramid needs levels built by vectorize --levels");
+  }
+  const int bands = filter_bands(image, options.object);
   for (const auto* etas : {&options.geometry_eta, &options.color_eta}) {
     if (static_cast<int>(etas->size()) > bands) {
       throw Error(ErrorCode::kInvalidArgument, std::to_string(etas->size()) + " eta values for " +
@@ -441,10 +502,28 @@ VectorImage filter(const VectorImage& image, const FilterOptions& options, Filte
   r = {};
   r.bands = bands;
   VectorImage out = image;
-  for (int band = bands; band >= 1; --band) {
-    const Band b = analyze(image.levels[band - 1], image.levels[band], image.width, image.height, band);
-    reconstruct(b, out.levels[band], eta_at(options.geometry_eta, band), eta_at(options.color_eta, band),
-                out.levels[band - 1], image.width, image.height, r);
+  if (options.object) {
+    ControlMesh& mesh = out.objects[*options.object].mesh;
+    mesh = filter_own(mesh, MeshTopology::kNoFrame, MeshTopology::kNoFrame, bands, options, 1, r);
+    return out;
+  }
+  // Levels 0 .. top hold one pyramid when every one above the first has its record. Where an
+  // edit dropped a record (make_object cuts its level), the level below the gap is filtered
+  // through its own pyramid, with the bands from the gap up, and the levels under it as usual.
+  int top = bands;
+  while (top >= 1) {
+    int low = top;
+    while (low >= 1 && !image.levels[low].parent_vertices.empty()) --low;
+    // Levels low .. top are one pyramid (low = top: a lone level).
+    const std::vector<ControlMesh> levels(image.levels.begin() + low, image.levels.begin() + top + 1);
+    std::vector<ControlMesh> part(out.levels.begin() + low, out.levels.begin() + top + 1);
+    filter_levels(levels, part, image.width, image.height, options, low + 1, r);
+    std::copy(part.begin(), part.end(), out.levels.begin() + low);
+    if (low == 0) break;
+    // Level low has no record: level low - 1 through its own pyramid, bands low .. bands.
+    out.levels[low - 1] = filter_own(image.levels[low - 1], image.width, image.height, bands - low + 1, options,
+                                     low, r);
+    top = low - 1;
   }
   return out;
 }

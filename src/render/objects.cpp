@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "core/parallel_p.h"
+#include "render/strokes_p.h"
 #include "subvec/mesh/validate.h"
 #include "subvec/render/renderer.h"
 #include "subvec/subdiv/subdivision.h"
@@ -58,7 +59,19 @@ void draw_objects(const VectorImage& image, int level, const ViewTransform& view
   RefinedMesh refined;
   for (size_t o = 0; o < image.objects.size(); ++o) {
     const Object& object = image.objects[o];
-    if (object.level != level || !object.visible || !meets(object.mesh, view, rect)) continue;
+    if (object.level != level || !object.visible) continue;
+    // Its strokes, over it and under the objects above.
+    auto draw_its_strokes = [&] {
+      if (clip) {
+        draw_strokes(object.strokes, level, view, *clip, out);
+      } else {
+        draw_strokes(object.strokes, level, view, out);
+      }
+    };
+    if (!meets(object.mesh, view, rect)) {
+      draw_its_strokes();  // a wide stroke may reach past the mesh's box
+      continue;
+    }
     const MeshTopology topology =
         validate_object(object, image.width, image.height, static_cast<int>(image.levels.size()),
                         static_cast<int>(o));
@@ -78,6 +91,7 @@ void draw_objects(const VectorImage& image, int level, const ViewTransform& view
     }
     rasterize_into(refined, view, raster, {}, nullptr, layer);
     composite(layer, rect, row0, out);
+    draw_its_strokes();
   }
 }
 

@@ -296,7 +296,8 @@ def test_objects():
     assert 'object 0 ("disk") made of the region inside feature 0' in line
     assert image.objects == [{"level": 0, "name": "disk", "visible": True,
                               "vertices": image.object_mesh(0)["positions"].shape[0],
-                              "triangles": image.object_mesh(0)["triangles"].shape[0], "features": 0}]
+                              "triangles": image.object_mesh(0)["triangles"].shape[0], "features": 0,
+                              "strokes": 0}]
     assert image.info()["objects"] == image.objects
     # In place, the picture is the same but along the object's anti-aliased rim.
     assert np.abs(image.render().astype(int) - before.astype(int)).mean() < 0.5
@@ -340,6 +341,27 @@ def test_objects():
     clicked = subvec.load(EXAMPLES / "01-disk.svec.json")
     clicked.make_object((48, 48))
     assert framed.objects == clicked.objects
+
+
+def test_object_stylize_and_filter():
+    image = subvec.load(EXAMPLES / "01-disk.svec.json")
+    image.make_object((48, 48))
+    # The object's outline (and features) stroked into its own strokes, which move with it.
+    report = image.stylize(object=0, threshold=0)
+    assert report["strokes"] >= 1 and image.objects[0]["strokes"] == report["strokes"]
+    assert image.info()["strokes"] == 0
+    image.move_object(0, translate=(6, 0))
+    back = subvec.from_bytes(image.to_bytes(format="svec", lossless=True))
+    assert back.objects == image.objects and np.array_equal(back.render(), image.render())
+    # Filtered alone through its own pyramid: colors only leave the positions as they were.
+    before = image.object_mesh(0)["positions"]
+    soft = image.filter(color_eta=[0.2], object=0)
+    assert np.array_equal(soft.object_mesh(0)["positions"], before)
+    assert np.array_equal(soft.mesh()["colors"], image.mesh()["colors"])
+    with pytest.raises(IndexError, match="object 2 is out of range"):
+        image.filter(color_eta=[0.5], object=2)
+    with pytest.raises(IndexError, match="object 2 is out of range"):
+        image.stylize(object=2)
 
 
 def test_color_selection_blend_and_transform():

@@ -32,7 +32,7 @@ interface LevelInfo { vertices: number; triangles: number; colors: number; featu
 interface DocInfo {
   name: string; stem: string; version: number; width: number; height: number; levels: LevelInfo[];
   undo: number; redo: number; strokes: number; save_to: string | null;
-  objects: { level: number; name: string; visible: boolean; vertices: number }[];
+  objects: { level: number; name: string; visible: boolean; vertices: number; strokes: number }[];
   filter: {
     available: boolean; bands: number; reason: string;
     current: null | { eta: number[]; geometry: boolean; color: boolean };
@@ -398,7 +398,7 @@ function showObjects(doc: DocInfo) {
     shown.title = 'shown';
     shown.addEventListener('change', () => void objectEdit('/api/object/visible', { object: o.index, visible: shown.checked }));
     const label = document.createElement('span');
-    label.textContent = `${o.name || 'object ' + o.index} (${o.vertices} vertices)`;
+    label.textContent = `${o.name || 'object ' + o.index} (${o.vertices} vertices${o.strokes ? `, ${o.strokes} strokes` : ''})`;
     label.addEventListener('click', () => { state.objectSel = o.index; showObjects(doc); status(`object ${o.index} selected`); });
     const up = document.createElement('button');
     up.textContent = '▲';
@@ -693,15 +693,27 @@ async function doColor(at: [number, number], eventTime = performance.now()) {
   });
 }
 
+// The object selected in the Objects panel or with the object tool, when it is on the level shown:
+// Stylize and Filter then act on it alone (null: on the level).
+function selectedObject(): number | null {
+  const o = state.doc?.objects?.[state.objectSel];
+  return o && o.level === state.level ? state.objectSel : null;
+}
+
+function onWhat(object: number | null) {
+  return object === null ? '' : ` (object ${object})`;
+}
+
 async function doStylize() {
   await edit(async () => {
     const threshold = $<HTMLInputElement>('threshold').value;
+    const object = selectedObject();
     const f = await postFrame('/api/stylize', {
-      session: state.session, version: state.version, level: state.level,
+      session: state.session, version: state.version, level: state.level, object,
       threshold: threshold === '' ? null : Number(threshold), seed: num('seed'), probability: num('probability'),
     });
     applyDelta(f);
-    status(`stylize: ${f.header.log}`);
+    status(`stylize${onWhat(object)}: ${f.header.log}`);
   });
 }
 
@@ -768,9 +780,10 @@ async function doFilter(reset = false) {
   const geometry = $<HTMLInputElement>('filter-geometry').checked;
   const color = $<HTMLInputElement>('filter-color').checked;
   await edit(async () => {
-    const f = await postFrame('/api/filter', { session: state.session, version: state.version, eta, geometry, color });
+    const object = selectedObject();
+    const f = await postFrame('/api/filter', { session: state.session, version: state.version, eta, geometry, color, object });
     applyDelta(f);
-    status(`filter: ${f.header.log}`);
+    status(`filter${onWhat(object)}: ${f.header.log}`);
   });
 }
 
@@ -1308,6 +1321,12 @@ window.addEventListener('keydown', (e) => {
   }
   if (key === 'r') { recolorPoints(); return; }
   if (key === 'escape' && state.tool === 'points' && !state.drag && state.selection.length) { setSelection([]); status('selection cleared'); return; }
+  if (key === 'escape' && state.objectSel >= 0 && !state.objectMove && state.doc) {
+    state.objectSel = -1;
+    showObjects(state.doc);
+    status('no object selected: Stylize and Filter act on the level');
+    return;
+  }
   const tools: Record<string, Tool> = { h: 'pan', v: 'select', d: 'drag', m: 'move', c: 'color', p: 'points', n: 'pen', o: 'object' };
   if (key === 'x' && state.tool === 'object') { void toggleObject(); return; }
   if (tools[key]) { setTool(tools[key]); return; }

@@ -1,6 +1,6 @@
 // End-to-end test of the editor's object tool (issue 26) in headless Chromium: on the disk
 // example, drag a rectangle round the disk to make it an object, drag the object 20 px to the
-// right, hide it with X, undo the hiding, save. Asserts on canvas pixels and on the saved file.
+// right, hide it with X, undo the hiding, stylize it alone, save. Asserts on canvas pixels and on the saved file.
 //
 //   node web/tests/e2e-objects.mjs BUILD/bin/subvec
 //
@@ -82,6 +82,17 @@ try {
   await idle(page);
   check('panel: checked shows it', red(await pixel(page, 70, 48)), `${await pixel(page, 70, 48)}`);
 
+  // Selected in the panel, Stylize (Y) strokes the object alone, into its own strokes; Esc
+  // deselects it, and Stylize then acts on the level again.
+  await page.locator('#object-list li span, #object-list li label').first().click();
+  await page.keyboard.press('y');
+  await idle(page);
+  check('stylize: the object', /^stylize \(object 0\): [1-9]\d* strokes/.test(await status()), await status());
+  const stroked = await page.evaluate(async () => (await (await fetch('/api/document')).json()).objects[0]);
+  check('stylize: its strokes', stroked && stroked.strokes > 0, JSON.stringify(stroked));
+  await page.keyboard.press('Escape');
+  check('escape: deselected', /no object selected/.test(await status()), await status());
+
   // Save in place: version 2 with one visible object, moved right.
   await page.keyboard.press('Control+s');
   await page.waitForFunction(() => /saved/.test(document.getElementById('status').textContent));
@@ -92,6 +103,8 @@ try {
   check('saved: version 2, one visible object moved right',
     file.version === 2 && objects.length === 1 && objects[0].visible !== false && meanX > 60,
     `version ${file.version}, ${objects.length} objects, mean x ${meanX}`);
+  check('saved: the object\'s strokes with it', objects.length === 1 && (objects[0].strokes ?? []).length > 0 &&
+    (file.strokes ?? []).length === 0, `${(objects[0]?.strokes ?? []).length} object strokes, ${(file.strokes ?? []).length} level strokes`);
   check('no page errors', errors.length === 0, errors.join('; '));
 } catch (e) {
   check('ran to its end', false, e && e.stack ? e.stack : String(e));

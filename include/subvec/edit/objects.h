@@ -14,11 +14,12 @@
 //    control edge off the tear, robustly, so that a stray color on the rim does not bend the
 //    fill. The closed curve stays a tear of the level, so nothing outside the hole changes.
 // A feature that crosses the curve at one of its vertices is split there, each side's part going
-// to its side.
+// to its side. The level's strokes with at least half their points inside the curve's control
+// polygon go to the object (Object::strokes): they belong to what they were drawn on.
 //
 // Editing an object. Its control points move rigidly (move, rotate, scale about a pivot): the
 // limit surface of an affine image of the control points is the same affine image of the limit
-// surface, so the object moves exactly. It can be hidden, shown and reordered; objects draw over
+// surface, so the object moves exactly, and its strokes with it. It can be hidden, shown and reordered; objects draw over
 // their level in the order of VectorImage::objects, each anti-aliased along its boundary.
 //
 // Every function validates what it is given and throws Error(kInvalidArgument) naming the problem
@@ -39,6 +40,7 @@ struct MakeObjectResult {
   int fill_vertices = 0;    // interior vertices of the background under it (after simplification)
   int removed = 0;          // hole vertices removed by the simplification
   int features_moved = 0;   // features (or parts of features) that went into the object
+  int strokes_moved = 0;    // strokes of the level that went into the object
 };
 
 // Makes an object of the region that feature `feature` (a closed tear of level `level`) bounds.
@@ -73,7 +75,8 @@ struct ObjectTransform {
   std::optional<Vec2> pivot = std::nullopt;
 };
 
-// Applies `transform` to object `object`'s control points. Throws Error(kInvalidArgument) for an
+// Applies `transform` to object `object`'s control points and its strokes' points (their widths
+// scaled by `scale`). Throws Error(kInvalidArgument) for an
 // index out of range, a non-finite value or a scale that is not positive.
 void transform_object(VectorImage& image, int object, const ObjectTransform& transform);
 

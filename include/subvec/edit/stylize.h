@@ -28,8 +28,12 @@ struct Rect {
 
 struct StylizeOptions {
   int level = 0;
-  std::optional<Rect> roi;           // region of interest; default: the whole image
-  std::optional<double> threshold;   // saliency threshold; default: the median over the region
+  // The object whose features are stroked (edit/objects.h), into its own strokes (Object::strokes),
+  // which move with it; `level` is then the object's. Default: the level's own mesh.
+  std::optional<int> object = std::nullopt;
+  std::optional<Rect> roi = std::nullopt;  // region of interest; default: the whole image (and, for an
+                                           // object, its control points' bounding box)
+  std::optional<double> threshold = std::nullopt;  // saliency threshold; default: the median over the region
   uint64_t seed = 1;                 // for the features below the threshold
   double probability = 0.3;          // chance that a feature below the threshold gets a stroke
   double contrast_weight = 2;        // w in S(f) = P(f) + w C(f)
@@ -54,15 +58,15 @@ std::vector<double> feature_saliency(const VectorImage& image, int level,
                                      double contrast_weight = 2);
 
 // The strokes for `options` (not added to the image). Deterministic: the same image and options
-// give the same strokes. Throws Error(kInvalidArgument) for a level out of range, an empty or
+// give the same strokes. Throws Error(kInvalidArgument) for a level or object out of range, an empty or
 // non-finite region, a negative or non-finite threshold, a probability outside [0, 1] or
 // non-positive widths.
 std::vector<Stroke> stylize(const VectorImage& image, const StylizeOptions& options,
                             StylizeReport* report = nullptr);
 
 // Stylizes `image` in place, the one policy of `subvec stylize`, the editor's Stylize and the
-// Python module: the strokes of options.level with at least half their points in the region are
-// replaced by the ones stylize() makes; other strokes stay. So stylizing twice gives the same
+// Python module: the strokes of options.level (or of options.object) with at least half their
+// points in the region are replaced by the ones stylize() makes; other strokes stay. So stylizing twice gives the same
 // image as once, and a second region adds to the first.
 StylizeReport apply_stylize(VectorImage& image, const StylizeOptions& options);
 

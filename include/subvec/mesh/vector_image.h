@@ -105,6 +105,9 @@ struct Object {
   std::string name;
   bool visible = true;
   ControlMesh mesh;   // parent_vertices and collapses stay empty
+  // Strokes on the object (edit/stylize.h with an object): drawn over its layer, under the objects
+  // above it, and moved with it. Each has the object's level.
+  std::vector<Stroke> strokes;
 };
 
 struct VectorImage {

@@ -24,6 +24,7 @@
 // edge profile across them stays (docs/levels.md, "Edge profiles").
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "subvec/mesh/vector_image.h"
@@ -35,7 +36,18 @@ struct FilterOptions {
   // repeats its last value; empty means 1 (unchanged).
   std::vector<double> geometry_eta;
   std::vector<double> color_eta;
+  // Filter this object (edit/objects.h) alone, through its own pyramid (below); default: the levels.
+  std::optional<int> object = std::nullopt;
 };
+
+// An object's mesh has no levels of its own. It is filtered through a pyramid made from itself:
+// filter_bands(image, object) coarser meshes, each removing half the smooth vertices left,
+// shortest edge first; its boundary, creases and tears stay (so it still fits its hole in the
+// level at every eta), and band b takes band b's eta. The same own pyramid fills a gap in the
+// levels' pyramid: a level whose record an edit dropped (make_object cuts its level) is not made
+// from the one below it any more, so that one is filtered through its own pyramid, with the bands
+// from the gap up.
+inline constexpr int kObjectBands = 2;  // at least, or as many as the image has
 
 struct FilterReport {
   int bands = 0;
@@ -45,10 +57,15 @@ struct FilterReport {
 // Whether `image` has a pyramid: two or more levels, each above level 0 with its record.
 bool has_pyramid(const VectorImage& image);
 
-// Filters every level of `image` (the coarsest stays as it is) and returns the result, a normal
-// vector image with the same levels, records and strokes (it can be filtered again). Positions
-// whose filtered value would flip a triangle move back toward the unfiltered position, as far as
-// needed. Throws Error(kInvalidArgument) when `image` has no pyramid, for more eta values than
+// How many bands filter() takes eta values for: the levels' (levels - 1), or an object's
+// (kObjectBands at least).
+int filter_bands(const VectorImage& image, std::optional<int> object = std::nullopt);
+
+// Filters every level of `image` (the coarsest stays as it is), or with options.object that object
+// alone, and returns the result, a normal vector image with the same levels, records, objects and
+// strokes (it can be filtered again). Positions whose filtered value would flip a triangle move
+// back toward the unfiltered position, as far as needed. Throws Error(kInvalidArgument) when
+// `image` has one level (without an object), for an object out of range, more eta values than
 // bands or non-finite ones, and Error(kInvalidMesh) when a record does not make its level.
 VectorImage filter(const VectorImage& image, const FilterOptions& options, FilterReport* report = nullptr);
 

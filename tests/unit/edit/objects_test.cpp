@@ -15,6 +15,7 @@
 #include "subvec/edit/objects.h"
 #include "subvec/edit/ops.h"
 #include "subvec/edit/feature_edit.h"
+#include "subvec/edit/stylize.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/validate.h"
@@ -562,6 +563,116 @@ TEST(Objects, FilesFromBeforeThemRenderAsBefore) {
     const VectorImage image = read_svec(root / file);
     EXPECT_TRUE(image.objects.empty());
     EXPECT_EQ(fnv(draw(image).pixels), hash) << file << ": 0x" << std::hex << fnv(draw(image).pixels);
+  }
+}
+
+TEST(Objects, StylizedStrokesBelongToTheObjectAndMoveWithIt) {
+  VectorImage image = small_image();
+  // A stroke drawn on the region before it becomes an object goes with it; one elsewhere stays.
+  VectorImage styled = image;
+  apply_stylize(styled, {.threshold = 0.0});
+  const int f = closed_feature(styled.levels[0]);
+  const MakeObjectResult made = make_object(styled, 0, f);
+  EXPECT_GT(made.strokes_moved, 0);
+  EXPECT_EQ(int(styled.objects[0].strokes.size()), made.strokes_moved);
+  EXPECT_GT(styled.strokes.size(), 0u);
+  validate(styled);
+
+  make_object(image, 0, closed_feature(image.levels[0]));
+  const int features = int(image.objects[0].mesh.features.size());
+  StylizeOptions options{.object = 0, .threshold = 0.0};
+  const StylizeReport report = apply_stylize(image, options);
+  EXPECT_EQ(report.in_region, features + 1) << "its features and its outline";
+  EXPECT_GT(report.strokes, 0);
+  EXPECT_EQ(int(image.objects[0].strokes.size()), report.strokes);
+  EXPECT_TRUE(image.strokes.empty()) << "the level's strokes are the level's";
+  // Stylizing again replaces them (the same strokes), and a wrong object is refused.
+  EXPECT_EQ(apply_stylize(image, options).replaced, report.strokes);
+  EXPECT_EQ(int(image.objects[0].strokes.size()), report.strokes);
+  EXPECT_THROW(apply_stylize(image, {.object = 3}), Error);
+
+  // The strokes draw over the object, inside its footprint (and the strokes' width) only.
+  VectorImage bare = image;
+  bare.objects[0].strokes.clear();
+  const Image8 with = draw(image), without = draw(bare);
+  const std::vector<uint8_t> near = grow(footprint(image, 0), with.width, with.height, 3);
+  int changed = 0;
+  for (int y = 0; y < with.height; ++y)
+    for (int x = 0; x < with.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        if (with.row(y)[x * 3 + c] == without.row(y)[x * 3 + c]) continue;
+        EXPECT_TRUE(near[size_t(y) * with.width + x]) << x << "," << y;
+        ++changed;
+      }
+  EXPECT_GT(changed, 50);
+
+  // Moved, turned and scaled: every stroke point goes where the object's control points go.
+  const Object start = image.objects[0];
+  const ObjectTransform t{.translate = {9, -4}, .rotate_degrees = 30, .scale = 1.5};
+  transform_object(image, 0, t);
+  const Vec2 c = object_center(start);
+  const double a = 30 * std::numbers::pi / 180;
+  for (size_t s = 0; s < start.strokes.size(); ++s) {
+    EXPECT_FLOAT_EQ(image.objects[0].strokes[s].width, start.strokes[s].width * 1.5f);
+    for (size_t i = 0; i < start.strokes[s].points.size(); ++i) {
+      const Vec2 p = start.strokes[s].points[i], q = image.objects[0].strokes[s].points[i];
+      const double x = p.x - c.x, y = p.y - c.y;
+      EXPECT_NEAR(q.x, c.x + 1.5 * (std::cos(a) * x - std::sin(a) * y) + 9, 1e-9);
+      EXPECT_NEAR(q.y, c.y + 1.5 * (std::sin(a) * x + std::cos(a) * y) - 4, 1e-9);
+    }
+  }
+  // Hidden, its strokes go too.
+  VectorImage hidden = image;
+  hidden.objects[0].visible = false;
+  VectorImage none = hidden;
+  none.objects[0].strokes.clear();
+  EXPECT_EQ(draw(hidden).pixels, draw(none).pixels);
+}
+
+TEST(Objects, FilesKeepTheirStrokes) {
+  VectorImage image = small_image();
+  make_object(image, 0, closed_feature(image.levels[0]), "disk");
+  apply_stylize(image, {.object = 0, .threshold = 0.0});
+  ASSERT_FALSE(image.objects[0].strokes.empty());
+  const Image8 drawn = draw(image);
+  for (const SvecWriteOptions& options : {SvecWriteOptions{.lossless = true}, SvecWriteOptions{}}) {
+    const std::vector<uint8_t> bytes = to_svec_binary(image, options);
+    EXPECT_EQ(bytes[12], 3) << "flags: objects and object strokes";
+    const VectorImage back = parse_svec_binary(bytes);
+    ASSERT_EQ(back.objects[0].strokes.size(), image.objects[0].strokes.size());
+    EXPECT_EQ(back.objects[0].strokes[0].points, image.objects[0].strokes[0].points);
+    EXPECT_EQ(to_svec_binary(back, options), bytes);
+  }
+  EXPECT_EQ(draw(parse_svec_binary(to_svec_binary(image, {.lossless = true}))).pixels, drawn.pixels);
+  const std::string json = to_svec_json(image);
+  const VectorImage back = parse_svec_json(json);
+  EXPECT_EQ(to_svec_json(back), json);
+  EXPECT_EQ(draw(back).pixels, drawn.pixels);
+  // Objects without strokes keep flag 1 alone (files as session 28 wrote them).
+  VectorImage plain = image;
+  plain.objects[0].strokes.clear();
+  EXPECT_EQ(to_svec_binary(plain)[12], 1);
+  EXPECT_EQ(to_svec_json(plain).find("\"strokes\""), std::string::npos);
+  // A stroke on another level than its object's is refused, naming both.
+  VectorImage wrong = image;
+  wrong.objects[0].strokes[0].level = 1;
+  wrong.levels.push_back(wrong.levels[0]);
+  try {
+    validate(wrong);
+    ADD_FAILURE() << "validated";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("object 0: stroke 0: level 1 is not the object's level 0"), std::string::npos)
+        << e.what();
+  }
+  // Flag 2 without flag 1 is refused.
+  std::vector<uint8_t> bad = to_svec_binary(small_image());
+  bad[12] = 2;
+  try {
+    parse_svec_binary(bad);
+    ADD_FAILURE() << "parsed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("flag 2 (object strokes) is set without flag 1"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -83,7 +83,8 @@ const std::vector<BadFile>& corpus() {
       // Binary containers.
       {"wrong-magic.svec", E::kBadFile, {"not a .svec file: wrong magic bytes (53 55 42 56 45 58"}},
       {"wrong-version.svec", E::kBadFile, {"unsupported .svec version 7 (this build reads 1, 2 and 3)"}},
-      {"unknown-flags.svec", E::kBadFile, {"unsupported .svec flags 2"}},
+      {"unknown-flags.svec", E::kBadFile, {"unsupported .svec flags 4"}},
+      {"object-strokes-without-objects.svec", E::kBadFile, {"flag 2 (object strokes) is set without flag 1"}},
       {"truncated-header.svec",
        E::kBadFile,
        {"truncated .svec header: 20 bytes, the header needs 32"}},

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include "pyramid_test_util.h"
 #include "support/image_measures.h"
 #include "subvec/core/error.h"
+#include "subvec/edit/objects.h"
 #include "subvec/io/image_io.h"
 #include "subvec/io/svec.h"
 #include "subvec/mesh/validate.h"
@@ -310,6 +312,123 @@ TEST(Pyramid, FilesKeepThePyramid) {
   bad = image;
   bad.levels[0].parent_vertices = {0};
   EXPECT_THROW(validate(bad), Error);
+}
+
+// shapes() with its first closed tear that can be one made into an object on level 0: the levels'
+// pyramid then has a gap (make_object drops level 1's record).
+VectorImage shapes_with_object() {
+  VectorImage image = shapes();
+  for (int f = 0; f < static_cast<int>(image.levels[0].features.size()); ++f) {
+    if (!image.levels[0].features[f].closed()) continue;
+    try {
+      make_object(image, 0, f, "shape");
+      return image;
+    } catch (const Error&) {
+    }
+  }
+  ADD_FAILURE() << "no closed tear of shapes() makes an object";
+  return image;
+}
+
+// Mean |difference| of the control colors across the mesh's edges (both sides of a tear apart):
+// the texture a color filter smooths.
+double color_roughness(const ControlMesh& m) {
+  double sum = 0;
+  int n = 0;
+  for (int t = 0; t < m.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Color a = m.colors[m.triangle_colors[t][k]], b = m.colors[m.triangle_colors[t][(k + 1) % 3]];
+      sum += std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b);
+      ++n;
+    }
+  return n ? sum / n : 0;
+}
+
+// The vertices on an edge with one face: an object's outline.
+std::vector<int32_t> outline(const ControlMesh& m) {
+  std::map<std::pair<int32_t, int32_t>, int> edges;
+  for (const Tri& t : m.triangles)
+    for (int k = 0; k < 3; ++k) ++edges[std::minmax(t[k], t[(k + 1) % 3])];
+  std::vector<int32_t> out;
+  for (const auto& [e, n] : edges)
+    if (n == 1) out.push_back(e.first), out.push_back(e.second);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+TEST(Pyramid, AnObjectIsFilteredThroughItsOwnPyramid) {
+  const VectorImage image = shapes_with_object();
+  ASSERT_EQ(image.objects.size(), 1u);
+  EXPECT_FALSE(has_pyramid(image));
+  EXPECT_EQ(filter_bands(image, 0), std::max(kObjectBands, int(image.levels.size()) - 1));
+  const ControlMesh& before = image.objects[0].mesh;
+  // eta = 1 gives the object back.
+  FilterOptions one = uniform(1.0);
+  one.object = 0;
+  const ControlMesh same = filter(image, one).objects[0].mesh;
+  ASSERT_EQ(same.positions.size(), before.positions.size());
+  for (size_t v = 0; v < before.positions.size(); ++v) {
+    EXPECT_NEAR(same.positions[v].x, before.positions[v].x, 1e-9);
+    EXPECT_NEAR(same.positions[v].y, before.positions[v].y, 1e-9);
+  }
+  for (size_t c = 0; c < before.colors.size(); ++c) EXPECT_NEAR(same.colors[c].r, before.colors[c].r, 1e-3);
+  // Colors at eta = 0.3: smoother, the levels untouched.
+  FilterOptions soft = colors(0.3);
+  soft.object = 0;
+  FilterReport report;
+  const VectorImage out = filter(image, soft, &report);
+  validate(out);
+  EXPECT_EQ(report.bands, filter_bands(image, 0));
+  EXPECT_LT(color_roughness(out.objects[0].mesh), 0.8 * color_roughness(before));
+  EXPECT_EQ(out.objects[0].mesh.positions, before.positions);
+  for (size_t l = 0; l < image.levels.size(); ++l) {
+    EXPECT_EQ(out.levels[l].positions, image.levels[l].positions);
+    EXPECT_EQ(out.levels[l].colors, image.levels[l].colors);
+  }
+  // Geometry at eta = 0.3: the inside moves, the outline stays exactly where the hole is.
+  FilterOptions calm = uniform(0.3);
+  calm.object = 0;
+  const VectorImage moved = filter(image, calm);
+  validate(moved);
+  const std::vector<int32_t> rim = outline(before);
+  ASSERT_FALSE(rim.empty());
+  for (int32_t v : rim) EXPECT_EQ(moved.objects[0].mesh.positions[v], before.positions[v]) << v;
+  EXPECT_NE(moved.objects[0].mesh.positions, before.positions);
+  // Deterministic, and refused for an object that is not there.
+  EXPECT_EQ(filter(image, calm).objects[0].mesh.positions, moved.objects[0].mesh.positions);
+  FilterOptions missing = colors(0.5);
+  missing.object = 1;
+  EXPECT_THROW(filter(image, missing), Error);
+}
+
+TEST(Pyramid, TheLevelsAreFilteredAcrossTheGapAnObjectLeaves) {
+  const VectorImage image = shapes_with_object();
+  // eta = 1 still gives every level back.
+  const VectorImage same = filter(image, uniform(1.0));
+  for (size_t l = 0; l < image.levels.size(); ++l) {
+    ASSERT_EQ(same.levels[l].positions.size(), image.levels[l].positions.size());
+    for (size_t v = 0; v < image.levels[l].positions.size(); ++v) {
+      EXPECT_NEAR(same.levels[l].positions[v].x, image.levels[l].positions[v].x, 1e-9);
+      EXPECT_NEAR(same.levels[l].positions[v].y, image.levels[l].positions[v].y, 1e-9);
+    }
+    for (size_t c = 0; c < image.levels[l].colors.size(); ++c)
+      EXPECT_NEAR(same.levels[l].colors[c].g, image.levels[l].colors[c].g, 1e-3);
+  }
+  // Smoothing reaches level 0 through its own pyramid; above the gap the bands are the image's.
+  const VectorImage out = filter(image, colors(0.3));
+  validate(out);
+  EXPECT_LT(color_roughness(out.levels[0]), 0.9 * color_roughness(image.levels[0]));
+  VectorImage upper = image;
+  upper.levels.erase(upper.levels.begin());
+  upper.levels[0].parent_vertices.clear();
+  upper.levels[0].collapses.clear();
+  upper.objects.clear();
+  if (upper.levels.size() >= 2) {
+    const VectorImage direct = filter(upper, colors(0.3));
+    EXPECT_EQ(direct.levels[0].colors, out.levels[1].colors);
+  }
+  EXPECT_EQ(out.objects[0].mesh.colors, image.objects[0].mesh.colors);  // the object is its own layer
 }
 
 }  // namespace
