@@ -6,7 +6,8 @@
 // files with objects made at test time (`subvec edit` with tests/bad-input/files/ops-objects.json:
 // examples/01-disk's disk made an object, moved, rotated and scaled; and one that reaches past the
 // image, drawn also in a window larger than the image; a hidden one; one with a vertex on the image's
-// corner), plus a window on an object's boundary. Then the <subvec-image> element's behaviour and the demo page
+// corner; strokes on an object, and on the lower of two objects), plus a window on an object's
+// boundary. Then the <subvec-image> element's behaviour and the demo page
 // (viewer-element.mjs), and the bundle's import in node.
 //
 //   node web/tests/viewer-compare.mjs BUILD/bin/subvec
@@ -138,6 +139,14 @@ async function main() {
         triangles: [[0, 1, 3], [1, 2, 3], [2, 0, 3]] } }];
       writeFileSync(join(dir, 'corner-object.svec.json'), JSON.stringify(corner));
       objects.push(join(dir, 'corner-object.svec.json'));
+      // Strokes on objects (`stylize --object`): the disk object's, as .svec and JSON; and the
+      // lower of two overlapping objects stylized, so that the upper one covers its strokes.
+      objects.push(made('disk-object-styled.svec', 'stylize', objects[0], '-o', '@', '--object', '0'));
+      objects.push(made('disk-object-styled-json.svec.json', 'convert', join(dir, 'disk-object-styled.svec'), '-o', '@'));
+      writeFileSync(join(dir, 'ops-two.json'), JSON.stringify([{ op: 'make-object', at: [48, 48], name: 'lower' },
+        { op: 'move-object', object: 0, translate: [-12, 6], scale: 0.6 }, { op: 'make-object', at: [48, 48], name: 'upper' }]));
+      const two = made('two-objects.svec', 'edit', disk, '-o', '@', '--ops', join(dir, 'ops-two.json'));
+      objects.push(made('two-objects-styled.svec', 'stylize', two, '-o', '@', '--object', '0'));
     } catch (e) {
       failed++;
       console.log(`FAIL making the files with objects: ${why(e)}`);

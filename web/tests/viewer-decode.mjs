@@ -7,13 +7,14 @@
 //     `subvec info` rejects, each with a SvecError of one non-empty line (both messages printed);
 //  2. good files (the examples as JSON and as .svec versions 1, 2 and 3, a vectorized and a stylized
 //     photograph, a hand-made image with strokes and metadata, files with objects made by
-//     `subvec edit` in every version) decode to what the C++ reader
+//     `subvec edit` in every version, with strokes on them by `subvec stylize --object`) decode
+//     to what the C++ reader
 //     gives, as `subvec convert X -o X.svec.json --lossless` writes it: same numbering, same
 //     values (positions within 1e-9 relative, colors exact in float32);
 //  3. the worked examples of docs/format.md (JSON, and the version 2 and 3 payloads) decode as the
 //     document says;
-//  4. small crafted inputs (JSON corner cases, huge counts in tiny payloads, objects good and bad
-//     in both forms) are accepted or rejected as by the C++ reader (bad objects with the C++
+//  4. small crafted inputs (JSON corner cases, huge counts in tiny payloads, objects and their
+//     strokes good and bad in both forms) are accepted or rejected as by the C++ reader (bad objects with the C++
 //     reader's message, word for word);
 //  5. mutations of good files (truncations; flipped bytes of the file, and of the payload wrapped
 //     in a fresh zstd frame) always give a SvecError or a valid image, quickly; accept/reject as
@@ -159,6 +160,18 @@ function compare(image, ref) {
       array(g.vertices, f.vertices, `${l} feature ${i} vertices`);
     });
   };
+  const strokes = (mine, theirs = [], owner = '') => {
+    eq(mine.length, theirs.length, `${owner}strokes`);
+    theirs.forEach((s, i) => {
+      const t = mine[i];
+      if (!t) return;
+      eq(t.level, s.level ?? 0, `${owner}stroke ${i} level`);
+      array(t.points, flat(s.points), `${owner}stroke ${i} points`, close);
+      eq(t.width, Math.fround(s.width), `${owner}stroke ${i} width`);
+      array(t.color, s.color.map(Math.fround), `${owner}stroke ${i} color`);
+      eq(t.taper, Math.fround(s.taper ?? 0.25), `${owner}stroke ${i} taper`);
+    });
+  };
   ref.levels.forEach((r, l) => image.levels[l] && mesh(image.levels[l], r, `level ${l}`));
   eq(image.objects.length, (ref.objects ?? []).length, 'objects');
   (ref.objects ?? []).forEach((o, i) => {
@@ -168,17 +181,9 @@ function compare(image, ref) {
     eq(p.name, o.name ?? '', `object ${i} name`);
     eq(p.visible, o.visible ?? true, `object ${i} visible`);
     mesh(p.mesh, o.mesh, `object ${i}`);
+    strokes(p.strokes, o.strokes, `object ${i} `);
   });
-  eq(image.strokes.length, (ref.strokes ?? []).length, 'strokes');
-  (ref.strokes ?? []).forEach((s, i) => {
-    const t = image.strokes[i];
-    if (!t) return;
-    eq(t.level, s.level, `stroke ${i} level`);
-    array(t.points, flat(s.points), `stroke ${i} points`, close);
-    eq(t.width, Math.fround(s.width), `stroke ${i} width`);
-    array(t.color, s.color.map(Math.fround), `stroke ${i} color`);
-    eq(t.taper, Math.fround(s.taper), `stroke ${i} taper`);
-  });
+  strokes(image.strokes, ref.strokes);
   array(image.metadata.map((e) => e.join('\u0000')), Object.entries(ref.metadata ?? {}).map((e) => e.join('\u0000')), 'metadata');
   return diffs;
 }
@@ -189,7 +194,7 @@ function same_as_cpp(file, label = path.relative(tmp, file)) {
   const v = fs.readFileSync(file).subarray(0, 8).toString('latin1') === 'SUBVEC\0\x1a' ? `v${fs.readFileSync(file).readUInt32LE(8)}` : 'json';
   const size = (m) => `${m.positions.length / 2}/${m.triangles.length / 3}/${m.colors.length / 3}`;
   const sizes = j.image.levels.map(size).join(' ');
-  const objects = j.image.objects.length ? `, objects ${j.image.objects.map((o) => `${size(o.mesh)}${o.visible ? '' : ' hidden'}`).join(' ')}` : '';
+  const objects = j.image.objects.length ? `, objects ${j.image.objects.map((o) => `${size(o.mesh)}${o.visible ? '' : ' hidden'}${o.strokes.length ? ` +${o.strokes.length} strokes` : ''}`).join(' ')}` : '';
   if (check(!diffs.length, `${label}: differs from the C++ decode: ${diffs.join('; ')}`))
     console.log(`  ${label} (${v}, levels V/T/C ${sizes}${objects}, ${j.image.strokes.length} strokes, ${j.image.metadata.length} metadata): same as C++ (${j.ms.toFixed(1)} ms)`);
   return j.image;
@@ -247,6 +252,16 @@ if (rocket) {
   ]));
   const two = make('two-objects.svec', 'edit', disk, '-o', '@', '--ops', path.join(tmp, 'ops-two.json'));
   if (two) make('two-objects-v1.svec', 'convert', two, '-o', '@', '--lossless');
+  // Strokes on an object (header flag 2; "strokes" in a JSON object): the disk object stylized,
+  // in every version; the second of two objects stylized, and the image stylized over it.
+  const styled = object && make('disk-object-styled.svec', 'stylize', object, '-o', '@', '--object', '0');
+  if (styled) {
+    make('disk-object-styled-v1.svec', 'convert', styled, '-o', '@', '--lossless');
+    make('disk-object-styled-v2.svec', 'convert', styled, '-o', '@', '--compact-version', '2');
+    make('disk-object-styled.svec.json', 'convert', styled, '-o', '@');
+  }
+  const twoStyled = two && make('two-objects-styled.svec', 'stylize', two, '-o', '@', '--object', '1');
+  if (twoStyled) make('two-objects-styled-all.svec', 'stylize', twoStyled, '-o', '@');
 }
 for (const file of goods) same_as_cpp(file, path.relative(file.startsWith(tmp) ? tmp : root, file));
 
@@ -330,6 +345,9 @@ const le = (...words) => Buffer.concat(words.map(([type, v]) => {
 const triangle = { vertices: [[1, 1], [3, 1], [2, 3]], colors: [[0, 200, 0], [0, 200, 0], [0, 100, 0]], triangles: [[0, 1, 2]] };
 function objectFiles() {
   const json = (objects, version = 2, extra = '') => square(`${extra}, "objects": ${JSON.stringify(objects)}`).replace('"version": 1', `"version": ${version}`);
+  // The square twice: two levels (no pyramid record), for objects over level 1.
+  const json2 = (objects) => json(objects).replace(/"levels": \[(\{.*\})\]/, '"levels": [$1, $1]');
+  const stroke = { level: 0, points: [[0.5, 0.5], [2, 3.25], [3.5, 1]], width: 0.5, color: [255, 255, 0], taper: 0.1 };
   const with_ = (change) => [{ level: 0, name: 'tri', visible: true, mesh: { ...triangle, ...change } }];
   // Two triangles sharing vertex 0 only: a boundary pinched there (four boundary edges).
   const bowtie = { vertices: [[2, 2], [3, 1], [3, 3], [1, 3], [1, 1]], colors: Array(5).fill([9, 9, 9]), triangles: [[0, 1, 2], [0, 3, 4]] };
@@ -365,6 +383,25 @@ function objectFiles() {
     'object-json-color-owner.svec.json': json(with_({ triangle_colors: [[0, 1, 1]] })),
     'object-json-unused-color.svec.json': json(with_({ colors: [...triangle.colors, [1, 1, 1]], triangle_colors: [[0, 1, 2]] })),
     'object-json-too-many.svec.json': json(Array(4097).fill({ mesh: triangle })),
+    // Strokes on objects: the form of the image's strokes, each of its object's level.
+    'object-json-strokes.svec.json': json([{ mesh: triangle, strokes: [stroke, { ...stroke, taper: 0 }] }, { mesh: triangle, visible: false, strokes: [stroke] }],
+      2, `, "strokes": ${JSON.stringify([stroke])}`),
+    'object-json-strokes-empty.svec.json': json([{ mesh: triangle, strokes: [] }]),
+    'object-json-strokes-defaults.svec.json': json([{ mesh: triangle, strokes: [{ points: [[0, 0], [4, 4]], width: 1, color: [0, 0, 0] }] }]),
+    'object-json-strokes-not-array.svec.json': json([{ mesh: triangle, strokes: stroke }]),
+    'object-json-stroke-unknown-key.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, dash: 2 }] }]),
+    'object-json-stroke-no-width.svec.json': json([{ mesh: triangle, strokes: [{ points: stroke.points, color: stroke.color }] }]),
+    'object-json-stroke-color-string.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, color: 'red' }] }]),
+    'object-json-stroke-level-out.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, level: 4 }] }]),
+    'object-json-stroke-level-other.svec.json': json2([{ level: 1, mesh: triangle, strokes: [stroke, { ...stroke, level: 0 }] }]),
+    'object-json-stroke-level-default.svec.json': json2([{ level: 1, mesh: triangle, strokes: [{ points: stroke.points, width: 1, color: [0, 0, 0] }] }]),
+    'object-json-stroke-level-1.svec.json': json2([{ level: 1, mesh: triangle, strokes: [{ ...stroke, level: 1 }] }]),
+    'object-json-stroke-one-point.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, points: [[1, 1]] }] }]),
+    'object-json-stroke-width-0.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, width: 0 }] }]),
+    'object-json-stroke-taper.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, taper: 0.75 }] }]),
+    'object-json-stroke-second-object.svec.json': json([{ mesh: triangle, strokes: [stroke] }, { mesh: triangle, strokes: [stroke, { ...stroke, width: -2 }] }]),
+    'object-json-stroke-bad-mesh-first.svec.json': json([{ mesh: { ...triangle, triangles: [[0, 2, 1]] }, strokes: [{ ...stroke, width: 0 }] }]),
+    'object-json-stroke-and-image-stroke.svec.json': json([{ mesh: triangle, strokes: [{ ...stroke, level: 3 }] }], 2, `, "strokes": [${JSON.stringify({ ...stroke, level: 5 })}]`),
   };
   // Binary: the square in version 1, then the objects (flag 1).
   const mesh = (m) => le(['u32', m.vertices.length], ['u32', m.colors.length], ['u32', m.triangles.length], ['u32', 0], ['u32', 0],
@@ -373,7 +410,14 @@ function objectFiles() {
   const sq = { vertices: [[0, 0], [4, 0], [4, 4], [0, 4], [2, 2]], colors: [[255, 0, 0], [255, 0, 0], [0, 0, 255], [0, 0, 255], [127.5, 0, 127.5]],
     triangles: [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]] };
   const object = ({ level = 0, visible = 1, name = [0x74], m = triangle } = {}) => le(['u32', level], ['u8', visible], ['u32', name.length], ['bytes', name], ['bytes', mesh(m)]);
-  const payload = (objects, count = objects.length) => Buffer.concat([le(['u32', 4], ['u32', 4], ['u32', 1]), mesh(sq), le(['u32', count]), ...objects, le(['u32', 0], ['u32', 0])]);
+  const payload = (objects, count = objects.length, objectStrokes = [], levels = 1) =>
+    Buffer.concat([le(['u32', 4], ['u32', 4], ['u32', levels]), ...Array(levels).fill(mesh(sq)), le(['u32', count]), ...objects, ...objectStrokes, le(['u32', 0], ['u32', 0])]);
+  // An object's strokes (flag 2): a count, then each stroke as the trailer's.
+  const strokeBytes = ({ level = 0, width = 0.5, color = [255, 255, 0], taper = 0.1, points = [[0.5, 0.5], [2, 3.25], [3.5, 1]] } = {}) =>
+    le(['u32', level], ['f32', width], ...color.map((c) => ['f32', c]), ['f32', taper], ['u32', points.length], ...points.flat().map((v) => ['f64', v]));
+  const strokes = (...list) => Buffer.concat([le(['u32', list.length]), ...list.map(strokeBytes)]);
+  const two = [object(), object({ visible: 0, name: [0xc3, 0xa9] })];
+  const withStrokes = payload(two, 2, [strokes({}, { taper: 0 }), strokes({ width: 2 })]);
   const good = payload([object(), object({ visible: 0, name: [0xc3, 0xa9] })]);
   Object.assign(files, {
     'object-v1.svec': svecFile(good, 1, 1),
@@ -392,6 +436,29 @@ function objectFiles() {
     'object-v1-flipped.svec': svecFile(payload([object({ m: { ...triangle, triangles: [[0, 2, 1]] } })]), 1, 1),
     'object-v1-bad-index.svec': svecFile(payload([object({ m: { ...triangle, triangles: [[0, 1, 7]] } })]), 1, 1),
     'object-v1-nan-color.svec': svecFile(payload([object({ m: { ...triangle, colors: [[0, 0, 0], [0, NaN, 0], [0, 0, 0]] } })]), 1, 1),
+    // Strokes on objects (flag 2, only with flag 1): after the last object, each object's count
+    // and strokes.
+    'object-v1-strokes.svec': svecFile(withStrokes, 1, 3),
+    'object-v1-strokes-none.svec': svecFile(payload(two, 2, [strokes(), strokes()]), 1, 3),
+    'object-v1-strokes-flag-1.svec': svecFile(withStrokes, 1, 1),
+    'object-v1-strokes-flag-2.svec': svecFile(withStrokes, 1, 2),
+    'object-v1-strokes-flags-7.svec': svecFile(withStrokes, 1, 7),
+    'object-v1-strokes-flags-6.svec': svecFile(withStrokes, 1, 6),
+    'object-v1-strokes-no-objects.svec': svecFile(payload([], 0, []), 1, 3),
+    'object-v1-strokes-truncated-count.svec': svecFile(withStrokes.subarray(0, withStrokes.length - 8 - strokeBytes({ width: 2 }).length - 2), 1, 3),
+    'object-v1-strokes-truncated-points.svec': svecFile(withStrokes.subarray(0, withStrokes.length - 8 - 20), 1, 3),
+    'object-v1-strokes-truncated-stroke.svec': svecFile(withStrokes.subarray(0, withStrokes.length - 8 - strokeBytes({ width: 2 }).length + 10), 1, 3),
+    'object-v1-strokes-huge-count.svec': svecFile(payload(two, 2, [le(['u32', 2 ** 26 + 1])]), 1, 3),
+    'object-v1-strokes-big-count.svec': svecFile(payload(two, 2, [le(['u32', 1000]), strokeBytes()]), 1, 3),
+    'object-v1-strokes-huge-points.svec': svecFile(payload(two, 2, [le(['u32', 1], ['u32', 0], ['f32', 1], ['f32', 0], ['f32', 0], ['f32', 0], ['f32', 0], ['u32', 2 ** 26 + 1]), strokes()]), 1, 3),
+    'object-v1-stroke-level-out.svec': svecFile(payload(two, 2, [strokes({ level: 9 }), strokes()]), 1, 3),
+    'object-v1-stroke-level-other.svec': svecFile(payload([object({ level: 1 })], 1, [strokes({ level: 1 }, { level: 0 })], 2), 1, 3),
+    'object-v1-stroke-level-negative.svec': svecFile(payload(two, 2, [strokes(), strokes({ level: -1 })]), 1, 3),
+    'object-v1-stroke-nan-point.svec': svecFile(payload(two, 2, [strokes({ points: [[0, 0], [NaN, 1]] }), strokes()]), 1, 3),
+    'object-v1-stroke-one-point.svec': svecFile(payload(two, 2, [strokes({ points: [[0, 0]] }), strokes()]), 1, 3),
+    'object-v1-stroke-inf-color.svec': svecFile(payload(two, 2, [strokes(), strokes({ color: [0, Infinity, 0] })]), 1, 3),
+    'object-v1-stroke-taper.svec': svecFile(payload(two, 2, [strokes({ taper: -0.5 }), strokes()]), 1, 3),
+    'object-v1-stroke-width-nan.svec': svecFile(payload(two, 2, [strokes({ width: NaN }), strokes()]), 1, 3),
   });
   return files;
 }
@@ -476,7 +543,8 @@ function judge({ bytes, what, file }, c) {
   if (check(c.ok === j.ok, `${what}: C++ ${c.ok ? 'accepts' : `rejects (${c.message})`}, the viewer ${j.ok ? 'accepts' : `rejects (${j.message})`}`)) stats.agree++;
   if (c.ok && j.ok) check(!compare(j.image, reference(file)).length, `${what}: differs from the C++ decode`);
 }
-const sources = ['rocket.svec', 'rocket-v1.svec', 'rocket-v2.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec', 'disk-object-v1.svec', 'two-objects.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
+const sources = ['rocket.svec', 'rocket-v1.svec', 'rocket-v2.svec', 'rich-v3.svec', 'doc-v2.svec', 'doc-v3.svec', 'disk-object-v1.svec', 'two-objects.svec',
+  'disk-object-styled-v1.svec', 'two-objects-styled-all.svec'].map((n) => path.join(tmp, n)).filter((f) => fs.existsSync(f));
 for (const file of sources) {
   const bytes = fs.readFileSync(file), label = path.basename(file), version = bytes.readUInt32LE(8);
   for (let k = 0; k < (label.startsWith('rocket') ? 20 : 8); k++) {

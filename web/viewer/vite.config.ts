@@ -5,8 +5,20 @@ import { defineConfig } from 'vite';
 
 const here = decodeURIComponent(new URL('.', import.meta.url).pathname);
 
+// The shaders' text (render.ts) ships in the bundle: written readably there, minified here (the
+// blanks around punctuation and between lines, and the zeros around a decimal point dropped).
+const minifyShaders = {
+  name: 'minify-shaders',
+  transform(code: string, id: string) {
+    if (!id.endsWith('/render.ts')) return null;
+    return code.replace(/(_[VF]S = `)([^`]*)`/g, (_, start: string, body: string) =>
+      start + body.replace(/\s*([-=+*/,;(){}<>?:])\s*/g, '$1').replace(/\s+/g, ' ').replace(/(\d\.)0+(?!\d)/g, '$1').replace(/(?<![\d.])0(\.\d)/g, '$1').trim() + '`');
+  },
+};
+
 export default defineConfig({
   root: here,
+  plugins: [minifyShaders],
   publicDir: false,
   build: {
     outDir: 'dist',

@@ -10,7 +10,6 @@
 // typed arrays sized up front: a page decodes its file once, before anything is compiled.
 import { Decompress } from 'fzstd';
 import { SvecError, SvecImage } from './image';
-import { escape, fail, validate } from './validate';
 import { checksum, container, readJson, readPayload } from './wasm';
 
 const GIB = 2 ** 30; // largest file, and largest payload
@@ -19,8 +18,12 @@ const HEADER = 32;
 
 const latin1 = (b: Uint8Array) => String.fromCharCode(...b);
 
-// ---------------------------------------------------------------------------------------------
-// Bytes.
+function fail(message: string): never {
+  throw new SvecError(message);
+}
+
+/** Control characters as \xNN, for one-line messages. */
+const escape = (s: string) => s.replace(/[\x00-\x1f\x7f]/g, (c) => `\\x${c.charCodeAt(0).toString(16).padStart(2, '0')}`);
 
 // ---------------------------------------------------------------------------------------------
 // zstd: one frame that must decompress to exactly `expected` bytes (fzstd, plus the checks
@@ -47,22 +50,12 @@ function unzstd(f: Uint8Array, expected: number, end: number, partial: number, d
 }
 
 // ---------------------------------------------------------------------------------------------
-// The binary form: header, payload version 1 (lossless), trailer, pyramid records.
+// The binary form: the header and the zstd frame checked, the payload decompressed here, then
+// read and validated in WebAssembly (wasm/json.c, validate.c).
 
 function binary(b: Uint8Array): SvecImage {
   const [size, end, partial, d, version, flags] = container(b);
-  const [image, records, topologies, objectRecords] = readPayload(unzstd(b.subarray(HEADER), size, end, partial, d), version, flags);
-  validate(image, records, topologies, objectRecords);
-  return image;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The JSON form: read in WebAssembly (wasm/json.c), checked here as the binary form is.
-
-function json(b: Uint8Array): SvecImage {
-  const [image, records, , objectRecords] = readJson(b);
-  validate(image, records, [], objectRecords);
-  return image;
+  return readPayload(unzstd(b.subarray(HEADER), size, end, partial, d), version, flags);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -94,7 +87,7 @@ export function decode(bytes: Uint8Array | ArrayBuffer, name?: string): SvecImag
     const bom = b[0] === 0xef && b[1] === 0xbb && b[2] === 0xbf ? 3 : 0;
     let i = bom;
     while (b[i] === 32 || b[i] === 9 || b[i] === 10 || b[i] === 13) i++;
-    if (b[i] === 123 || b[i] === 91) return json(b.subarray(bom));
+    if (b[i] === 123 || b[i] === 91) return readJson(b.subarray(bom));
     if (!b.length) fail('file is empty');
     const other = otherFormat(b, name);
     return other ? fail(other) : binary(b);

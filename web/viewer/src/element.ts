@@ -3,7 +3,7 @@
 // `error` event and the `error` property, never an exception reaching the page.
 import { load } from './decode';
 import { SvecError, type SvecImage } from './image';
-import { SubvecRenderer, type ViewWindow } from './render';
+import { SubvecRenderer, validWindow, type ViewWindow } from './render';
 
 // Like an <img>: inline-block, W x H CSS pixels by default, one side set by CSS gives the other
 // through the aspect ratio. Size containment keeps the canvas from feeding back into the size;
@@ -20,10 +20,6 @@ const Base = (typeof HTMLElement === 'undefined' ? class {} : HTMLElement) as ty
 function message(e: unknown): string {
   const text = e instanceof Error ? e.message : String(e);
   return text.split('\n')[0];
-}
-
-function validWindow(w: ViewWindow): boolean {
-  return [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
 }
 
 export class SubvecImageElement extends Base {

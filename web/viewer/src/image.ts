@@ -1,6 +1,6 @@
 // The vector image as the viewer holds it: the content of a `.svec` / `.svec.json` file
-// (docs/format.md), in typed arrays. Produced by decode.ts, checked by validate.ts, drawn by
-// subdivide.ts + render.ts.
+// (docs/format.md), in typed arrays. Produced by decode.ts (read and checked in WebAssembly:
+// wasm/json.c, validate.c), drawn by subdivide.ts + render.ts.
 
 /** A tear feature: a chain of vertex indices (closed when the last repeats the first). */
 export interface Feature {
@@ -36,12 +36,14 @@ export interface Stroke {
 
 /** An object (a layer, docs/format.md "Objects"): a control mesh of its own drawn over its level,
  * in file order from the bottom, when visible. Its mesh need not tile the image: its boundary
- * edges are creases, and what it covers is composited over the level. */
+ * edges are creases, and what it covers is composited over the level. Its strokes (each of the
+ * object's level) are drawn over it, under the objects above it. */
 export interface SvecObject {
   level: number;
   name: string;
   visible: boolean;
   mesh: Level;
+  strokes: Stroke[];
 }
 
 export interface SvecImage {

@@ -2,7 +2,8 @@
 // (src/render/renderer.cpp): the same view plan (visible faces from ring boxes, the depth rule in
 // output pixels), the same refinement (subdivide.ts), Gouraud-shaded limit triangles, then the
 // level's visible objects (src/render/objects.cpp: each refined at the level's depth, its boundary
-// a crease, drawn over the level in file order), then the strokes. Tears, the image border and the
+// a crease, drawn over the level in file order, each with its strokes over it), then the
+// strokes. Tears, the image border and the
 // objects' boundaries are anti-aliased by the canvas's 4x multisampling (the C++ rasterizer
 // supersamples those pixels 4 x 4): an object drawn opaque over the level's samples composites
 // with its coverage, as the C++ renderer's layer with alpha = coverage does; strokes by their
@@ -12,7 +13,7 @@
 //
 // A view reuses the last refinement when it needs the same level and depth and a subset of its
 // faces: zooming in within one depth, and panning within the refined region, only redraw.
-import { SvecError, type SvecImage } from './image';
+import { SvecError, type Stroke, type SvecImage } from './image';
 import { adaptiveIndices, buildTopology, refine, uniformIndices, type Refined, type Topology } from './wasm';
 import { strokeChords, type ViewTransform } from './strokes';
 
@@ -53,10 +54,10 @@ export function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom:
   return k;
 }
 
-// The shaders' text ships in the bundle, so it has no comments or indentation. view: the window's
-// origin (image pixels) and output pixels per image pixel; size: the output in pixels.
-const MESH_VS = `#version 300 es
-layout(location = 0) in vec2 position;
+// The shaders' text ships in the bundle, so it has no comments or indentation (and the build,
+// vite.config.ts, takes out the rest of its blanks); compile() puts the version line first. view:
+// the window's origin (image pixels) and output pixels per image pixel; size: the output in pixels.
+const MESH_VS = `layout(location = 0) in vec2 position;
 layout(location = 1) in vec3 color;
 uniform vec4 view;
 uniform vec2 size;
@@ -66,16 +67,14 @@ vec2 o = (position - view.xy) * view.zw;
 gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0);
 shade = color;
 }`;
-const MESH_FS = `#version 300 es
-precision highp float;
+const MESH_FS = `precision highp float;
 in vec3 shade;
 out vec4 outColor;
 void main() { outColor = vec4(clamp(shade / 255.0, 0.0, 1.0), 1.0); }`;
 
 // One instanced quad per chord, covering the chord's capsule plus a pixel: ends x0, y0, x1, y1 and
 // p, the pixel centre, in output pixels, y down.
-const CHORD_VS = `#version 300 es
-layout(location = 0) in vec2 corner;
+const CHORD_VS = `layout(location = 0) in vec2 corner;
 layout(location = 1) in vec4 ends;
 layout(location = 2) in vec2 radii;
 uniform vec2 size;
@@ -89,8 +88,7 @@ gl_Position = vec4(2.0 * o.x / size.x - 1.0, 1.0 - 2.0 * o.y / size.y, 0.0, 1.0)
 vEnds = ends;
 vRadii = radii;
 }`;
-const CHORD_FS = `#version 300 es
-precision highp float;
+const CHORD_FS = `precision highp float;
 in vec4 vEnds;
 in vec2 vRadii;
 uniform vec2 size;
@@ -104,11 +102,9 @@ float dist = length(p - (a + u * d)), r = mix(vRadii.x, vRadii.y, u);
 coverage = vec4(clamp(min(dist + r, 0.5) - max(dist - r, -0.5), 0.0, 1.0));
 }`;
 // Source-over of one stroke's color with its coverage (premultiplied output).
-const COMPOSITE_VS = `#version 300 es
-layout(location = 0) in vec2 corner;
+const COMPOSITE_VS = `layout(location = 0) in vec2 corner;
 void main() { gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0); }`;
-const COMPOSITE_FS = `#version 300 es
-precision highp float;
+const COMPOSITE_FS = `precision highp float;
 uniform sampler2D coverage;
 uniform vec3 color;
 out vec4 outColor;
@@ -124,7 +120,7 @@ function compile(gl: WebGL2RenderingContext, vs: string, fs: string): WebGLProgr
   for (const [type, source] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]] as const) {
     const shader = gl.createShader(type);
     if (!shader) throw new SvecError('WebGL2: cannot create a shader');
-    gl.shaderSource(shader, source);
+    gl.shaderSource(shader, `#version 300 es\n${source}`);
     gl.compileShader(shader);
     gl.attachShader(program, shader);
     gl.deleteShader(shader);
@@ -140,9 +136,11 @@ function linked(gl: WebGL2RenderingContext, program: WebGLProgram): WebGLProgram
   return program;
 }
 
+/** Whether w is a window: finite, x0 < x1 and y0 < y1. */
+export const validWindow = (w: ViewWindow): boolean => [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
+
 function checkWindow(w: ViewWindow): void {
-  const ok = [w.x0, w.y0, w.x1, w.y1].every(Number.isFinite) && w.x0 < w.x1 && w.y0 < w.y1;
-  if (!ok) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
+  if (!validWindow(w)) throw new SvecError(`window ${w.x0},${w.y0},${w.x1},${w.y1} is empty or not finite (want x0 < x1, y0 < y1)`);
 }
 
 // The refinement of the last view of a mesh (the level's, or an object's), on the GPU.
@@ -224,23 +222,27 @@ export class SubvecRenderer {
   // One empty draw in the mesh's state, so that the GPU process prepares its pipeline (software
   // GL compiles the shaders to machine code there) while the page decodes and refines the file.
   #warmUp(): void {
-    const gl = this.#gl;
-    const vao = gl.createVertexArray(), vertices = gl.createBuffer(), indices = gl.createBuffer();
-    gl.bindVertexArray(vao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
-    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(15), gl.STATIC_DRAW);
-    gl.enableVertexAttribArray(0);
-    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
-    gl.enableVertexAttribArray(1);
-    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
+    const gl = this.#gl, mesh = this.#meshArrays(new Float32Array(15));
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array([0, 1, 2]), gl.STATIC_DRAW);
     gl.useProgram(this.#mesh);
     gl.drawElements(gl.TRIANGLES, 3, gl.UNSIGNED_INT, 0);  // a degenerate triangle: no pixels
     gl.bindVertexArray(null);
-    gl.deleteVertexArray(vao);
-    gl.deleteBuffer(vertices);
-    gl.deleteBuffer(indices);
+    this.#drop(mesh);
+  }
+
+  // A vertex array over `vertices` (x, y, r, g, b each) and an index buffer, left bound.
+  #meshArrays(vertices: Float32Array): Pick<Cache, 'vao' | 'buffers'> {
+    const gl = this.#gl;
+    const vao = gl.createVertexArray()!, buffers = [gl.createBuffer()!, gl.createBuffer()!];
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, buffers[0]);
+    gl.bufferData(gl.ARRAY_BUFFER, vertices, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
+    gl.enableVertexAttribArray(1);
+    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers[1]);
+    return { vao, buffers };
   }
 
   /** Shows `image` (already validated by decode/load) at `level`. */
@@ -280,23 +282,26 @@ export class SubvecRenderer {
     const view: ViewTransform = { x0: w.x0, y0: w.y0, sx: width / (w.x1 - w.x0), sy: height / (w.y1 - w.y0), width, height };
 
     const t0 = performance.now();
-    const cache = this.#plan(image, w, view);
-    const meshes = [...(cache ? [cache] : []), ...this.#planObjects(image, w, view)];
+    const cache = this.#plan(image, w, view), layers = this.#planObjects(image, w, view);
+    const meshes = [cache, ...layers.map(([c]) => c)].filter((c): c is Cache => !!c);
     const t1 = performance.now();
     this.stats.refineMs = meshes.length ? t1 - t0 : 0;
     this.stats.triangles = meshes.reduce((n, c) => n + c.numIndices / 3, 0);
-    if (meshes.length) {
+    // The level, then each object and its strokes, then the image's strokes. (The mesh program is
+    // set again for each mesh: strokes between them use others.)
+    const draw = (c: Cache | null) => {
+      if (!c) return;
       if (!this.#meshLinked) this.#meshLinked = !!linked(gl, this.#mesh);
       gl.useProgram(this.#mesh);
       gl.uniform4f(gl.getUniformLocation(this.#mesh, 'view'), view.x0, view.y0, view.sx, view.sy);
       gl.uniform2f(gl.getUniformLocation(this.#mesh, 'size'), width, height);
-      for (const c of meshes) {
-        gl.bindVertexArray(c.vao);
-        gl.drawElements(gl.TRIANGLES, c.numIndices, gl.UNSIGNED_INT, 0);
-      }
+      gl.bindVertexArray(c.vao);
+      gl.drawElements(gl.TRIANGLES, c.numIndices, gl.UNSIGNED_INT, 0);
       gl.bindVertexArray(null);
-    }
-    this.#drawStrokes(image, view);
+    };
+    draw(cache);
+    for (const [c, strokes] of layers) draw(c), this.#drawStrokes(strokes, view);
+    this.#drawStrokes(image.strokes, view);
     this.stats.drawMs = performance.now() - t1;
   }
 
@@ -304,11 +309,7 @@ export class SubvecRenderer {
   dispose(): void {
     this.#dropCache();
     const gl = this.#gl;
-    if (this.#coverage) {
-      gl.deleteTexture(this.#coverage.texture);
-      gl.deleteFramebuffer(this.#coverage.framebuffer);
-      this.#coverage = null;
-    }
+    this.#dropCoverage();
     gl.deleteProgram(this.#mesh);
     if (this.#strokePrograms) {
       gl.deleteProgram(this.#strokePrograms.chord);
@@ -338,16 +339,17 @@ export class SubvecRenderer {
   // 2.5-pixel edges, fewer steps past the triangle budget): an object's boundary is drawn by its
   // chords, which the viewer's coarser depth for the level would show as facets; the adaptive
   // triangles keep only what the tolerances need. Their topology has no image corners (width and
-  // height NaN): the boundary is all crease.
-  #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Cache[] {
-    const out: Cache[] = [];
+  // height NaN): the boundary is all crease. Each with its strokes, also when none of its faces is
+  // in view (null).
+  #planObjects(image: SvecImage, w: ViewWindow, view: ViewTransform): Array<[Cache | null, Stroke[]]> {
+    const out: Array<[Cache | null, Stroke[]]> = [];
     image.objects.forEach((object, i) => {
       if (object.level !== this.#level || !object.visible) return;
       const topo = (this.#objectTopologies[i] ??= buildTopology(object.mesh, NaN, NaN));
       const [visible] = visibleFaces(topo, w, view);
       let depth = this.#objectDepth;
       while (depth > 0 && visible.length * 4 ** depth > MAX_TRIANGLES) --depth;
-      if (visible.length) out.push((this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)));
+      out.push([visible.length ? (this.#objectCaches[i] = this.#refined(this.#objectCaches[i], -1 - i, topo, visible, depth, view)) : null, object.strokes]);
     });
     return out;
   }
@@ -366,20 +368,9 @@ export class SubvecRenderer {
   }
 
   #upload(key: number, topo: Topology, faces: Int32Array | null, depth: number): Cache {
-    const gl = this.#gl;
-    const refined = refine(topo, faces, depth);
-    const vao = gl.createVertexArray()!;
-    const vertices = gl.createBuffer()!, indices = gl.createBuffer()!;
-    gl.bindVertexArray(vao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, vertices);
-    gl.bufferData(gl.ARRAY_BUFFER, refined.vertices, gl.STATIC_DRAW);
-    gl.enableVertexAttribArray(0);
-    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 20, 0);
-    gl.enableVertexAttribArray(1);
-    gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 20, 8);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indices);
-    gl.bindVertexArray(null);
-    return { level: key, depth, faces, refined, scale: NaN, numIndices: 0, vao, buffers: [vertices, indices] };
+    const refined = refine(topo, faces, depth), mesh = this.#meshArrays(refined.vertices);
+    this.#gl.bindVertexArray(null);
+    return { level: key, depth, faces, refined, scale: NaN, numIndices: 0, ...mesh };
   }
 
   // The triangles to draw at this scale: each face as deep as it needs (the position tolerance is
@@ -395,7 +386,7 @@ export class SubvecRenderer {
     cache.numIndices = indices.length;
   }
 
-  #drop(cache: Cache | null | undefined): void {
+  #drop(cache: Pick<Cache, 'vao' | 'buffers'> | null | undefined): void {
     if (!cache) return;
     this.#gl.deleteVertexArray(cache.vao);
     for (const b of cache.buffers) this.#gl.deleteBuffer(b);
@@ -407,10 +398,10 @@ export class SubvecRenderer {
     this.#objectCaches = [];
   }
 
-  // Each stroke of the level: its coverage (the maximum over its chords) into a texture, then
-  // composited over the frame, in file order.
-  #drawStrokes(image: SvecImage, view: ViewTransform): void {
-    const strokes = image.strokes.filter((s) => s.level === this.#level && s.points.length >= 4);
+  // Each of the strokes of the level (the image's, or an object's): its coverage (the maximum over
+  // its chords) into a texture, then composited over the frame, in file order.
+  #drawStrokes(all: Stroke[], view: ViewTransform): void {
+    const strokes = all.filter((s) => s.level === this.#level && s.points.length >= 4);
     if (strokes.length === 0) return;
     const gl = this.#gl;
     const target = this.#coverageTarget(view.width, view.height);
@@ -475,13 +466,18 @@ export class SubvecRenderer {
     return this.#strokePrograms;
   }
 
+  #dropCoverage(): void {
+    if (this.#coverage) {
+      this.#gl.deleteTexture(this.#coverage.texture);
+      this.#gl.deleteFramebuffer(this.#coverage.framebuffer);
+    }
+    this.#coverage = null;
+  }
+
   #coverageTarget(width: number, height: number) {
     const gl = this.#gl;
     if (this.#coverage && this.#coverage.width === width && this.#coverage.height === height) return this.#coverage;
-    if (this.#coverage) {
-      gl.deleteTexture(this.#coverage.texture);
-      gl.deleteFramebuffer(this.#coverage.framebuffer);
-    }
+    this.#dropCoverage();
     const texture = gl.createTexture()!;
     gl.bindTexture(gl.TEXTURE_2D, texture);
     gl.texStorage2D(gl.TEXTURE_2D, 1, gl.R8, width, height);

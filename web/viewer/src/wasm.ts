@@ -9,10 +9,9 @@
 // calls: each call resets its arena, copies the inputs in and the outputs out.
 import { Decompress } from 'fzstd';
 import type { Feature, Level, Stroke, SvecImage, SvecObject } from './image';
-import type { PyramidRecord } from './validate';
 import { SvecError, num } from './image';
 import type { Refined, Topology } from './subdivide';
-import { WASM, WASM_BYTES } from './wasm-binary';
+import { WASM, WASM_BYTES, WASM_SIZE } from './wasm-binary';
 
 export { uniformIndices, type Refined, type Topology } from './subdivide';
 
@@ -25,8 +24,6 @@ interface Exports {
   refine(...args: number[]): number;
   adaptive(...args: number[]): number;
   compact(...args: number[]): number;
-  check_level(...args: number[]): number;
-  check_object(...args: number[]): number;
   xxh64(bytes: number, length: number): number;
   json(bytes: number, length: number): number;
   payload(bytes: number, length: number, version: number, flags: number): number;
@@ -36,8 +33,8 @@ interface Exports {
 let instance: Exports | null = null;
 const MAX_KEPT = 64 * 2 ** 20; // an arena grown past this is dropped after the call
 
-// The module's bytes: base 116 (wasm/build: 7 characters, 1 to 126 without 7 to 13, escape, '
-// and \, per 6 bytes, big-endian) of its zstd frame.
+// The module's bytes (WASM_SIZE of them): base 116 (wasm/build: 7 characters, 1 to 126 without 7
+// to 13, escape, ' and \, per 6 bytes, big-endian) of its zstd frame.
 function unpack(): Uint8Array<ArrayBuffer> {
   const packed = new Uint8Array((WASM.length / 7) * 6);
   for (let i = 0, o = 0; i < WASM.length; o += 6) {
@@ -48,10 +45,9 @@ function unpack(): Uint8Array<ArrayBuffer> {
     }
     for (let k = o + 6; k-- > o; v = Math.floor(v / 256)) packed[k] = v % 256;
   }
-  const parts: Uint8Array[] = [];
-  new Decompress((part) => parts.push(part)).push(packed.subarray(0, WASM_BYTES), true);
-  const bytes = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  parts.reduce((at, p) => (bytes.set(p, at), at + p.length), 0);
+  const bytes = new Uint8Array(WASM_SIZE);
+  let at = 0;
+  new Decompress((part) => (bytes.set(part, at), (at += part.length))).push(packed.subarray(0, WASM_BYTES), true);
   return bytes;
 }
 
@@ -219,46 +215,6 @@ function mean(terms: number, n: number): number {
 // a·b + c·d for integers too large for doubles, rounded once (as C++ converts an exact int64).
 const exact = (a: number, b: number, c: number, d: number) => Number(BigInt(a) * BigInt(b) + BigInt(c) * BigInt(d));
 
-/** The edges of a level the decoder built, sorted by (a, b) with a < b, and the triangle across
- * each (-1 on the border): what check_level needs of them. */
-export interface Edges {
-  a: Int32Array;
-  b: Int32Array;
-  g: Int32Array;
-}
-
-/** Throws a SvecError naming the first validity rule (docs/format.md) that level l breaks.
- * `built`: the edges of a level the decoder built, whose colors, indices and topology are valid
- * by construction. */
-export const checkLevel = (level: Level, width: number, height: number, l: number, built?: Edges): void =>
-  checkMesh(level, (m, args, put) => {
-    let edges = 0;
-    if (built) {
-      const fields = new Int32Array(16);
-      fields.set([built.a.length, put(built.a), put(built.b), 0, put(built.g), 0, 0, -1]);
-      edges = put(fields);
-    }
-    return m.check_level(...args, width, height, edges, l);
-  });
-
-/** The same for object `index`'s mesh (docs/format.md, "Objects"): it need not tile the image. */
-export const checkObject = (mesh: Level, index: number): void => checkMesh(mesh, (m, args) => m.check_object(...args, index));
-
-function checkMesh(level: Level, run: (m: Exports, args: number[], put: (a: Typed) => number) => number): void {
-  const { positions: p, colors: c, triangles: t, features } = level, nf = features.length;
-  const offsets = new Int32Array(nf + 1);
-  features.forEach((f, i) => (offsets[i + 1] = offsets[i] + f.vertices.length));
-  const verts = new Int32Array(offsets[nf]);
-  features.forEach((f, i) => verts.set(f.vertices, offsets[i]));
-  call(
-    (put, m) =>
-      run(m, [p.length / 2, put(p), c.length / 3, put(c), t.length / 3, put(t), put(level.triangleColors), level.creases.length / 2,
-        put(level.creases), nf, put(Int32Array.from(features, (f) => f.id)), put(Float64Array.from(features, (f) => f.saliency)),
-        put(offsets), put(verts)], put),
-    () => undefined,
-  );
-}
-
 // ---------------------------------------------------------------------------------------------
 // The JSON form (wasm/json.c).
 
@@ -276,54 +232,40 @@ function string(at: number, n: number, out: number): number {
 
 type Get = <T extends Typed>(c: TypedClass<T>, at: number, n: number) => T;
 
-// wasm/json.c's JsonImage, JsonLevel, JsonObject, JsonStroke, JsonEntry (32-bit fields; an Array
-// is n, then a pointer). Returns the image, the pyramid records of its levels, the edges of its
-// compact levels and the records of its objects' meshes (which must have none).
-function image(at: number, get: Get, i32: (at: number) => number, binary: boolean): [SvecImage, PyramidRecord[], Edges[], PyramidRecord[]] {
+// wasm/image.h's JsonImage, JsonLevel, JsonObject, JsonStroke, JsonEntry (32-bit fields; an
+// Array is n, then a pointer), read back after wasm/validate.c has checked them.
+function image(at: number, get: Get, i32: (at: number) => number): SvecImage {
   const f = (p: number, k: number) => i32(p + 4 * k);
   const ints = (p: number, k: number) => get(Int32Array, f(p, k + 1), f(p, k));
-  const text = (p: number, k: number) => {
-    try {
-      return utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
-    } catch {
-      return '\ud800'; // invalid UTF-8, which validate() reports in its place in the order
-    }
-  };
-  const records: PyramidRecord[] = [], topologies: Edges[] = [], objectRecords: PyramidRecord[] = [];
-  const mesh = (p: number, into: PyramidRecord[], l: number): Level => {
-    const nf = f(p, 14), edge = (k: number) => get(Int32Array, f(p, k), f(p, 19));
-    into[l] = { parents: ints(p, 10), collapses: ints(p, 12) };
-    if (f(p, 18)) topologies[l] = { a: edge(20), b: edge(21), g: edge(22) };
-    const saliency = get(Float64Array, f(p, 16), nf);
+  const text = (p: number, k: number) => utf8.decode(get(Uint8Array, f(p, k), f(p, k + 1)));
+  const mesh = (p: number): Level => {
+    const nf = f(p, 14), saliency = get(Float64Array, f(p, 16), nf);
     return {
       positions: get(Float64Array, f(p, 1), f(p, 0)), colors: get(Float32Array, f(p, 3), f(p, 2)), triangles: ints(p, 4),
       triangleColors: ints(p, 6), creases: ints(p, 8),
-      features: Array.from({ length: nf }, (_, k): Feature => {
-        const id = f(f(p, 15), k), vertices = ints(f(p, 17) + 8 * k, 0);
-        return binary ? { id, saliency: saliency[k], vertices } : { id, vertices, saliency: saliency[k] };
-      }),
+      features: Array.from({ length: nf }, (_, k): Feature => ({ id: f(f(p, 15), k), saliency: saliency[k], vertices: ints(f(p, 17) + 8 * k, 0) })),
     };
   };
-  const levels = Array.from({ length: f(at, 2) }, (_, l) => mesh(f(at, 3) + 92 * l, records, l));
-  const objects = Array.from({ length: f(at, 8) }, (_, k): SvecObject => {
-    const p = f(at, 9) + 108 * k;
-    return { level: f(p, 0), name: text(p, 2), visible: !!f(p, 1), mesh: mesh(p + 16, objectRecords, k) };
+  const strokes = (p: number) => Array.from({ length: f(p, 0) }, (_, k): Stroke => {
+    const s = f(p, 1) + 32 * k, v = get(Float32Array, s + 4, 5);
+    return { level: f(s, 0), points: get(Float64Array, f(s, 7), f(s, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
   });
-  const strokes = Array.from({ length: f(at, 4) }, (_, k): Stroke => {
-    const p = f(at, 5) + 32 * k, v = get(Float32Array, p + 4, 5);
-    return { level: f(p, 0), points: get(Float64Array, f(p, 7), f(p, 6)), width: v[0], color: [v[1], v[2], v[3]], taper: v[4] };
+  const levels = Array.from({ length: f(at, 2) }, (_, l) => mesh(f(at, 3) + 76 * l));
+  const objects = Array.from({ length: f(at, 8) }, (_, k): SvecObject => {
+    const p = f(at, 9) + 100 * k;
+    return { level: f(p, 0), name: text(p, 2), visible: !!f(p, 1), mesh: mesh(p + 16), strokes: strokes(p + 92) };
   });
   const metadata = Array.from({ length: f(at, 6) }, (_, k): [string, string] => [text(f(at, 7) + 16 * k, 0), text(f(at, 7) + 16 * k, 2)]);
-  return [{ width: f(at, 0), height: f(at, 1), levels, objects, strokes, metadata }, records, topologies, objectRecords];
+  return { width: f(at, 0), height: f(at, 1), levels, objects, strokes: strokes(at + 16), metadata };
 }
 
-/** A .svec.json file's image (before validate()), its pyramid records (and its objects'), or a SvecError. */
-export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), (at, get, i32) => image(at, get, i32, false));
+/** A .svec.json file's image, validated, or a SvecError. */
+export const readJson = (b: Uint8Array) => call((put, m) => m.json(put(b), b.length), image);
 
-/** A .svec payload's image (before validate()), its pyramid records, the compact levels' edges
- * and its objects' records, or a SvecError. `flags`: the header's (1: the payload holds objects). */
+/** A .svec payload's image, validated, or a SvecError. `flags`: the header's (1: the payload
+ * holds objects, 2: and their strokes). */
 export const readPayload = (b: Uint8Array, version: number, flags: number) =>
-  call((put, m) => m.payload(put(b), b.length, version, flags), (at, get, i32) => image(at, get, i32, true));
+  call((put, m) => m.payload(put(b), b.length, version, flags), image);
 
 /** A .svec file's header and its zstd frame's header and blocks checked (wasm/json.c): the
  * payload's size, the frame's end, what a cut raw block gives, the frame descriptor, the version, the flags. */

@@ -26,7 +26,7 @@ enum { OP_C, OP_L, OP_R, OP_E, OP_S };
 enum { VIRTUAL = 0, SPLIT = 1, X = 2, STEP_FIRST = 4, STEP_NEXT = 5, ID = 6, LENGTH = 7, COLOR = 8 };
 enum { CTX_OP_C = 1, CTX_OP_R = 9, CTX_OP_L = 17, SALIENCY = 25 + 170 * 23, CONTEXTS = SALIENCY + 8202 };
 enum { TAG_CREASE = 1, TAG_TEAR = 2, TAG_BORDER = 3 };
-static const double MAX_ELEMENTS = 67108864.0; // 2^26, validate.ts
+static const double MAX_ELEMENTS = 67108864.0; // 2^26, Limits::kMaxElements
 
 static double pow2(int k) {
   double v = 1;
@@ -860,8 +860,7 @@ static int32_t check_mesh(int32_t nv, const double *p, int32_t nc, const float *
   return 1;
 }
 
-// A level's rules (check_mesh), its messages prefixed "level L: ".
-EXPORT(check_level)
+// A level's rules (check_mesh), its messages prefixed "level L: " (validate.c calls it).
 int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
                     int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
                     const int32_t *offsets, const int32_t *verts, double width, double height, const Edges *built,
@@ -871,7 +870,6 @@ int32_t check_level(int32_t nv, const double *p, int32_t nc, const float *c, int
 }
 
 // Object `index`'s mesh (check_mesh), its messages prefixed "object N: ".
-EXPORT(check_object)
 int32_t check_object(int32_t nv, const double *p, int32_t nc, const float *c, int32_t nt, const int32_t *t, const int32_t *tc,
                      int32_t ncreases, const int32_t *creases, int32_t nfeatures, const int32_t *ids, const double *saliency,
                      const int32_t *offsets, const int32_t *verts, int32_t index) {

@@ -6,10 +6,11 @@
 //   (Number(), JSON.parse on strict UTF-8);
 // - the binary form: the header and the zstd frame's header and blocks (fzstd, in JavaScript,
 //   decompresses), then the payload: a cursor that names what it was reading, the version-1
-//   levels, the compact levels' counts and sections (decode.c decodes them), strokes, metadata
-//   and pyramid records.
-// Numbers in messages are written by JavaScript (message.h); the image-wide rules stay there
-// (validate.ts). wasm.ts reads the JsonImage back.
+//   levels, the compact levels' counts and sections (decode.c decodes them), the objects and
+//   their strokes, strokes, metadata and pyramid records.
+// Numbers in messages are written by JavaScript (message.h). Both readers end with the image-wide
+// rules (validate.c); wasm.ts reads the JsonImage (image.h) back.
+#include "image.h"
 #include "message.h"
 
 IMPORT(number) double js_number(const uint8_t *text, int32_t n);
@@ -300,7 +301,6 @@ static void tuple(const Node *t, const Path *p, int32_t n, const char *shape, Re
     store(out, type, at + k, read(x, &q));
   }
 }
-typedef struct { int32_t n; void *data; } Array; // n values
 static Array tuples(int type, const Node *j, const Path *p, int32_t n, const char *shape, Read *read) {
   const Node *items = list(j, p);
   Array a = {n * items->n, need_memory(alloc_array(type == F64 ? 8 : 4, (double)n * items->n + 1))};
@@ -344,29 +344,6 @@ static double field(const Node *m, const Path *up, const char *key, int type, in
 }
 #define REQUIRED __builtin_nan("")
 
-// What JavaScript reads back (wasm.ts): 32-bit fields.
-typedef struct {
-  Array positions, colors, triangles, triangle_colors, creases, parents, collapses;
-  int32_t num_features;
-  int32_t *feature_ids;
-  double *saliency;
-  Array *feature_vertices;
-  int32_t compact, num_edges; // a compact level: its edges (decode.c's), for validate()
-  int32_t *a, *b, *g;
-} JsonLevel;
-typedef struct { int32_t level; float width, color[3], taper; Array points; } JsonStroke;
-typedef struct { const uint8_t *key; int32_t keyn; const uint8_t *value; int32_t valuen; } JsonEntry;
-typedef struct { int32_t level, visible; const uint8_t *name; int32_t namen; JsonLevel mesh; } JsonObject;
-typedef struct {
-  int32_t width, height, num_levels;
-  JsonLevel *levels;
-  int32_t num_strokes;
-  JsonStroke *strokes;
-  int32_t num_metadata;
-  JsonEntry *metadata;
-  int32_t num_objects;
-  JsonObject *objects;
-} JsonImage;
 #define MAX_OBJECTS 4096
 
 // JSON.stringify of a value (format's), numbers as String().
@@ -434,6 +411,27 @@ static void json_level(const Node *j, const Path *p, JsonLevel *level) {
   field(m, p, "collapses", I32, 2, "[removed, kept] (two vertex indices)", 0, &level->collapses);
 }
 
+// m's "strokes" (the image's, or an object's), when it has them, into *out.
+static void json_strokes(const Node *m, const Path *up, Strokes *out) {
+  AT_KEY(ps, up, "strokes");
+  const Node *o = find(m, "strokes");
+  if (!o) return;
+  const Node *ss = list(o, &ps);
+  out->n = ss->n, out->items = (JsonStroke *)need_memory(NEW(JsonStroke, ss->n + 1));
+  int32_t k = 0;
+  for (const Node *j = ss->first; j; j = j->next, ++k) {
+    AT_INDEX(p, &ps, k);
+    const Node *s = known(j, &p, "level, points, width, color, taper");
+    JsonStroke *stroke = &out->items[k];
+    AT_KEY(pcl, &p, "color");
+    stroke->level = (int32_t)field(s, &p, "level", I32, 0, 0, 0, 0);
+    field(s, &p, "points", F64, 2, "[x, y]", REQUIRED, &stroke->points);
+    stroke->width = (float)field(s, &p, "width", F32, 0, 0, REQUIRED, 0);
+    tuple(need(s, &p, "color"), &pcl, 3, "[r, g, b]", to_float, stroke->color, F32, 0);
+    stroke->taper = (float)field(s, &p, "taper", F32, 0, 0, 0.25, 0);
+  }
+}
+
 EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
   b = bytes, len = n, i = depth = 0, table = 0, slots = used = 0;
   const Node *top = value();
@@ -469,7 +467,7 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
     int32_t k = 0;
     for (const Node *j = os->first; j; j = j->next, ++k) {
       AT_INDEX(p, &po, k);
-      const Node *m = known(j, &p, "level, name, visible, mesh"), *x;
+      const Node *m = known(j, &p, "level, name, visible, mesh, strokes"), *x;
       JsonObject *object = &image->objects[k];
       object->level = (int32_t)field(m, &p, "level", I32, 0, 0, 0, 0), object->visible = 1;
       AT_KEY(pn, &p, "name");
@@ -484,25 +482,10 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
       }
       AT_KEY(pme, &p, "mesh");
       json_level(need(m, &p, "mesh"), &pme, &object->mesh);
+      json_strokes(m, &p, &object->strokes);
     }
   }
-  AT_KEY(ps, 0, "strokes");
-  if ((o = find(top, "strokes"))) {
-    const Node *ss = list(o, &ps);
-    image->num_strokes = ss->n, image->strokes = (JsonStroke *)need_memory(NEW(JsonStroke, ss->n + 1));
-    int32_t k = 0;
-    for (const Node *j = ss->first; j; j = j->next, ++k) {
-      AT_INDEX(p, &ps, k);
-      const Node *m = known(j, &p, "level, points, width, color, taper");
-      JsonStroke *s = &image->strokes[k];
-      AT_KEY(pcl, &p, "color");
-      s->level = (int32_t)field(m, &p, "level", I32, 0, 0, 0, 0);
-      field(m, &p, "points", F64, 2, "[x, y]", REQUIRED, &s->points);
-      s->width = (float)field(m, &p, "width", F32, 0, 0, REQUIRED, 0);
-      tuple(need(m, &p, "color"), &pcl, 3, "[r, g, b]", to_float, s->color, F32, 0);
-      s->taper = (float)field(m, &p, "taper", F32, 0, 0, 0.25, 0);
-    }
-  }
+  json_strokes(top, 0, &image->strokes);
   AT_KEY(pm, 0, "metadata");
   if ((o = find(top, "metadata"))) {
     const Node *mm = object(o, &pm);
@@ -516,6 +499,7 @@ EXPORT(json) JsonImage *json(const uint8_t *bytes, int32_t n) {
       image->metadata[k] = (JsonEntry){x->key, x->keyn, x->s, x->n};
     }
   }
+  validate_image(image);
   return image;
 }
 
@@ -655,6 +639,24 @@ static int32_t vertex_index(int32_t record, double base, double code) {
   return (int32_t)(base + delta);
 }
 
+// Strokes as the trailer holds them, named by mesh_prefix ("": the image's, with `owner` unused;
+// "object # ": object `owner`'s).
+static void binary_strokes(int32_t owner, Strokes *out) {
+  int by_object = *mesh_prefix != 0;
+  level_name("strokes", owner, 0);
+  int32_t ns = out->n = count(28, MAX_ELEMENTS);
+  out->items = (JsonStroke *)need_memory(NEW(JsonStroke, ns + 1));
+  for (int32_t k = 0; k < ns; ++k) {
+    JsonStroke *s = &out->items[k];
+    level_name("stroke #", by_object ? owner : k, k);
+    s->level = (int32_t)u32(), s->width = (float)f32();
+    for (int q = 0; q < 3; ++q) s->color[q] = (float)f32();
+    s->taper = (float)f32();
+    level_name("stroke # points", by_object ? owner : k, k);
+    s->points = array(2.0 * count(16, MAX_ELEMENTS), 8);
+  }
+}
+
 EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t version, int32_t flags) {
   b = bytes, len = n, pos = what_count = 0, mesh_prefix = "level # ";
   JsonImage *image = (JsonImage *)need_memory(alloc(sizeof(JsonImage)));
@@ -698,7 +700,7 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
       level->feature_vertices = (Array *)need_memory(NEW(Array, c[4] + 1));
       const int32_t *offsets = FIELD(7), *vertices = FIELD(8);
       for (int32_t k = 0; k < c[4]; ++k) level->feature_vertices[k] = (Array){offsets[k + 1] - offsets[k], (void *)(vertices + offsets[k])};
-      level->compact = 1, level->num_edges = L[10], level->a = FIELD(11), level->b = FIELD(12), level->g = FIELD(14);
+      level->edges = L + 10;
       continue;
     }
     mesh_v1(level, l);
@@ -720,20 +722,12 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
       object->name = s.data, object->namen = s.n;
       mesh_v1(&object->mesh, k);
     }
-    mesh_prefix = "level # ";
+    // The objects' strokes (header flag 2), each object's as the image's.
+    if (flags & 2)
+      for (int32_t k = 0; k < no; ++k) binary_strokes(k, &image->objects[k].strokes);
   }
-  name("strokes", 0, 0);
-  int32_t ns = image->num_strokes = count(28, MAX_ELEMENTS);
-  image->strokes = (JsonStroke *)need_memory(NEW(JsonStroke, ns + 1));
-  for (int32_t k = 0; k < ns; ++k) {
-    JsonStroke *s = &image->strokes[k];
-    name("stroke #", k, 0);
-    s->level = (int32_t)u32(), s->width = (float)f32();
-    for (int q = 0; q < 3; ++q) s->color[q] = (float)f32();
-    s->taper = (float)f32();
-    name("stroke # points", k, 0);
-    s->points = array(2.0 * count(16, MAX_ELEMENTS), 8);
-  }
+  mesh_prefix = "";
+  binary_strokes(0, &image->strokes);
   name("metadata entries", 0, 0);
   int32_t nm = image->num_metadata = count(8, MAX_ELEMENTS);
   image->metadata = (JsonEntry *)need_memory(NEW(JsonEntry, nm + 1));
@@ -768,6 +762,7 @@ EXPORT(payload) JsonImage *payload(const uint8_t *bytes, int32_t n, int32_t vers
     }
   }
   if (left()) say_start(), say_number(AS_INTEGER, left()), say(" unexpected bytes after the payload's pyramid records"), say_fail();
+  validate_image(image);
   return image;
 }
 
@@ -807,7 +802,8 @@ EXPORT(container) double *container(const uint8_t *file, int32_t n) {
   uint64_t size, frame, available = (uint64_t)(n - 32);
   __builtin_memcpy(&version, file + 8, 4), __builtin_memcpy(&flags, file + 12, 4), __builtin_memcpy(&size, file + 16, 8), __builtin_memcpy(&frame, file + 24, 8);
   if (version < 1 || version > 3) say_start(), say("unsupported .svec version "), say_number(AS_INTEGER, version), say(" (this build reads 1, 2 and 3)"), say_fail();
-  if (flags & ~1u) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows 1: objects)"), say_fail();
+  if (flags & ~3u) say_start(), say("unsupported .svec flags "), say_number(AS_INTEGER, flags), say(" (this build knows 1: objects, 2: object strokes)"), say_fail();
+  if (flags == 2) say_start(), say(".svec flag 2 (object strokes) is set without flag 1 (objects)"), say_fail();
   if (size > 1073741824) say_start(), say("declared payload of "), say_u64(size), say(" bytes is over the limit of 1073741824"), say_fail();
   if (frame > available)
     say_start(), say("truncated .svec file: the header declares a "), say_u64(frame), say("-byte zstd frame but only "), say_u64(available), say(" bytes follow"), say_fail();

@@ -2,7 +2,7 @@
 
 IMPORT(fail) __attribute__((noreturn)) void js_fail(const uint8_t *message, int32_t n);
 
-int32_t message_level, message_prefix;
+int32_t message_level, message_prefix, message_owner;
 const double *message_positions;
 
 static uint8_t *text;
@@ -37,7 +37,8 @@ void say_fail(void) { js_fail(text, said); }
 // "%g", \5 a word, \6 chain (is feature, i): "feature i" or "crease i", \7 the same with the id
 // ("feature i (id d)"), \10 a vertex's position "(x, y)", \16 what a version 2 section read
 // (section, feature: the section's name, or "feature i" when i >= 0). \1 is the level's name
-// ("level L "), \2 the checks' prefix ("level L: ", or "object L: ").
+// ("level L "), \2 the checks' prefix ("level L: ", "object L: ", or a stroke's "stroke L: " or
+// "object N stroke L: ").
 static const char *const TEMPLATES[] = {
   "out of memory: the image needs more than WebAssembly can hold",
   "\1stream: corrupt coded data (bad first bytes)",
@@ -99,12 +100,33 @@ static const char *const TEMPLATES[] = {
   "\2has no triangles",
   "\2vertex \3 \10 is on \3 boundary edges (an object's boundary is made of closed loops, two edges at each vertex)",
   "\2triangles overlap around vertex \3 \10: their angles there sum to \4*pi",
+  "\5 \3 is not positive",
+  "\5 \3 is over the limit of 65536",
+  "image size \3 x \3 is over the limit of 1073741824 pixels",
+  "the image has no levels",
+  "\2level 0 has no level before it, but names parent vertices or collapses",
+  "\2\3 parent vertices for \3 vertices",
+  "\2\3 collapses do not take level \3's \3 vertices to \3",
+  "\2parent vertex \3 is \3, out of range",
+  "\2parent vertex \3 appears twice",
+  "\2collapse \3 (\3, \3) is out of range",
+  "\2collapse \3 removes vertex \3, which is kept or already removed",
+  "\2level \3 is out of range (\3 levels)",
+  "\2name is not UTF-8",
+  "\2an object has no parent vertices or collapses",
+  "\2stroke \3: level \3 is not the object's level \3",
+  "\2has fewer than two points",
+  "\2point \3 (\4, \4) is not finite",
+  "\2width \4 is not a positive number",
+  "\2color (\4, \4, \4) is not finite",
+  "\2taper \4 is outside [0, 0.5]",
 };
 static const char *const WORDS[] = {"connectivity", "split offsets", "positions", "features", "feature steps", "colors", "header",
-                                    "overlap", "leave a gap", "an image corner", "a border vertex", "an interior vertex"};
+                                    "overlap", "leave a gap", "an image corner", "a border vertex", "an interior vertex", "width", "height"};
 
 static void say_level(const char *end) {
-  say(message_prefix == 2 ? "object " : "level ");
+  if (message_prefix == 3 && message_owner >= 0) say("object "), say_number(AS_INTEGER, message_owner), say(" ");
+  say(message_prefix == 3 ? "stroke " : message_prefix == 2 ? "object " : "level ");
   say_number(AS_INTEGER, message_level);
   say(end);
 }

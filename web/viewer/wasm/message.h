@@ -10,7 +10,9 @@ enum { AS_INTEGER = 0xfd, AS_G, AS_DUMP };
 
 // The level the messages name ("level L ", and "level L: " while `message_prefix` is 1, "object
 // L: " while it is 2), and its positions (for the messages that show a vertex's position).
-extern int32_t message_level, message_prefix;
+// "object N stroke K: " / "stroke K: " while it is 3, with message_owner N (-1: the image's) and
+// message_level K.
+extern int32_t message_level, message_prefix, message_owner;
 extern const double *message_positions;
 
 void say_start(void);
@@ -45,6 +47,10 @@ enum {
   V_FLIPPED, V_UNUSED_VERTEX, V_GAP_EDGE, V_NO_CORNER, V_ANGLES, V_AREA, V_COLOR_OWNER, V_UNUSED_COLOR, V_COLOR_EDGE,
   // an object's mesh (check_object)
   V_POSITION_FAR, V_NO_TRIANGLES, V_BOUNDARY_EDGES, V_TURNS,
+  // the image-wide rules (validate.c): size, pyramid links, objects, strokes
+  V_NOT_POSITIVE, V_OVER_LIMIT, V_IMAGE_SIZE, V_NO_LEVELS,
+  L_LEVEL_0, L_PARENT_COUNT, L_COLLAPSE_COUNT, L_PARENT_RANGE, L_PARENT_TWICE, L_COLLAPSE_RANGE, L_COLLAPSE_REMOVES,
+  O_LEVEL, O_NAME, O_RECORD, O_STROKE_LEVEL, S_FEW_POINTS, S_POINT, S_WIDTH, S_COLOR, S_TAPER,
 };
 // Words of the templates' \5 (section names first, in decode.c's order).
-enum { W_OVERLAP = 7, W_GAP, W_CORNER };
+enum { W_OVERLAP = 7, W_GAP, W_CORNER, W_WIDTH = 12 };

@@ -29,12 +29,14 @@ export interface Stroke {
 }
 /** An object (a layer, docs/format.md "Objects"): a control mesh of its own drawn over its level,
  * in file order from the bottom, when visible. Its mesh need not tile the image: its boundary
- * edges are creases, and what it covers is composited over the level. */
+ * edges are creases, and what it covers is composited over the level. Its strokes (each of the
+ * object's level) are drawn over it, under the objects above it. */
 export interface SvecObject {
     level: number;
     name: string;
     visible: boolean;
     mesh: Level;
+    strokes: Stroke[];
 }
 export interface SvecImage {
     width: number;

@@ -18,6 +18,8 @@ export interface RenderStats {
 }
 export declare const DEFAULT_MAX_EDGE_PIXELS = 5;
 export declare function chooseDepth(meanEdgePixels: number, maxEdgePixels: number, zoom: number, faces: number): number;
+/** Whether w is a window: finite, x0 < x1 and y0 < y1. */
+export declare const validWindow: (w: ViewWindow) => boolean;
 export declare class SubvecRenderer {
     #private;
     readonly canvas: HTMLCanvasElement | OffscreenCanvas;
