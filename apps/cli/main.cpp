@@ -106,6 +106,7 @@ struct RenderArgs {
   double tolerance = 0.25;  // .pdf and .svg only
   std::string pdf_target = "any";  // .pdf only: any or poppler (checked by CLI11)
   std::string svg_target = "browser";  // .svg only: browser or inkscape (checked by CLI11)
+  double svg_color_tolerance = subvec::ExportOptions{}.linear_color_tolerance;  // .svg, browser
   bool verbose = false;     // -v: what a vector export holds
   bool gpu = false;         // --gpu (issue 10, docs/gpu.md)
   int64_t max_pixels = subvec::RenderOptions{}.max_pixels;  // the library's default
@@ -141,14 +142,19 @@ void run_vector_export(const RenderArgs& a, const subvec::VectorImage& image, bo
       lower(a.pdf_target) == "poppler" ? subvec::PdfTarget::kPoppler : subvec::PdfTarget::kAny;
   options.svg_target = lower(a.svg_target) == "inkscape" ? subvec::SvgTarget::kInkscape
                                                          : subvec::SvgTarget::kBrowser;
+  options.linear_color_tolerance = a.svg_color_tolerance;
   subvec::ExportReport report;
   subvec::write_vector_export(a.output, image, options, &report);
   if (a.verbose) {
-    const std::string pieces =
+    std::string pieces =
         report.patches ? std::to_string(report.patches) + " mesh patches (one per control face)"
                        : std::to_string(report.triangles) + " triangles (control faces at depths " +
                              std::to_string(report.min_depth) + " to " +
                              std::to_string(report.depth) + ")";
+    if (report.shapes > 0) {
+      pieces += " in " + std::to_string(report.shapes) + " shapes, " + std::to_string(report.gradients) +
+                " of them linear gradients";
+    }
     std::fprintf(stderr, "subvec: %s: %s, %lld tear hints, %lld strokes, %lld bytes\n",
                  a.output.c_str(), pieces.c_str(), static_cast<long long>(report.tear_hints),
                  static_cast<long long>(report.strokes), static_cast<long long>(report.bytes));
@@ -806,11 +812,17 @@ int run(int argc, char** argv) {
       ->default_str("any");
   render
       ->add_option("--svg-target", ra.svg_target,
-                   ".svg: the programs the file is built for: browser (default; flat triangles, "
-                   "drawn alike by browsers and librsvg) or inkscape (SVG 2 mesh gradients, one "
+                   ".svg: the programs the file is built for: browser (default; linear gradients "
+                   "and flat triangles, drawn alike by browsers and librsvg) or inkscape (SVG 2 mesh gradients, one "
                    "patch per control face, editable with Inkscape's mesh tool)")
       ->check(CLI::IsMember({"browser", "inkscape"}, CLI::ignore_case))
       ->default_str("browser");
+  render
+      ->add_option("--svg-color-tolerance", ra.svg_color_tolerance,
+                   ".svg for browsers: how far, on average in levels (0-255), a linear gradient may "
+                   "stray from the limit surface's colors over its cell (default 8); smaller gives "
+                   "truer colors and larger files")
+      ->check(subvec_cli::positive_number());
   render->add_flag("-v,--verbose", ra.verbose,
                    ".pdf, .svg: print what the file holds (triangles or patches, tear hints, "
                    "strokes) and its size");

@@ -28,6 +28,9 @@ using detail::invalid;
 using detail::num;
 
 constexpr int64_t kMaxTriangles = int64_t{1} << 24;
+// What the SVG writer spends, about, on a flat triangle (a subpath in its color's path) and on a
+// linear gradient (its definition and its path): how Shading::kLinear chooses between them.
+constexpr double kFlatTriangleBytes = 50, kGradientBytes = 200;
 
 // Calls edge(i0, j0, i1, j1) for each edge of the triangles of a face's grid of size n (the
 // grid points (i, j), i + j <= n): each once.
@@ -140,6 +143,44 @@ FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int s
     for_each_grid_edge(n, edge);
     return error;
   }
+  if (tolerance.shading == Shading::kLinear) {
+    // A triangle against the LinearColor fitted to its corners and edge midpoints: the mean of its
+    // error there. (The largest error made every cell on a textured photograph split: a linear
+    // gradient cannot follow the hump of color around each control vertex, which averages out.)
+    auto triangle = [&](std::array<int, 2> p, std::array<int, 2> q, std::array<int, 2> r) {
+      const std::array<std::array<int, 2>, 3> c = {p, q, r};
+      std::array<ColorSample, 6> samples;
+      for (int e = 0; e < 3; ++e) {
+        const Value& a = at(2 * c[e][0], 2 * c[e][1]);
+        const Value& m = at(c[e][0] + c[(e + 1) % 3][0], c[e][1] + c[(e + 1) % 3][1]);
+        samples[e] = {a.x, a.y, {a.c[0], a.c[1], a.c[2]}};
+        samples[3 + e] = {m.x, m.y, {m.c[0], m.c[1], m.c[2]}};
+      }
+      const LinearColor fit = fit_linear_color(samples);
+      double position = 0, color = 0, longest = 0, drawn[3];
+      for (int e = 0; e < 3; ++e) {
+        const auto &s0 = c[e], &t0 = c[(e + 1) % 3];
+        const Value &a = at(2 * s0[0], 2 * s0[1]), &b = at(2 * t0[0], 2 * t0[1]);
+        const double delta = midpoint_deviation(a, b, at(s0[0] + t0[0], s0[1] + t0[1]));
+        if (sharp(s0[0], s0[1], t0[0], t0[1])) position = std::max(position, delta);
+        fit.at(a.x, a.y, drawn);
+        const double e0 = color_error(2 * s0[0], 2 * s0[1], drawn, 0);
+        // The chord's midpoint draws the fit's color there, for the limit's point `delta` away.
+        fit.at(0.5 * (a.x + b.x), 0.5 * (a.y + b.y), drawn);
+        const double e1 = color_error(s0[0] + t0[0], s0[1] + t0[1], drawn, delta);
+        color += (e0 + e1) / 6;  // the mean over the six samples
+        longest = std::max(longest, length(a, b));
+      }
+      record(position, color, longest);
+    };
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i + j < n; ++i) {
+        triangle({i, j}, {i + 1, j}, {i, j + 1});
+        if (i + j + 1 < n) triangle({i + 1, j}, {i + 1, j + 1}, {i, j + 1});
+      }
+    }
+    return error;
+  }
   // Flat: a triangle (corners p, q, r in grid units at depth d) against its mean color at its
   // corners and edge midpoints.
   auto triangle = [&](std::array<int, 2> p, std::array<int, 2> q, std::array<int, 2> r) {
@@ -170,6 +211,44 @@ FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int s
 }
 
 }  // namespace
+
+LinearColor fit_linear_color(std::span<const ColorSample> samples) {
+  LinearColor out;
+  const double n = double(samples.size());
+  if (samples.empty()) return out;
+  for (const ColorSample& s : samples) {
+    out.centre[0] += s.x / n, out.centre[1] += s.y / n;
+    for (int k = 0; k < 3; ++k) out.mean[k] += s.c[k] / n;
+  }
+  // Least squares per channel: the gradient b_k solves S b_k = r_k, S the points' scatter.
+  double sxx = 0, sxy = 0, syy = 0, r[3][2] = {};
+  for (const ColorSample& s : samples) {
+    const double dx = s.x - out.centre[0], dy = s.y - out.centre[1];
+    sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
+    for (int k = 0; k < 3; ++k) r[k][0] += dx * (s.c[k] - out.mean[k]), r[k][1] += dy * (s.c[k] - out.mean[k]);
+  }
+  const double det = sxx * syy - sxy * sxy;
+  if (!(det > 1e-12 * (sxx + syy) * (sxx + syy))) return out;  // collinear points: flat
+  // Along a unit direction d the best slopes are (r_k . d) / (d^T S d), and they take away
+  // sum_k (r_k . d)^2 / (d^T S d) of the squared residual: the best d is the top eigenvector of
+  // the pencil (M, S), M = sum_k r_k r_k^T, i.e. of A = S^-1 M.
+  double m00 = 0, m01 = 0, m11 = 0;
+  for (int k = 0; k < 3; ++k) m00 += r[k][0] * r[k][0], m01 += r[k][0] * r[k][1], m11 += r[k][1] * r[k][1];
+  const double a00 = (syy * m00 - sxy * m01) / det, a01 = (syy * m01 - sxy * m11) / det;
+  const double a10 = (sxx * m01 - sxy * m00) / det, a11 = (sxx * m11 - sxy * m01) / det;
+  const double trace = a00 + a11, disc = std::max(0.0, trace * trace - 4 * (a00 * a11 - a01 * a10));
+  const double lambda = 0.5 * (trace + std::sqrt(disc));
+  // (A - lambda I) d = 0: of the two rows' null vectors, the better conditioned.
+  double dx = a01, dy = lambda - a00;
+  if (std::hypot(lambda - a11, a10) > std::hypot(dx, dy)) dx = lambda - a11, dy = a10;
+  const double norm = std::hypot(dx, dy);
+  if (!(norm > 0)) return out;  // no variation: flat
+  out.direction[0] = dx / norm, out.direction[1] = dy / norm;
+  const double dsd = sxx * out.direction[0] * out.direction[0] + 2 * sxy * out.direction[0] * out.direction[1] +
+                     syy * out.direction[1] * out.direction[1];
+  for (int k = 0; k < 3; ++k) out.slope[k] = (r[k][0] * out.direction[0] + r[k][1] * out.direction[1]) / dsd;
+  return out;
+}
 
 LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mesh, int depth,
                          double position_tolerance, double color_tolerance,
@@ -241,7 +320,8 @@ std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlM
 }
 
 RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& topology,
-                                const LimitEvaluator& evaluator, std::span<const uint8_t> depths) {
+                                const LimitEvaluator& evaluator, std::span<const uint8_t> depths,
+                                std::vector<std::array<float, 6>>* params) {
   const int faces = mesh.num_triangles();
   // An edge is sampled at the finer depth of its faces.
   std::vector<uint8_t> edge_depth(topology.num_edges(), 0);
@@ -268,10 +348,11 @@ RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& top
   constexpr int kKeyBits = 16;
   struct Point {
     int32_t vertex, color;
+    float u = 0, v = 0;  // in the face it was made for
   };
   // The point of face f at parameters (u, v) = (i, j) / 2^depth; `side` is the face's edge k that
   // it lies on (-1 inside), `t` its parameter along that edge from corner k, as a multiple of 2^-16.
-  auto point = [&](int f, int depth, int i, int j) -> Point {
+  auto point_of = [&](int f, int depth, int i, int j) -> Point {
     const Tri& v = mesh.triangles[f];
     const Tri& c = mesh.triangle_colors[f];
     const int n = 1 << depth;
@@ -306,7 +387,14 @@ RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& top
     const int32_t q = color != edge_color.end() ? color->second : edge_color[color_key] = new_color(value);
     return {p, q};
   };
+  // The same, with its parameters in face f.
+  auto point = [&](int f, int depth, int i, int j) -> Point {
+    Point p = point_of(f, depth, i, j);
+    p.u = static_cast<float>(double(i) / (1 << depth)), p.v = static_cast<float>(double(j) / (1 << depth));
+    return p;
+  };
   auto triangle = [&](int f, const Point& a, const Point& b, const Point& c) {
+    if (params) params->push_back({a.u, a.v, b.u, b.v, c.u, c.v});
     out.triangles.push_back({a.vertex, b.vertex, c.vertex});
     out.triangle_colors.push_back({a.color, b.color, c.color});
     out.triangle_parent.push_back(f);
@@ -357,7 +445,8 @@ RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& top
         } else {
           // Fan from the triangle's centre.
           const Value value = evaluate(evaluator, f, (i + 1.0 / 3) / n, (j + 1.0 / 3) / n);
-          const Point centre{new_vertex(value), new_color(value)};
+          const Point centre{new_vertex(value), new_color(value), static_cast<float>((i + 1.0 / 3) / n),
+                             static_cast<float>((j + 1.0 / 3) / n)};
           for (size_t k = 0; k < polygon.size(); ++k)
             triangle(f, centre, polygon[k], polygon[(k + 1) % polygon.size()]);
         }
@@ -413,6 +502,10 @@ double check_export_options(const VectorImage& image, const ExportOptions& optio
     invalid("tolerance " + num(options.tolerance) + " is not a positive number");
   if (!(options.color_tolerance > 0) || !std::isfinite(options.color_tolerance))
     invalid("color tolerance " + num(options.color_tolerance) + " is not a positive number");
+  if (!(options.flat_color_tolerance > 0) || !std::isfinite(options.flat_color_tolerance))
+    invalid("flat color tolerance " + num(options.flat_color_tolerance) + " is not a positive number");
+  if (!(options.linear_color_tolerance > 0) || !std::isfinite(options.linear_color_tolerance))
+    invalid("linear color tolerance " + num(options.linear_color_tolerance) + " is not a positive number");
   if (options.depth > 8) invalid("depth " + std::to_string(options.depth) + " is over 8");
   if (options.max_depth < 0 || options.max_depth > 8)
     invalid("max depth " + std::to_string(options.max_depth) + " is out of range (0 to 8)");
@@ -423,10 +516,11 @@ namespace {
 
 // export_mesh() of one control mesh (a level's, or an object's) with its topology.
 RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology, double scale,
-                           const ExportOptions& options, Shading shading, ExportReport& report) {
+                           const ExportOptions& options, Shading shading, ExportReport& report,
+                           LinearCells* cells) {
   const int64_t faces = mesh.num_triangles();
   const LimitEvaluator evaluator(mesh, topology);
-  std::vector<uint8_t> depths;
+  std::vector<uint8_t> depths, color_depths, flat_faces;
   if (options.depth >= 0) {
     if (faces << (2 * options.depth) > kMaxTriangles) {
       throw Error(ErrorCode::kLimit, "depth " + std::to_string(options.depth) + " over " +
@@ -438,8 +532,9 @@ RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology
     FaceTolerance tolerance;
     tolerance.shading = shading;
     tolerance.position = options.tolerance / scale;
-    tolerance.color = shading == Shading::kFlat ? options.flat_color_tolerance
-                                                : options.color_tolerance;
+    tolerance.color = shading == Shading::kGouraud ? options.color_tolerance
+                      : shading == Shading::kFlat  ? options.flat_color_tolerance
+                                                   : options.linear_color_tolerance;
     tolerance.small = 1 / scale;
     // No face goes deeper than `subvec render` refines the whole image at this scale (its depth
     // rule, which also keeps the triangles under 2^24): the renderer is the reference.
@@ -454,12 +549,99 @@ RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology
         options.max_depth, choose_depth(faces ? edge_sum / double(3 * faces) : 0,
                                         RenderOptions{}.max_edge_pixels, scale, faces));
     LinearError error;
-    depths = face_depths(evaluator, mesh, topology, tolerance, max_depth, &error);
+    if (shading == Shading::kLinear) {
+      // Geometry: chords within the position tolerance on the sharp sides, whatever the color.
+      FaceTolerance geometry = tolerance;
+      geometry.shading = Shading::kFlat;
+      geometry.color = INFINITY;
+      depths = face_depths(evaluator, mesh, topology, geometry, max_depth);
+      // Colors: each cell's fit within the color tolerance.
+      FaceTolerance color = tolerance;
+      color.position = INFINITY;
+      color_depths = face_depths(evaluator, mesh, topology, color, max_depth, &error);
+      // Or flat triangles, where they take fewer bytes: a face whose color curves needs many
+      // cells, and a linear gradient costs about ten flat triangles.
+      FaceTolerance flat = tolerance;
+      flat.shading = Shading::kFlat;
+      flat.position = INFINITY;
+      flat.color = options.flat_color_tolerance;
+      const std::vector<uint8_t> flat_depths = face_depths(evaluator, mesh, topology, flat, max_depth);
+      flat_faces.assign(faces, 0);
+      for (int64_t f = 0; f < faces; ++f) {
+        const int as_flat = std::max(depths[f], flat_depths[f]);
+        const double flat_bytes = kFlatTriangleBytes * double(int64_t{1} << (2 * as_flat));
+        const double linear_bytes = kGradientBytes * double(int64_t{1} << (2 * color_depths[f]));
+        if (flat_bytes < linear_bytes) {
+          flat_faces[f] = 1;
+          depths[f] = color_depths[f] = static_cast<uint8_t>(as_flat);
+        } else {
+          depths[f] = std::max(depths[f], color_depths[f]);
+        }
+      }
+    } else {
+      depths = face_depths(evaluator, mesh, topology, tolerance, max_depth, &error);
+    }
     report.max_position_error = error.max_position * scale;
     report.max_color_error = error.max_color;
     report.over_tolerance = error.edges ? double(error.over) / double(error.edges) : 0;
   }
-  RefinedMesh refined = adaptive_limit_mesh(mesh, topology, evaluator, depths);
+  if (cells && color_depths.empty()) color_depths = depths;  // an explicit depth: one cell a triangle
+  std::vector<std::array<float, 6>> params;
+  RefinedMesh refined = adaptive_limit_mesh(mesh, topology, evaluator, depths, cells ? &params : nullptr);
+  if (cells) {
+    // Cells numbered face by face: face f's cells are the 4^c triangles of its grid at its color
+    // depth c, (i, j) upward as 2 (j-row-major index), downward + 1.
+    std::vector<int64_t> first(size_t(faces) + 1, 0);
+    for (int64_t f = 0; f < faces; ++f) first[f + 1] = first[f] + (int64_t{1} << (2 * color_depths[f]));
+    auto cell_index = [&](int f, int i, int j, bool down) {
+      const int n = 1 << color_depths[f];
+      // Triangles of rows below j: row r holds 2 (n - r) - 1.
+      int64_t k = int64_t(j) * (2 * n - j);
+      return first[f] + k + 2 * i + (down ? 1 : 0);
+    };
+    cells->cell_of.resize(refined.triangles.size());
+    for (int32_t t = 0; t < refined.num_triangles(); ++t) {
+      const std::array<float, 6>& q = params[size_t(t)];
+      const int f = refined.triangle_parent[t];
+      const int n = 1 << color_depths[f];
+      const double u = (double(q[0]) + q[2] + q[4]) / 3 * n, v = (double(q[1]) + q[3] + q[5]) / 3 * n;
+      const int i = std::clamp(int(std::floor(u)), 0, n - 1), j = std::clamp(int(std::floor(v)), 0, n - 1 - i);
+      const bool down = (u - i) + (v - j) > 1 && i + j + 1 < n;
+      cells->cell_of[size_t(t)] = static_cast<int32_t>(cell_index(f, i, j, down));
+    }
+    cells->colors.assign(size_t(first[faces]), LinearColor{});
+    parallel_for(static_cast<int>(faces), 0, [&](int f) {
+      const int n = 1 << color_depths[f];
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i + j < n; ++i) {
+          for (int down = 0; down < 2; ++down) {
+            if (down && i + j + 1 >= n) continue;
+            // The cell's corners in the face's parameters.
+            const double c[3][2] = {{double(i + down), double(j)},
+                                    {double(i + (down ? 1 : 0)), double(j + 1)},
+                                    {double(down ? i : i + 1), double(down ? j + 1 : j)}};
+            const double d[3][2] = {{c[0][0] / n, c[0][1] / n}, {c[1][0] / n, c[1][1] / n}, {c[2][0] / n, c[2][1] / n}};
+            std::array<ColorSample, 7> samples;
+            constexpr double kWeights[7][3] = {{1, 0, 0},     {0, 1, 0},     {0, 0, 1},       {0.5, 0.5, 0},
+                                               {0, 0.5, 0.5}, {0.5, 0, 0.5}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+            for (int k = 0; k < 7; ++k) {
+              const double* w = kWeights[k];
+              const Value value = evaluate(evaluator, f, w[0] * d[0][0] + w[1] * d[1][0] + w[2] * d[2][0],
+                                           w[0] * d[0][1] + w[1] * d[1][1] + w[2] * d[2][1]);
+              samples[k] = {value.x, value.y, {value.c[0], value.c[1], value.c[2]}};
+            }
+            LinearColor& fit = cells->colors[size_t(cell_index(f, i, j, down != 0))];
+            if (!flat_faces.empty() && flat_faces[f]) {
+              // A flat triangle: the mean of its corners.
+              for (int k = 0; k < 3; ++k) fit.mean[k] = (samples[0].c[k] + samples[1].c[k] + samples[2].c[k]) / 3;
+            } else {
+              fit = fit_linear_color(samples);
+            }
+          }
+        }
+      }
+    });
+  }
   report.depth = refined.depth;
   report.min_depth = depths.empty() ? 0 : *std::min_element(depths.begin(), depths.end());
   report.triangles = refined.num_triangles();
@@ -469,11 +651,11 @@ RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology
 }  // namespace
 
 RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
-                        ExportReport& report) {
+                        ExportReport& report, LinearCells* cells) {
   const double scale = check_export_options(image, options);
   const ControlMesh& mesh = image.levels[options.level];
   const MeshTopology topology = validate_level(mesh, image.width, image.height, options.level);
-  return export_mesh_of(mesh, topology, scale, options, shading, report);
+  return export_mesh_of(mesh, topology, scale, options, shading, report, cells);
 }
 
 std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const ExportOptions& options,
@@ -482,14 +664,16 @@ std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const Exp
   std::vector<ObjectMesh> out;
   for (const ObjectTopology& o : visible_objects(image, options.level)) {
     ExportReport part;
-    RefinedMesh mesh = export_mesh_of(image.objects[o.object].mesh, o.topology, scale, options, shading, part);
+    LinearCells cells;
+    RefinedMesh mesh = export_mesh_of(image.objects[o.object].mesh, o.topology, scale, options, shading, part,
+                                      shading == Shading::kLinear ? &cells : nullptr);
     report.depth = std::max(report.depth, part.depth);
     report.min_depth = std::min(report.min_depth, part.min_depth);
     report.triangles += part.triangles;
     report.max_position_error = std::max(report.max_position_error, part.max_position_error);
     report.max_color_error = std::max(report.max_color_error, part.max_color_error);
     ++report.objects;
-    out.push_back({o.object, std::move(mesh)});
+    out.push_back({o.object, std::move(mesh), std::move(cells)});
   }
   return out;
 }

@@ -2,6 +2,7 @@
 // as its own error needs, stitched without cracks.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -28,8 +29,30 @@ LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mes
                          std::vector<double>* positions = nullptr);
 
 // How a viewer fills a refined triangle: Gouraud (PDF's free-form meshes interpolate the corner
-// colors linearly) or flat (SVG: one color, the mean of the corners).
-enum class Shading : uint8_t { kGouraud, kFlat };
+// colors linearly), flat (one color, the mean of the corners) or linear (SVG's browser target: a
+// linear gradient, the rank-one least-squares fit of the limit colors over the triangle).
+enum class Shading : uint8_t { kGouraud, kFlat, kLinear };
+
+// A color that varies along one direction: c(p) = mean + ((p - centre) . direction) slope, the
+// colors of an SVG linearGradient (one direction for all three channels).
+struct LinearColor {
+  double centre[2] = {0, 0};
+  double mean[3] = {0, 0, 0};
+  double direction[2] = {1, 0};  // unit
+  double slope[3] = {0, 0, 0};   // levels per pixel along `direction`
+  void at(double x, double y, double* out) const {
+    const double t = (x - centre[0]) * direction[0] + (y - centre[1]) * direction[1];
+    for (int k = 0; k < 3; ++k) out[k] = mean[k] + t * slope[k];
+  }
+};
+
+// The LinearColor that best fits colors c_i at points (x_i, y_i) in the least-squares sense: of
+// all colors that vary along one direction, the one with the smallest sum of squared differences
+// (the top eigenvector of a 2 x 2 pencil, see the code). Flat when the points are collinear.
+struct ColorSample {
+  double x, y, c[3];
+};
+LinearColor fit_linear_color(std::span<const ColorSample> samples);
 
 // What a face's refined triangles must meet, in image pixels and levels (0-255).
 struct FaceTolerance {
@@ -58,22 +81,38 @@ std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlM
 // T-junctions. Vertices are shared where faces meet; color values too, except across tears.
 // tear_edges, crease_edges and border_edges list the refined edges along the control mesh's sharp
 // edges. With every depth equal to d this is the uniformly refined mesh at depth d.
+// With `params`, each refined triangle's corners' parameters in its control face (u, v).
 RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& topology,
-                                const LimitEvaluator& evaluator, std::span<const uint8_t> depths);
+                                const LimitEvaluator& evaluator, std::span<const uint8_t> depths,
+                                std::vector<std::array<float, 6>>* params = nullptr);
 
 // Checks the options and the level (Error as export.h says) and returns the scale.
 double check_export_options(const VectorImage& image, const ExportOptions& options);
 
+// Shading::kLinear's colors. The geometry and the colors need different depths: a tear must be
+// drawn within a fraction of a pixel, and a face's color may be one linear gradient. So each face
+// is cut into color cells, the triangles of the grid of its parameters at its color depth (the
+// smallest at which the LinearColor fitted to each cell meets the color tolerance), and refined
+// at the deeper of that and its geometry depth; every refined triangle lies in one cell and draws
+// that cell's color.
+struct LinearCells {
+  std::vector<int32_t> cell_of;      // per refined triangle
+  std::vector<LinearColor> colors;   // per cell, fitted to the limit at its corners, edge midpoints
+                                     // and centre
+};
+
 // The mesh an export draws: options.depth everywhere when it is given, else each face at the depth
-// of the tolerances for `shading` (report: depths, triangles, errors).
+// of the tolerances for `shading` (report: depths, triangles, errors). Shading::kLinear fills
+// `cells`.
 RefinedMesh export_mesh(const VectorImage& image, const ExportOptions& options, Shading shading,
-                        ExportReport& report);
+                        ExportReport& report, LinearCells* cells = nullptr);
 
 // The visible objects of options.level (mesh/vector_image.h), bottom to top, each refined as
 // export_mesh() refines a level; the report adds their triangles, depths, errors and count.
 struct ObjectMesh {
   int object = 0;  // index in VectorImage::objects
   RefinedMesh mesh;
+  LinearCells cells;  // Shading::kLinear
 };
 std::vector<ObjectMesh> export_object_meshes(const VectorImage& image, const ExportOptions& options,
                                              Shading shading, ExportReport& report);

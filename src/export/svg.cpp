@@ -28,12 +28,24 @@ namespace {
 
 // Consecutive tear bands whose colors are this close (levels) are drawn as one (export_p.h).
 constexpr double kHintColorTolerance = 1.0;
+// A triangle whose LinearColor varies by less than this (levels) is drawn flat.
+constexpr double kFlatRange = 1.0;
 
 std::string hex_color(double r, double g, double b) {
   auto byte = [](double v) { return static_cast<int>(std::lround(std::clamp(v, 0.0, 255.0))); };
   char buf[8];
   std::snprintf(buf, sizeof buf, "#%02x%02x%02x", byte(r), byte(g), byte(b));
   return buf;
+}
+
+// n in base 36 (least significant digit first): short ids.
+std::string base36(int64_t n) {
+  std::string id;
+  do {
+    id += "0123456789abcdefghijklmnopqrstuvwxyz"[n % 36];
+    n /= 36;
+  } while (n > 0);
+  return id;
 }
 
 std::string xml_text(const std::string& s) {
@@ -150,14 +162,7 @@ void mesh_patches(const ControlMesh& mesh, const MeshTopology& topology, int dec
   }
 
   // Base-36 ids: the file repeats one per face twice.
-  auto id_of = [&](int f) {
-    std::string id;
-    do {
-      id += "0123456789abcdefghijklmnopqrstuvwxyz"[f % 36];
-      f /= 36;
-    } while (f > 0);
-    return prefix + id;
-  };
+  auto id_of = [&](int f) { return prefix + base36(f); };
   for (int f = 0; f < mesh.num_triangles(); ++f) {
     const Tri& v = mesh.triangles[f];
     std::array<std::array<Vec2, 4>, 3> side;
@@ -266,10 +271,10 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   ExportReport local;
   ExportReport& r = report ? *report : local;
   if (options.svg_target == SvgTarget::kInkscape) return svg_mesh(image, options, r);
-  const RefinedMesh mesh =
-      detail::export_mesh(image, options, detail::Shading::kFlat, r);
+  detail::LinearCells cells;
+  const RefinedMesh mesh = detail::export_mesh(image, options, detail::Shading::kLinear, r, &cells);
   const std::vector<detail::ObjectMesh> objects =
-      detail::export_object_meshes(image, options, detail::Shading::kFlat, r);
+      detail::export_object_meshes(image, options, detail::Shading::kLinear, r);
   const double s = export_scale(options, image.width);
   // Coordinates in image pixels, to a tenth of an output pixel (crisp edges sample pixel centres).
   const int decimals = std::clamp(static_cast<int>(std::ceil(std::log10(s * 10) - 1e-9)), 1, 9);
@@ -278,39 +283,121 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   const double unit = std::pow(10.0, decimals), offset = 0.5 / unit;
   auto grid = [&](double v) { return double(std::llround((v - offset) * unit)) / unit; };
 
-  // One refined mesh: its triangles, those of one color sharing a path in order of first
-  // appearance, then the hints along its tears.
-  auto draw = [&](const RefinedMesh& refined) {
-    std::vector<std::string> order;
-    std::unordered_map<std::string, PathData> paths;
+  // One refined mesh: each color cell (limit_mesh_p.h, LinearCells) filled with its LinearColor,
+  // as a linear gradient (a `linearGradient` from the template "_", in user space, its two stops at
+  // the cell's extreme points along the direction) over one path of its triangles or, where the
+  // color varies by less than kFlatRange levels over the cell, flat in its color at the centre;
+  // flat triangles of one color share a path, in order of first appearance. Then the hints along
+  // its tears.
+  auto draw = [&](const RefinedMesh& refined, const detail::LinearCells& fills) {
+    const size_t num_cells = fills.colors.size();
+    // Each cell's triangles, in order.
+    std::vector<std::vector<int32_t>> members(num_cells);
+    std::vector<int32_t> cell_order;
     for (int32_t t = 0; t < refined.num_triangles(); ++t) {
-      const Tri& v = refined.triangles[t];
-      const Tri& c = refined.triangle_colors[t];
-      double mean[3] = {0, 0, 0};
-      for (int k = 0; k < 3; ++k)
-        for (int ch = 0; ch < 3; ++ch) mean[ch] += refined.colors[3 * c[k] + ch] / 3.0;
-      const std::string color = hex_color(mean[0], mean[1], mean[2]);
-      auto [it, fresh] = paths.try_emplace(color, decimals);
-      if (fresh) order.push_back(color);
-      PathData& d = it->second;
-      double px = grid(refined.positions[2 * v[0]]), py = grid(refined.positions[2 * v[0] + 1]);
-      d.command('M');
-      d.number(px);
-      d.number(py);
-      d.command('l');
-      for (int k = 1; k < 3; ++k) {
-        const double x = grid(refined.positions[2 * v[k]]), y = grid(refined.positions[2 * v[k] + 1]);
+      std::vector<int32_t>& m = members[size_t(fills.cell_of[size_t(t)])];
+      if (m.empty()) cell_order.push_back(fills.cell_of[size_t(t)]);
+      m.push_back(t);
+    }
+    auto point = [&](PathData& d, int32_t v, double& px, double& py, bool first) {
+      const double x = grid(refined.positions[2 * v]), y = grid(refined.positions[2 * v + 1]);
+      if (first) {
+        d.command('M');
+        d.number(x);
+        d.number(y);
+        d.command('l');
+      } else {
         d.number(x - px);
         d.number(y - py);
-        px = x;
-        py = y;
       }
-      d.command('z');
+      px = x, py = y;
+    };
+    // A cell's outline: its triangles tile a disk, so the edges not shared by two of them make one
+    // loop, drawn as one polygon (else, as a fallback, its triangles one by one).
+    std::vector<std::pair<int32_t, int32_t>> boundary;
+    auto outline = [&](PathData& d, const std::vector<int32_t>& tris) {
+      boundary.clear();
+      for (const int32_t t : tris)
+        for (int k = 0; k < 3; ++k) boundary.push_back({refined.triangles[t][k], refined.triangles[t][(k + 1) % 3]});
+      std::sort(boundary.begin(), boundary.end());
+      std::vector<std::pair<int32_t, int32_t>> loop;
+      for (const auto& [a, b] : boundary)
+        if (!std::binary_search(boundary.begin(), boundary.end(), std::pair{b, a})) loop.push_back({a, b});
+      // Chain the loop from its smallest vertex; each vertex starts one edge.
+      bool chained = !loop.empty();
+      std::vector<int32_t> polygon;
+      if (chained) {
+        polygon.push_back(loop[0].first);
+        for (size_t k = 0; k < loop.size() && chained; ++k) {
+          const auto it = std::lower_bound(loop.begin(), loop.end(), std::pair{polygon.back(), INT32_MIN});
+          if (it == loop.end() || it->first != polygon.back() || (it + 1 != loop.end() && (it + 1)->first == it->first)) {
+            chained = false;
+            break;
+          }
+          polygon.push_back(it->second);
+        }
+        chained = chained && polygon.size() == loop.size() + 1 && polygon.back() == polygon.front();
+      }
+      double px = 0, py = 0;
+      if (chained) {
+        polygon.pop_back();
+        for (size_t k = 0; k < polygon.size(); ++k) point(d, polygon[k], px, py, k == 0);
+        d.command('z');
+        return;
+      }
+      for (const int32_t t : tris) {
+        for (int k = 0; k < 3; ++k) point(d, refined.triangles[t][k], px, py, k == 0);
+        d.command('z');
+      }
+    };
+    std::vector<std::string> order;
+    std::unordered_map<std::string, PathData> paths;
+    std::string defs, shaded;
+    for (const int32_t cell : cell_order) {
+      const detail::LinearColor& fit = fills.colors[size_t(cell)];
+      const std::vector<int32_t>& tris = members[size_t(cell)];
+      // The cell's extent along its direction, and the centre of its box.
+      double lo = INFINITY, hi = -INFINITY, x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+      for (const int32_t t : tris) {
+        for (const int32_t v : refined.triangles[t]) {
+          const double x = refined.positions[2 * v], y = refined.positions[2 * v + 1];
+          const double along = (x - fit.centre[0]) * fit.direction[0] + (y - fit.centre[1]) * fit.direction[1];
+          lo = std::min(lo, along), hi = std::max(hi, along);
+          x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+      }
+      double range = 0;
+      for (int k = 0; k < 3; ++k) range = std::max(range, std::abs(fit.slope[k]) * (hi - lo));
+      ++r.shapes;
+      if (range < kFlatRange) {
+        double c[3];
+        fit.at(0.5 * (x0 + x1), 0.5 * (y0 + y1), c);
+        const std::string color = hex_color(c[0], c[1], c[2]);
+        auto [it, fresh] = paths.try_emplace(color, decimals);
+        if (fresh) order.push_back(color);
+        outline(it->second, tris);
+        continue;
+      }
+      double a[3], b[3];
+      const double ax = fit.centre[0] + lo * fit.direction[0], ay = fit.centre[1] + lo * fit.direction[1];
+      const double bx = fit.centre[0] + hi * fit.direction[0], by = fit.centre[1] + hi * fit.direction[1];
+      fit.at(ax, ay, a);
+      fit.at(bx, by, b);
+      const std::string id = base36(r.gradients++);
+      defs += "<linearGradient id=\"" + id + "\" href=\"#_\" x1=\"" + detail::fixed(grid(ax), decimals) +
+              "\" y1=\"" + detail::fixed(grid(ay), decimals) + "\" x2=\"" + detail::fixed(grid(bx), decimals) +
+              "\" y2=\"" + detail::fixed(grid(by), decimals) + "\"><stop stop-color=\"" + hex_color(a[0], a[1], a[2]) +
+              "\"/><stop offset=\"1\" stop-color=\"" + hex_color(b[0], b[1], b[2]) + "\"/></linearGradient>\n";
+      PathData d(decimals);
+      outline(d, tris);
+      shaded += "<path fill=\"url(#" + id + ")\" d=\"" + d.text() + "\"/>\n";
     }
     std::string out = "<g shape-rendering=\"crispEdges\" transform=\"translate(" + detail::fixed(offset, 9) +
                       " " + detail::fixed(offset, 9) + ")\">\n";
+    if (!defs.empty()) out += "<defs>\n" + defs + "</defs>\n";
     for (const std::string& color : order)
       out += "<path fill=\"" + color + "\" d=\"" + paths.at(color).text() + "\"/>\n";
+    out += shaded;
     out += "</g>\n";
     if (options.tear_hints) {
       for (const detail::TearHint& hint : detail::tear_hints(refined, 1.0 / s, kHintColorTolerance)) {
@@ -333,11 +420,13 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
   };
 
   std::string svg = header(image, s, "");
-  svg += draw(mesh);
+  // The gradients' template: user-space coordinates (the triangles' own).
+  svg += "<defs><linearGradient id=\"_\" gradientUnits=\"userSpaceOnUse\"/></defs>\n";
+  svg += draw(mesh, cells);
   // Each object a group over the level, bottom to top, named by its title.
   for (const detail::ObjectMesh& object : objects) {
     svg += "<g id=\"object-" + std::to_string(object.object) + "\"><title>" +
-           xml_text(image.objects[object.object].name) + "</title>\n" + draw(object.mesh) +
+           xml_text(image.objects[object.object].name) + "</title>\n" + draw(object.mesh, object.cells) +
            stroke_paths(image.objects[object.object].strokes, options.level, decimals + 1, r) + "</g>\n";
   }
   svg += stroke_paths(image.strokes, options.level, decimals + 1, r);

@@ -4,8 +4,8 @@
 //  - PDF: one ShadingType 4 (free-form Gouraud-shaded triangle mesh) shading, thin bands along the
 //    tears that anti-alias them where a viewer does not anti-alias shadings, strokes as filled
 //    paths;
-//  - SVG: every triangle filled flat with its mean color, with crisp edges (no seams), and the same
-//    tear bands.
+//  - SVG: linear gradients over color cells of the faces (or flat triangles, where fewer bytes),
+//    with crisp edges (no seams), and the same tear bands.
 // Outputs are deterministic: the same image and options give the same bytes.
 #pragma once
 
@@ -26,8 +26,8 @@ namespace subvec {
 // sample at pixel centres (cairo, MuPDF, Ghostscript), and the file is about four times larger.
 enum class PdfTarget { kAny, kPoppler };
 
-// Which SVG renderers the file is built for (docs/export.md, "SVG"). kBrowser: flat triangles at
-// each face's depth, drawn alike by browsers and librsvg. kInkscape: SVG 2 mesh gradients, one
+// Which SVG renderers the file is built for (docs/export.md, "SVG"). kBrowser: linear gradients
+// and flat triangles, drawn alike by browsers and librsvg. kInkscape: SVG 2 mesh gradients, one
 // bicubic Coons patch per control face, which Inkscape draws and its mesh tool edits (browsers and
 // librsvg draw nothing of them).
 enum class SvgTarget { kBrowser, kInkscape };
@@ -44,8 +44,12 @@ struct ExportOptions {
   // junctions, the error only halves per level).
   double tolerance = 0.25;
   double color_tolerance = 1.0;
-  // SVG (flat triangles, one color each): the largest difference, in levels, between a triangle's
-  // color and the limit surface's at its corners and edge midpoints.
+  // SVG for browsers (docs/export.md, "SVG"): each face is drawn either as color cells, each one
+  // linear gradient whose mean difference from the limit surface's color at its corners and edge
+  // midpoints is at most `linear_color_tolerance` levels, or as flat triangles, each within
+  // `flat_color_tolerance` levels of the limit there (the largest difference), whichever takes
+  // fewer bytes.
+  double linear_color_tolerance = 8.0;
   double flat_color_tolerance = 3.0;
   int depth = -1;      // 0..8: this subdivision depth instead of the tolerance rule
   int max_depth = 6;   // the tolerance rule stops here, or at the renderer's depth if lower
@@ -68,6 +72,10 @@ struct ExportReport {
   // What the file holds: mesh patches (SvgTarget::kInkscape, else 0), tear-hint paths, stroke
   // outlines, and its size.
   int64_t patches = 0;
+  // SvgTarget::kBrowser: the shapes that fill the mesh (a color cell's outline, or a flat
+  // triangle), and how many of them are linear gradients.
+  int64_t shapes = 0;
+  int64_t gradients = 0;
   int64_t tear_hints = 0;
   int64_t strokes = 0;
   int64_t objects = 0;  // objects drawn (the visible ones of the level), each as its own group
