@@ -402,14 +402,20 @@ std::string to_svg(const VectorImage& image, const ExportOptions& options, Expor
     if (options.tear_hints) {
       for (const detail::TearHint& hint : detail::tear_hints(refined, 1.0 / s, kHintColorTolerance)) {
         ++r.tear_hints;
+        // Relative coordinates between points snapped to the grid of decimals + 1 (no drift).
+        const double hint_unit = std::pow(10.0, decimals + 1);
+        auto snap = [&](double v) { return double(std::llround(v * hint_unit)) / hint_unit; };
         PathData d(decimals + 1);
+        double px = snap(hint.polygon[0].x), py = snap(hint.polygon[0].y);
         d.command('M');
-        d.number(hint.polygon[0].x);
-        d.number(hint.polygon[0].y);
-        d.command('L');
+        d.number(px);
+        d.number(py);
+        d.command('l');
         for (size_t k = 1; k < hint.polygon.size(); ++k) {
-          d.number(hint.polygon[k].x);
-          d.number(hint.polygon[k].y);
+          const double x = snap(hint.polygon[k].x), y = snap(hint.polygon[k].y);
+          d.number(x - px);
+          d.number(y - py);
+          px = x, py = y;
         }
         d.command('z');
         out += "<path fill=\"" + hex_color(hint.color[0], hint.color[1], hint.color[2]) +
