@@ -201,8 +201,13 @@ CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolera
     fit.deviation = deviation(r, fit.points, fit.closed);
     const int spans = fit.closed ? n : n - 1;
     if (fit.deviation <= tolerance || r.length / spans < 1.5 * kMinSpacing) break;
-    n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.5)));
-    n = std::min(n, static_cast<int>(r.length / kMinSpacing) + 1);
+    // More control points, up to one every kMinSpacing; none more to add ends it. (Without that
+    // stop a piece 2.9 px long between two junctions, held to 2 points, looped forever: a
+    // GrabCut rectangle on a photograph hung `subvec edit`.)
+    const int more = std::min(std::max(n + 1, static_cast<int>(std::ceil(n * 1.5))),
+                              static_cast<int>(r.length / kMinSpacing) + 1);
+    if (more <= n) break;
+    n = more;
   }
   return fit;
 }

@@ -145,6 +145,17 @@ VectorImage small_image(bool features) {
 }
 VectorImage smooth_image() { return small_image(false); }
 
+// A piece too short for more control points ends its fit with the deviation it has (a bent piece
+// 2.9 px long between two junctions once looped forever: one point more was over the cap of
+// one every kMinSpacing).
+TEST(FeatureEdit, AShortBentPieceEndsItsFit) {
+  const std::vector<Vec2> bent = {{0, 0}, {1.2, 0.8}, {2.4, 0}};
+  const CurveFit fit = fit_curve(bent, 3.0, 0.5, false);
+  EXPECT_EQ(fit.points.size(), 2u);
+  EXPECT_GT(fit.deviation, 0.5);
+  EXPECT_LT(fit.deviation, 0.9);
+}
+
 TEST(FeatureEdit, TheFitFollowsTheDrawnCurve) {
   const std::vector<Vec2> drawn = wave({10, 60}, {150, 70}, 12, 200);
   const CurveFit fit = fit_curve(drawn, 8);
