@@ -292,6 +292,150 @@ bool on_polygon(std::span<const Vec2> points, Vec2 p) {
   return false;
 }
 
+// The closed cycle of control edges around the faces whose centroid `mask` holds: the largest
+// edge-connected group of them (faces with a vertex on the image border left out), its holes
+// filled, and the faces round any vertex the outline would pass twice added, so that the outline
+// is one simple loop. Returns it closed (first == last), or empty when nothing is left.
+std::vector<int32_t> cycle_around_mask(const ControlMesh& mesh, const MeshTopology& topology, const RegionMask& mask,
+                                       int width, int height) {
+  const int nf = mesh.num_triangles();
+  std::vector<uint8_t> on_border(mesh.num_vertices(), 0);
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    const Vec2 p = mesh.positions[v];
+    on_border[v] = p.x <= 0 || p.y <= 0 || p.x >= width || p.y >= height;
+  }
+  std::vector<uint8_t> inside(nf, 0);
+  std::vector<double> area_of(nf, 0);
+  for (int f = 0; f < nf; ++f) {
+    const Tri& t = mesh.triangles[f];
+    const Vec2 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+    area_of[f] = area(a, b, c);
+    if (on_border[t[0]] || on_border[t[1]] || on_border[t[2]]) continue;
+    const int x = std::clamp(static_cast<int>((a.x + b.x + c.x) / 3), 0, mask.width - 1);
+    const int y = std::clamp(static_cast<int>((a.y + b.y + c.y) / 3), 0, mask.height - 1);
+    inside[f] = mask.at(x, y);
+  }
+  auto across = [&](int f, int k) {
+    const auto& ef = topology.edge_faces[topology.face_edges[f][k]];
+    return ef[0] == f ? ef[1] : ef[0];
+  };
+  // The largest group.
+  std::vector<int> group(nf, -1), queue;
+  int best = -1;
+  double best_area = 0;
+  for (int f0 = 0; f0 < nf; ++f0) {
+    if (!inside[f0] || group[f0] >= 0) continue;
+    double sum = 0;
+    queue.assign(1, f0);
+    group[f0] = f0;
+    for (size_t q = 0; q < queue.size(); ++q) {
+      sum += area_of[queue[q]];
+      for (int k = 0; k < 3; ++k) {
+        const int g = across(queue[q], k);
+        if (g >= 0 && inside[g] && group[g] < 0) group[g] = f0, queue.push_back(g);
+      }
+    }
+    if (sum > best_area) best = f0, best_area = sum;
+  }
+  if (best < 0) return {};
+  for (int f = 0; f < nf; ++f) inside[f] = group[f] == best;
+  for (int round = 0; round < 32; ++round) {
+    // Holes: the faces outside that the outside cannot reach from the image border.
+    std::vector<uint8_t> reached(nf, 0);
+    queue.clear();
+    for (int f = 0; f < nf; ++f) {
+      if (inside[f]) continue;
+      for (int k = 0; k < 3; ++k)
+        if (across(f, k) < 0 && !reached[f]) reached[f] = 1, queue.push_back(f);
+    }
+    for (size_t q = 0; q < queue.size(); ++q) {
+      for (int k = 0; k < 3; ++k) {
+        const int g = across(queue[q], k);
+        if (g >= 0 && !inside[g] && !reached[g]) reached[g] = 1, queue.push_back(g);
+      }
+    }
+    for (int f = 0; f < nf; ++f)
+      if (!inside[f] && !reached[f]) inside[f] = 1;
+    // The outline's directed edges; a vertex that starts two is a pinch.
+    std::vector<int> starts(mesh.num_vertices(), 0);
+    for (int f = 0; f < nf; ++f) {
+      if (!inside[f]) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int g = across(f, k);
+        if (g < 0 || !inside[g]) ++starts[mesh.triangles[f][k]];
+      }
+    }
+    bool pinched = false;
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+      if (starts[v] < 2) continue;
+      pinched = true;
+      const auto [b, e] = topology.faces_of(v);
+      for (const int32_t* f = b; f != e; ++f) inside[*f] = 1;
+    }
+    if (pinched) continue;
+    std::vector<int32_t> next(mesh.num_vertices(), -1);
+    int first = -1, count = 0;
+    for (int f = 0; f < nf; ++f) {
+      if (!inside[f]) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int g = across(f, k);
+        if (g >= 0 && inside[g]) continue;
+        const int32_t a = mesh.triangles[f][k], b = mesh.triangles[f][(k + 1) % 3];
+        if (on_border[a] || on_border[b]) return {};  // (pinches grew it to the border)
+        next[a] = b, ++count;
+        if (first < 0 || a < first) first = a;
+      }
+    }
+    std::vector<int32_t> cycle{first};
+    for (int steps = 0; steps < count; ++steps) cycle.push_back(next[cycle.back()]);
+    if (cycle.back() != first || cycle.size() < 4) return {};  // more than one loop
+    return cycle;
+  }
+  return {};
+}
+
+// Makes every edge of `cycle` (closed) a tear: its runs of edges that are not tears yet become
+// new features (a crease among them stops being one), and the colors split along them, each side
+// keeping its value, so the picture is unchanged but for the tear rules along the new edges.
+void tear_along(ControlMesh& mesh, int width, int height, const MeshTopology& topology,
+                const std::vector<int32_t>& cycle) {
+  const size_t n = cycle.size() - 1;  // edges
+  std::vector<uint8_t> tear(n);
+  for (size_t i = 0; i < n; ++i) tear[i] = topology.edge_tags[topology.find_edge(cycle[i], cycle[i + 1])] == EdgeTag::kTear;
+  std::erase_if(mesh.creases, [&](const EdgeVerts& c) {
+    for (size_t i = 0; i < n; ++i)
+      if (std::minmax(c[0], c[1]) == std::minmax(cycle[i], cycle[i + 1])) return true;
+    return false;
+  });
+  int32_t next_id = 0;
+  for (const Feature& f : mesh.features) next_id = std::max(next_id, f.id + 1);
+  const size_t start = std::find(tear.begin(), tear.end(), 1) - tear.begin();
+  if (start == n) {
+    mesh.features.push_back({next_id, cycle, 0.0});  // no tear on the way: one closed feature
+  } else {
+    // Runs of non-tear edges, from the first tear edge round.
+    Feature run{next_id, {}, 0.0};
+    for (size_t k = 1; k <= n; ++k) {
+      const size_t i = (start + k) % n;
+      if (tear[i]) {
+        if (!run.vertices.empty()) mesh.features.push_back(run), run = {++next_id, {}, 0.0};
+        continue;
+      }
+      if (run.vertices.empty()) run.vertices.push_back(cycle[i]);
+      run.vertices.push_back(cycle[i + 1]);
+    }
+    if (!run.vertices.empty()) mesh.features.push_back(run);
+  }
+  const MeshTopology t = MeshTopology::build(mesh, width, height);
+  int count = 0;
+  const std::vector<Tri> fv = face_varying_indices(mesh, t, count);
+  std::vector<Color> colors(count);
+  for (int f = 0; f < mesh.num_triangles(); ++f)
+    for (int k = 0; k < 3; ++k) colors[fv[f][k]] = mesh.colors[mesh.triangle_colors[f][k]];
+  mesh.colors = std::move(colors);
+  mesh.triangle_colors = fv;
+}
+
 Object& object_at(VectorImage& image, int object) {
   if (object < 0 || object >= static_cast<int>(image.objects.size())) {
     invalid("object " + std::to_string(object) + " is out of range (" +
@@ -484,8 +628,26 @@ MakeObjectResult make_object_in_rect(VectorImage& image, int level, const PixelR
   try {
     added = add_feature(cut, image.width, image.height, boundary[0].points, FeatureKind::kTear);
   } catch (const Error& e) {
-    invalid(std::string("the boundary GrabCut finds in the rectangle cannot be cut in: ") + e.what() +
-            "; make an object of a closed feature instead (draw one with the pen)");
+    // Where the boundary runs along features at a glancing angle, its fitted curve would cross
+    // them between control points, and add_feature refuses it. Then the object's outline is the
+    // cycle of control edges round the faces GrabCut's foreground holds: it follows the tears
+    // where the foreground does, and is made a tear where it is not one yet (the picture does not
+    // change but for the tear rules along it).
+    const MeshTopology topology = validate_level(mesh, image.width, image.height, level);
+    const std::vector<int32_t> cycle = cycle_around_mask(mesh, topology, mask, image.width, image.height);
+    if (cycle.empty()) {
+      invalid(std::string("the boundary GrabCut finds in the rectangle cannot be cut in (") + e.what() +
+              "), nor followed along control edges; make an object of a closed feature instead (draw one with the pen)");
+    }
+    ControlMesh along = mesh;
+    tear_along(along, image.width, image.height, topology, cycle);
+    work.levels[level] = std::move(along);
+    const MeshTopology now = validate_level(work.levels[level], image.width, image.height, level);
+    MakeObjectResult result =
+        make_object_along(work, level, cycle, now, "the control edges round the foreground in the rectangle", name);
+    result.along_edges = true;
+    image = std::move(work);
+    return result;
   }
   // The curve: the new pieces, joined end to end at their junctions.
   std::vector<std::vector<int32_t>> pieces;

@@ -41,6 +41,9 @@ struct MakeObjectResult {
   int removed = 0;          // hole vertices removed by the simplification
   int features_moved = 0;   // features (or parts of features) that went into the object
   int strokes_moved = 0;    // strokes of the level that went into the object
+  // make_object_in_rect: the outline follows the control edges round GrabCut's foreground (its
+  // fitted curve could not be cut in), not the curve.
+  bool along_edges = false;
 };
 
 // Makes an object of the region that feature `feature` (a closed tear of level `level`) bounds.
@@ -54,9 +57,11 @@ MakeObjectResult make_object(VectorImage& image, int level, int feature, const s
 // GrabCut finds in the rectangle on the level's render (segment_foreground, vectorize/segment.h),
 // whose boundary is first cut into the level as a closed tear (add_feature, edit/feature_edit.h:
 // it meets the features it crosses at junctions, and the object's curve is then made of the
-// pieces between them). Throws Error(kInvalidArgument), the image unchanged, for a rectangle
-// GrabCut cannot use, a foreground that reaches the image border, or a boundary add_feature
-// refuses.
+// pieces between them). Where add_feature refuses that curve (it runs along features at a
+// glancing angle), the outline is the cycle of control edges round the faces whose centroid the
+// foreground holds, made a tear where it is not one (MakeObjectResult::along_edges). Throws
+// Error(kInvalidArgument), the image unchanged, for a rectangle GrabCut cannot use, or a
+// foreground that reaches the image border or leaves no faces.
 MakeObjectResult make_object_in_rect(VectorImage& image, int level, const PixelRect& rect,
                                      const std::string& name = "");
 

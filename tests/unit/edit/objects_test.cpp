@@ -89,11 +89,14 @@ struct Moved {
 };
 
 // The measure: make an object of the segment, move it (30, 0) px rotated 10 degrees.
-Moved move_segment(const Image8& photo, PixelRect rect) {
+// With `in_editor`, as the editor's rectangle does it: the photograph vectorized without a segment,
+// then make_object_in_rect (GrabCut on the render, its boundary cut in, or the control edges
+// round it).
+Moved move_segment(const Image8& photo, PixelRect rect, bool in_editor = false) {
   VectorizeOptions options;
   options.ratio = 0.01;
   options.levels.levels = 1;
-  options.segment = rect;
+  if (!in_editor) options.segment = rect;
   const VectorImage vectorized = vectorize(photo, options);
   const Image8 before = draw(vectorized);
   // The reference for the moved object: the image before, rendered 4x and sampled bilinearly at
@@ -105,9 +108,14 @@ Moved move_segment(const Image8& photo, PixelRect rect) {
   const int w = before.width, h = before.height;
 
   VectorImage image = vectorized;
-  const int f = closed_feature(image.levels[0]);
-  EXPECT_GE(f, 0);
-  const MakeObjectResult made = make_object(image, 0, f, "segment");
+  MakeObjectResult made;
+  if (in_editor) {
+    made = make_object_in_rect(image, 0, rect, "framed");
+  } else {
+    const int f = closed_feature(image.levels[0]);
+    EXPECT_GE(f, 0);
+    made = make_object(image, 0, f, "segment");
+  }
   EXPECT_NO_THROW(validate(image));
   Moved m;
   m.made = made;
@@ -673,6 +681,35 @@ TEST(Objects, FilesKeepTheirStrokes) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("flag 2 (object strokes) is set without flag 1"), std::string::npos)
         << e.what();
+  }
+}
+
+// The editor's way: a rectangle drawn on a vectorized photograph. (Until session 29 the boundary
+// GrabCut found was refused on 15 of 16 rectangles on the photographs: its fitted curve crossed
+// features it ran along.)
+TEST(Objects, MoveARectangleOnPhotographs) {
+  struct Case {
+    const char* name;
+    PixelRect rect;
+  };
+  const Case cases[] = {{"butterfly", {3, 70, 486, 250}},
+                        {"squirrel", {120, 100, 260, 250}},
+                        {"apple", {30, 40, 440, 460}}};
+  const std::filesystem::path dir = std::filesystem::path(SUBVEC_SOURCE_DIR) / ".." / "shared" / "images";
+  for (const Case& c : cases) {
+    const std::filesystem::path path = dir / (std::string(c.name) + ".png");
+    if (const auto why = test::skip_shared_photos(path)) GTEST_SKIP() << *why;
+    const Moved m = move_segment(read_image(path), c.rect, true);
+    std::printf("%s (editor): object MAE %.3f over %d px, fill worst %.2f over %d px, hidden %.2f, rest MAE %.3f%s\n",
+                c.name, m.object_mae, m.object_pixels, m.worst_fill, m.fill_pixels, m.hidden_fill, m.rest_mae,
+                m.made.along_edges ? " (along control edges)" : "");
+    EXPECT_GT(m.object_pixels, 5000) << c.name;
+    EXPECT_LE(m.object_mae, 1.0) << c.name;
+    // The outline along control edges is a staircase of faces, and the fill meets it at its
+    // corners: 12.2 on butterfly against the curve's 3.7 (the 12 is for the segment).
+    EXPECT_LE(m.worst_fill, 15) << c.name;
+    EXPECT_LE(m.hidden_fill, 15) << c.name;
+    EXPECT_LE(m.rest_mae, 0.3) << c.name;
   }
 }
 
