@@ -45,6 +45,18 @@ void for_each_grid_edge(int n, const Edge& edge) {
   }
 }
 
+// Calls triangle(p, q, r) for each triangle of a face's grid of size n, corners in grid units:
+// the upward (i, j), (i + 1, j), (i, j + 1), then the downward one beside it.
+template <class Triangle>
+void for_each_grid_triangle(int n, const Triangle& triangle) {
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i + j < n; ++i) {
+      triangle(std::array<int, 2>{i, j}, std::array<int, 2>{i + 1, j}, std::array<int, 2>{i, j + 1});
+      if (i + j + 1 < n) triangle(std::array<int, 2>{i + 1, j}, std::array<int, 2>{i + 1, j + 1}, std::array<int, 2>{i, j + 1});
+    }
+  }
+}
+
 // A face's limit values on the grid of parameters (i / n, j / n), i + j <= n.
 struct Value {
   double x, y, c[3];
@@ -173,12 +185,7 @@ FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int s
       }
       record(position, color, longest);
     };
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i + j < n; ++i) {
-        triangle({i, j}, {i + 1, j}, {i, j + 1});
-        if (i + j + 1 < n) triangle({i + 1, j}, {i + 1, j + 1}, {i, j + 1});
-      }
-    }
+    for_each_grid_triangle(n, triangle);
     return error;
   }
   // Flat: a triangle (corners p, q, r in grid units at depth d) against its mean color at its
@@ -201,12 +208,7 @@ FaceError face_error(const FaceGrid& fine, const FaceTolerance& tolerance, int s
     }
     record(position, color, longest);
   };
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i + j < n; ++i) {
-      triangle({i, j}, {i + 1, j}, {i, j + 1});
-      if (i + j + 1 < n) triangle({i + 1, j}, {i + 1, j + 1}, {i, j + 1});
-    }
-  }
+  for_each_grid_triangle(n, triangle);
   return error;
 }
 
