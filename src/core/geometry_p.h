@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace subvec::detail {
 
@@ -48,6 +49,18 @@ void for_pixels_near_segment(T ax, T ay, T bx, T by, double r, int width, int he
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x)
       if (segment_distance(x + 0.5, y + 0.5, ax, ay, bx, by) < r) visit(x, y);
+}
+
+// Whether (px, py) is inside the closed polygon through `points` (members x and y; the last joined
+// to the first, a repeated first point adding nothing), by the crossings of a ray to its right.
+template <class Points>
+bool inside_polygon(const Points& points, double px, double py) {
+  bool inside = false;
+  for (size_t i = 0, j = points.size() - 1; i < points.size(); j = i++) {
+    const auto a = points[j], b = points[i];
+    if ((a.y > py) != (b.y > py) && px < a.x + (py - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
+  }
+  return inside;
 }
 
 }  // namespace subvec::detail

@@ -1095,15 +1095,6 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   const std::vector<Vec2> curve = sample_bspline(polygon, closed, kPerSpan);
   std::vector<uint8_t> band(size_t(width) * height, 0);
   const size_t n = polygon.size();
-  // Whether a point is inside the closed curve (crossings of a ray to its right).
-  auto inside_curve = [&](Vec2 p) {
-    bool inside = false;
-    for (size_t i = 0, k = curve.size() - 1; i < curve.size(); k = i++) {
-      const Vec2 a = curve[k], b = curve[i];
-      if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
-    }
-    return inside;
-  };
   for (size_t i = 0; i + 1 < curve.size(); ++i) {
     const size_t span = i / kPerSpan;
     const double t = double(i % kPerSpan) / kPerSpan;
@@ -1115,7 +1106,7 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
                                       if (band[k]) return;
                                       if (closed && w > inside_cap) {
                                         const Vec2 c{x + 0.5, y + 0.5};
-                                        if (inside_curve(c) &&
+                                        if (detail::inside_polygon(curve, c.x, c.y) &&
                                             detail::segment_distance(c, curve[i], curve[i + 1]) > inside_cap)
                                           return;
                                       }

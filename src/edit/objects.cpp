@@ -13,6 +13,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "core/geometry_p.h"
 #include "core/messages_p.h"
 #include "mesh/collapse_engine_p.h"
 #include "mesh/coarsen_p.h"
@@ -270,17 +271,6 @@ void fill_hole_colors(ControlMesh& mesh, const std::vector<uint8_t>& hole_face) 
   }
 }
 
-// Whether p is inside the closed polygon through `points` (last joined to first; a repeated first
-// point adds nothing), by the crossings of a ray to its right.
-bool inside_polygon(std::span<const Vec2> points, Vec2 p) {
-  bool inside = false;
-  for (size_t i = 0, j = points.size() - 1; i < points.size(); j = i++) {
-    const Vec2 a = points[j], b = points[i];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) inside = !inside;
-  }
-  return inside;
-}
-
 // Whether p lies on the closed polygon through `points` (within 1e-6 px).
 bool on_polygon(std::span<const Vec2> points, Vec2 p) {
   for (size_t i = 0, j = points.size() - 1; i < points.size(); j = i++) {
@@ -528,7 +518,7 @@ MakeObjectResult make_object_along(VectorImage& image, int level, std::vector<in
   for (const Stroke& stroke : image.strokes) {
     size_t in_curve = 0;
     if (stroke.level == level) {
-      for (const Vec2& p : stroke.points) in_curve += inside_polygon(curve, p) || on_polygon(curve, p);
+      for (const Vec2& p : stroke.points) in_curve += detail::inside_polygon(curve, p.x, p.y) || on_polygon(curve, p);
     }
     (2 * in_curve >= stroke.points.size() && in_curve > 0 ? object.strokes : strokes).push_back(stroke);
   }
@@ -686,7 +676,7 @@ int closed_feature_around(const ControlMesh& mesh, Vec2 p) {
     if (!feature.closed()) continue;
     std::vector<Vec2> polygon;
     for (const int32_t v : feature.vertices) polygon.push_back(mesh.positions[v]);
-    const bool inside = inside_polygon(polygon, p);
+    const bool inside = detail::inside_polygon(polygon, p.x, p.y);
     const double area = polygon_area(mesh, feature);
     if (inside && (best < 0 || area < best_area)) best = f, best_area = area;
   }
