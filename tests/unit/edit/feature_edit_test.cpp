@@ -465,12 +465,11 @@ TEST(FeatureEdit, ADeletedFeatureLeavesNoStep) {
     const int32_t id = image.levels[0].features[f].id;
     const bool closed = image.levels[0].features[f].closed();
     const DeleteMeasure m = measure_delete(image, f);
-    // Inside a closed curve the band keeps a core of what it bounds (a third of the curve's extent
-    // wide at most): a jump of 150 round a small circle then ramps at 5 levels a pixel.
-    EXPECT_LE(m.jump, closed ? 5 : 4) << "feature " << f;
-    // The synthetic jumps are large (up to 150 levels) on a small image: the ramp that keeps the
-    // jump under 4 reaches past 3 rings (see DeletesOnPhotographs).
-    EXPECT_LE(m.far, 2.0) << "feature " << f;
+    // The issue's bounds, on jumps of up to 150 levels: no step over 4 levels across where the
+    // feature was, and the pixels past 3 control rings within MAE 0.5. (With unit membrane
+    // weights instead of the cotangents the ramp bunched near the curve: a closed one reached 5.)
+    EXPECT_LE(m.jump, 4) << "feature " << f;
+    EXPECT_LE(m.far, 0.5) << "feature " << f;
     EXPECT_EQ(m.vertices_after, m.vertices_before);
     for (const Feature& g : image.levels[0].features) EXPECT_NE(g.id, id);
   }
@@ -588,10 +587,9 @@ void expect_a_drawn_tear_changes_nothing(const VectorImage& image, const char* n
 
 // The issue's acceptance on photographs: a tear drawn in a smooth spot (above), and detected
 // features deleted, the five longest of three photographs (the hardest: long outlines with large
-// jumps). A ramp that climbs at most 4 levels a
-// pixel needs to be J / 4 pixels wide for a jump of J, which for the butterfly's wing outline
-// (J ~ 200) reaches past 3 control rings, so the two bounds pull apart there: every deletion is
-// held to looser bounds, and most to the issue's (docs/editing.md has the table over 96 features).
+// jumps). Every deletion keeps the pixels past 3 rings within the issue's MAE 0.5; the ramp climbs
+// at most 8 levels a pixel (a few reach 5-7 near a junction or in the photograph's own slopes), and
+// most deletions are within both of the issue's bounds (docs/editing.md has the table over 96).
 TEST(FeatureEdit, OnPhotographs) {
   const std::filesystem::path dir = test::shared_photos();
   if (const auto why = test::skip_shared_photos(dir)) GTEST_SKIP() << *why;
@@ -611,15 +609,15 @@ TEST(FeatureEdit, OnPhotographs) {
     for (size_t k = 0; k < std::min<size_t>(5, order.size()); ++k) {
       VectorImage edited = image;
       const DeleteMeasure m = measure_delete(edited, order[k]);
-      EXPECT_LE(m.jump, 12) << name << " feature " << order[k];
-      EXPECT_LE(m.far, 2.5) << name << " feature " << order[k];
+      EXPECT_LE(m.jump, 8) << name << " feature " << order[k];
+      EXPECT_LE(m.far, 0.5) << name << " feature " << order[k];
       EXPECT_EQ(m.vertices_after, m.vertices_before);
       within += m.jump <= 4 && m.far <= 0.5;
       ++deleted;
     }
   }
   RecordProperty("within_the_issue_bounds", std::to_string(within) + " of " + std::to_string(deleted));
-  EXPECT_GE(within * 10, deleted * 6) << within << " of " << deleted << " deletions within jump 4 and far MAE 0.5";
+  EXPECT_GE(within * 10, deleted * 8) << within << " of " << deleted << " deletions within jump 4 and far MAE 0.5";
 }
 
 }  // namespace
