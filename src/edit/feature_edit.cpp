@@ -552,9 +552,9 @@ std::vector<uint8_t> grow(const MeshTopology& topology, std::vector<uint8_t> in,
 
 // The colors of `mesh` (the edited level) refitted where `free_vertex` says, to `targets` (per
 // pixel, the surface before the edit; a pixel is left out where `band` is 1 and its control face
-// is in `band_faces`) plus
-// `membrane` times the squared differences of the free color values with their neighbours on the
-// triangles, plus a light pull to their current values. Returns the number of color values fitted.
+// is in `band_faces`) plus `membrane` times the Dirichlet energy of the free color values (their
+// squared differences with their neighbours on the triangles, cotangent-weighted), plus a light
+// pull to their current values. Returns the number of color values fitted.
 int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int height,
                  const std::vector<uint8_t>& free_vertex, const std::vector<std::array<float, 3>>& targets,
                  const std::vector<uint8_t>& band, const std::vector<uint8_t>& band_faces, double membrane) {
