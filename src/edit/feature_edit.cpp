@@ -1073,11 +1073,11 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   // The band where the membrane alone sets the colors: J / (2 kRampSlope) pixels on each side of
   // a jump J, so the ramp across it climbs about kRampSlope levels a pixel, and at least
   // kBandEdges control edges (wider than the stencils' two rings, or the data at its edge would
-  // rebuild the step). Over the photographs' 96 measured deletions, 3 keeps every ramp within
-  // 6 levels a pixel and the pixels past 3 rings within MAE 0.15; 1.5 made the band twice as wide
-  // and moved those pixels by up to 2.0 for no lower step (docs/editing.md).
+  // rebuild the step; short features need the width most, the ramp being steepest at a curve's
+  // ends). Over the photographs' 96 measured deletions, these keep 94 ramps within 4 levels a
+  // pixel and every deletion's pixels past 3 rings within MAE 0.5 (docs/editing.md).
   constexpr double kRampSlope = 3.0;
-  constexpr double kBandEdges = 3.5;
+  constexpr double kBandEdges = 4;
   // The membrane's weight against one pixel's: light, so that outside the band the data holds the
   // colors; inside it, where there is no data, the membrane alone sets them.
   constexpr double kMembrane = 1e-3;

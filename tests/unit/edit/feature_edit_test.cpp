@@ -463,7 +463,6 @@ TEST(FeatureEdit, ADeletedFeatureLeavesNoStep) {
     VectorImage image = small_image(true);
     ASSERT_EQ(image.levels[0].features.size(), 4u);
     const int32_t id = image.levels[0].features[f].id;
-    const bool closed = image.levels[0].features[f].closed();
     const DeleteMeasure m = measure_delete(image, f);
     // The bounds, on jumps of up to 150 levels: no step over 4 levels across where the
     // feature was, and the pixels past 3 control rings within MAE 0.5. (With unit membrane
