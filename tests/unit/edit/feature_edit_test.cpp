@@ -585,14 +585,13 @@ void expect_a_drawn_tear_changes_nothing(const VectorImage& image, const char* n
 }
 
 // The issue's acceptance on photographs: a tear drawn in a smooth spot (above), and detected
-// features deleted, the five longest of three photographs (the hardest: long outlines with large
-// jumps). Every deletion keeps the pixels past 3 rings within the issue's MAE 0.5; the ramp climbs
-// at most 8 levels a pixel (a few reach 5-7 near a junction or in the photograph's own slopes), and
-// most deletions are within both of the issue's bounds (docs/editing.md has the table over 96).
+// features deleted, the five longest of three photographs (the hardest: long outlines with jumps
+// of up to 200 levels, pinched by the tears that stay). Every deletion is within the issue's
+// bounds: no step over 4 levels across where the feature was, and the pixels past 3 control rings
+// within MAE 0.5 (docs/editing.md has the table over 96 features).
 TEST(FeatureEdit, OnPhotographs) {
   const std::filesystem::path dir = test::shared_photos();
   if (const auto why = test::skip_shared_photos(dir)) GTEST_SKIP() << *why;
-  int deleted = 0, within = 0;
   for (const char* name : {"butterfly", "rocket", "chelsea"}) {
     const Image8 photo = read_image(dir / (std::string(name) + ".png"));
     VectorizeOptions options;
@@ -608,15 +607,11 @@ TEST(FeatureEdit, OnPhotographs) {
     for (size_t k = 0; k < std::min<size_t>(5, order.size()); ++k) {
       VectorImage edited = image;
       const DeleteMeasure m = measure_delete(edited, order[k]);
-      EXPECT_LE(m.jump, 8) << name << " feature " << order[k];
+      EXPECT_LE(m.jump, 4) << name << " feature " << order[k];
       EXPECT_LE(m.far, 0.5) << name << " feature " << order[k];
       EXPECT_EQ(m.vertices_after, m.vertices_before);
-      within += m.jump <= 4 && m.far <= 0.5;
-      ++deleted;
     }
   }
-  RecordProperty("within_the_issue_bounds", std::to_string(within) + " of " + std::to_string(deleted));
-  EXPECT_GE(within * 10, deleted * 8) << within << " of " << deleted << " deletions within jump 4 and far MAE 0.5";
 }
 
 }  // namespace
