@@ -170,6 +170,36 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
   }
   targets_ = rest_;
   framed_ = false;
+  // The frame stops the handles a margin inside it. Taking each target past it to the margin put
+  // every handle past it on one line, and a triangle of them flat: the drag stopped short (18 of
+  // 400 random drags on the photographs). So on a side that targets pass, the targets from the
+  // farthest one out to as far inside are squeezed, in order, into the inner half (an affine map
+  // that halves their distances to the side at most), and no two handles meet.
+  std::array<double, 4> past{0, 0, 0, 0};  // how far the targets pass each side: x = 0, x = w, y = 0, y = h
+  if (width_ >= 0) {
+    for (size_t i = 0; i < handles.vertices.size() && i < handles.targets.size(); ++i) {
+      const int v = handles.vertices[i];
+      const Vec2 t = handles.targets[i];
+      if (v < 0 || v >= n || !std::isfinite(t.x) || !std::isfinite(t.y)) continue;  // refused below
+      const unsigned s = sides_[v];
+      if (!(s & 3u)) past[0] = std::max(past[0], kFrameMargin - t.x), past[1] = std::max(past[1], t.x - (width_ - kFrameMargin));
+      if (!(s & 12u)) past[2] = std::max(past[2], kFrameMargin - t.y), past[3] = std::max(past[3], t.y - (height_ - kFrameMargin));
+    }
+  }
+  // Coordinate c on an axis from 0 to `extent` whose targets pass the low side by `low` and the
+  // high side by `high`.
+  const auto squeeze = [](double c, double extent, double low, double high) {
+    const double m = kFrameMargin, half = extent / 2;
+    if (low > 0) {
+      const double far = m - low, near = std::max(m, std::min(m + low, half));  // [far, near] -> [m, near]
+      if (c < near) c = m + (c - far) * (near - m) / (near - far);
+    }
+    if (high > 0) {
+      const double far = extent - m + high, near = std::min(extent - m, std::max(extent - m - high, half));
+      if (c > near) c = near + (c - near) * (extent - m - near) / (far - near);
+    }
+    return c;
+  };
   std::vector<uint8_t> seen(rest_.size(), 0);
   for (size_t i = 0; i < handles.vertices.size(); ++i) {
     const int v = handles.vertices[i];
@@ -189,8 +219,9 @@ void ShapeEditor::deform(const Handles& handles, std::vector<Vec2>& out) {
     const double m = kFrameMargin;
     framed_ |= (!(s & 3u) && (t.x < kFrameMargin || t.x > width_ - kFrameMargin)) ||
                (!(s & 12u) && (t.y < kFrameMargin || t.y > height_ - kFrameMargin));
-    targets_[v] = {(s & 3u) ? rest_[v].x : std::clamp(t.x, std::min(m, rest_[v].x), std::max(width_ - m, rest_[v].x)),
-                   (s & 12u) ? rest_[v].y : std::clamp(t.y, std::min(m, rest_[v].y), std::max(height_ - m, rest_[v].y))};
+    const double x = squeeze(t.x, width_, past[0], past[1]), y = squeeze(t.y, height_, past[2], past[3]);
+    targets_[v] = {(s & 3u) ? rest_[v].x : std::clamp(x, std::min(m, rest_[v].x), std::max(width_ - m, rest_[v].x)),
+                   (s & 12u) ? rest_[v].y : std::clamp(y, std::min(m, rest_[v].y), std::max(height_ - m, rest_[v].y))};
   }
   if (!(handles.region >= 0) || !std::isfinite(handles.region)) {
     invalid("the region " + num(handles.region) + " is not a number >= 0");
@@ -411,9 +442,11 @@ void ShapeEditor::fold_free(const ArapDeformer& deformer, std::vector<Vec2>& x) 
     if (slow >= 8) break;
     for (int k = 0; k < (t < 0.1 ? 5 : 1) * kRelaxSteps; ++k) relax_step(deformer, x);
   }
-  // Handles within a rounding error of their targets are put on them, if nothing reaches its
-  // floor then.
-  if (left > 0 && left < 1e-6) {
+  // Handles within 1 % of their way from their targets are put on them, if nothing reaches its
+  // floor then. The rounds approach the targets geometrically, and near the frame they used to
+  // stall at 99.9 % of the way (5 of 400 random drags on the photographs): the handles short of
+  // their targets by a few hundredths of a pixel, and the drag reported as stopped.
+  if (left > 0 && left < 1e-2) {
     proposal = x;
     for (size_t v = 0; v < n; ++v) {
       if (targets_[v].x != rest_[v].x || targets_[v].y != rest_[v].y) proposal[v] = targets_[v];

@@ -142,7 +142,7 @@ class ShapeEditor {
   std::vector<Vec2> rest_;
   std::vector<Tri> triangles_;
   int width_, height_;
-  static constexpr double kFrameMargin = 0.25;  // pixels: how close the frame lets a handle come
+  static constexpr double kFrameMargin = 1.0;  // pixels: how close the frame lets a handle come (0.25 squeezed more drags flat)
   std::vector<uint8_t> sides_;  // per vertex: bit 0 left, 1 right, 2 top, 3 bottom
   std::vector<uint8_t> pinned_;  // an object's mesh (no frame): its boundary vertices, held
   std::list<Cached> cache_;     // most recently used first

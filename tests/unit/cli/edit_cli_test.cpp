@@ -148,8 +148,9 @@ TEST_F(EditCli, OperationsTheImageRulesOutAreRefused) {
                           {"op": "drag", "select": "vertex", "from": [100, 10], "to": [95, 48]}])",
                       "ops[1] (drag vertex)");
   // A drag the mesh cannot take all the way (issue 25) is not refused: it stops at the last
-  // fold-free position, and its line says so.
-  const fs::path ops = write("far.json", R"([{"op": "drag", "select": "vertex", "from": [48, 48], "to": [95, 48]}])");
+  // fold-free position, and its line says so. (The centre into the corner: the triangles between
+  // it and the corner's sides have no room left.)
+  const fs::path ops = write("far.json", R"([{"op": "drag", "select": "vertex", "from": [48, 48], "to": [95, 95]}])");
   const CliResult far = subvec("edit " + q(kDisk) + " -o " + q(dir_ / "far.svec") + " --ops " + q(ops) + " -v");
   EXPECT_EQ(far.status, 0) << far.err;
   EXPECT_NE(far.out.find("% of the way, the last position before the control mesh would fold"), std::string::npos) << far.out;

@@ -512,7 +512,7 @@ TEST(Shape, ADragThatWouldFlipArrivesWithoutFolding) {
 
 // Issue 25's acceptance on real photographs (ratio 0.02): seeded random feature drags of 5-40 px
 // (sigma 25, the editor's region of 3 sigma) never fold the mesh, stop short only where the image
-// frame or a crossing holds them (at most 5 % for a crossing), and leave the pixels farther than
+// frame or a crossing holds them (at most 5 % of them, for either), and leave the pixels farther than
 // 3 sigma from the drag within MAE 1.0. scripts/measure-drags runs all eight photographs, 50 drags
 // each (docs/editing.md).
 TEST(Shape, RandomFeatureDragsOnPhotographsNeverFold) {
@@ -567,8 +567,8 @@ TEST(Shape, RandomFeatureDragsOnPhotographsNeverFold) {
   }
   RecordProperty("stopped_by_the_frame", framed);
   RecordProperty("stopped_by_a_crossing", crossings);
-  EXPECT_LE(crossings, drags / 20) << crossings << " of " << drags << " drags stopped short";
-  EXPECT_LE(framed, drags / 5);
+  EXPECT_LE(crossings + framed, drags / 20) << crossings << " stopped by a crossing and " << framed
+                                            << " by the frame, of " << drags << " drags";
 }
 
 // The frame stops a drag: a vertex dragged far past the right border ends a margin inside it,
