@@ -287,38 +287,57 @@ LinearError linear_error(const LimitEvaluator& evaluator, const ControlMesh& mes
   return error;
 }
 
-std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
-                                 const MeshTopology& topology, const FaceTolerance& tolerance,
-                                 int max_depth, LinearError* error) {
+std::vector<std::vector<uint8_t>> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
+                                              const MeshTopology& topology, std::span<const FaceTolerance> tolerances,
+                                              int max_depth, std::span<LinearError* const> errors) {
   const int faces = mesh.num_triangles();
-  std::vector<uint8_t> depths(faces, 0);
-  std::vector<FaceError> errors(faces);
+  const size_t count = tolerances.size();
+  std::vector<std::vector<uint8_t>> depths(count, std::vector<uint8_t>(faces, 0));
+  std::vector<std::vector<FaceError>> face_errors(count, std::vector<FaceError>(faces));
   parallel_for(faces, 0, [&](int f) {
     int sharp_sides = 0;
     for (int k = 0; k < 3; ++k) {
       const EdgeTag tag = topology.edge_tags[topology.face_edges[f][k]];
       if (tag == EdgeTag::kTear || tag == EdgeTag::kBorder) sharp_sides |= 1 << k;
     }
+    // One grid refined once for all the tolerances: each settles at its own depth.
     FaceGrid fine = finer_grid(evaluator, f, finer_grid(evaluator, f, {}));  // n = 2: depth 0
+    std::vector<uint8_t> open(count, 1);
     for (int depth = 0;; ++depth) {
-      errors[f] = face_error(fine, tolerance, sharp_sides);
-      if (errors[f].over == 0 || depth >= max_depth) {
-        depths[f] = static_cast<uint8_t>(depth);
-        break;
+      size_t left = 0;
+      for (size_t i = 0; i < count; ++i) {
+        if (!open[i]) continue;
+        face_errors[i][f] = face_error(fine, tolerances[i], sharp_sides);
+        if (face_errors[i][f].over == 0 || depth >= max_depth) {
+          depths[i][f] = static_cast<uint8_t>(depth);
+          open[i] = 0;
+        } else {
+          ++left;
+        }
       }
+      if (left == 0) break;
       fine = finer_grid(evaluator, f, fine);
     }
   });
-  if (error) {
-    *error = {};
-    for (const FaceError& e : errors) {
-      error->max_position = std::max(error->max_position, e.position);
-      error->max_color = std::max(error->max_color, e.color);
-      error->edges += e.pieces;
-      error->over += e.over;
+  for (size_t i = 0; i < count && i < errors.size(); ++i) {
+    if (!errors[i]) continue;
+    LinearError& error = *errors[i];
+    error = {};
+    for (const FaceError& e : face_errors[i]) {
+      error.max_position = std::max(error.max_position, e.position);
+      error.max_color = std::max(error.max_color, e.color);
+      error.edges += e.pieces;
+      error.over += e.over;
     }
   }
   return depths;
+}
+
+std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
+                                 const MeshTopology& topology, const FaceTolerance& tolerance,
+                                 int max_depth, LinearError* error) {
+  LinearError* const errors[1] = {error};
+  return std::move(face_depths(evaluator, mesh, topology, std::span(&tolerance, 1), max_depth, errors)[0]);
 }
 
 RefinedMesh adaptive_limit_mesh(const ControlMesh& mesh, const MeshTopology& topology,
@@ -556,18 +575,21 @@ RefinedMesh export_mesh_of(const ControlMesh& mesh, const MeshTopology& topology
       FaceTolerance geometry = tolerance;
       geometry.shading = Shading::kFlat;
       geometry.color = INFINITY;
-      depths = face_depths(evaluator, mesh, topology, geometry, max_depth);
-      // Colors: each cell's fit within the color tolerance.
+      // Colors: each cell's fit within the color tolerance. Or flat triangles, where they take
+      // fewer bytes: a face whose color curves needs many cells, and a linear gradient costs
+      // about four flat triangles. The three depths of a face come from one refinement of its grid.
       FaceTolerance color = tolerance;
       color.position = INFINITY;
-      color_depths = face_depths(evaluator, mesh, topology, color, max_depth, &error);
-      // Or flat triangles, where they take fewer bytes: a face whose color curves needs many
-      // cells, and a linear gradient costs about ten flat triangles.
       FaceTolerance flat = tolerance;
       flat.shading = Shading::kFlat;
       flat.position = INFINITY;
       flat.color = options.flat_color_tolerance;
-      const std::vector<uint8_t> flat_depths = face_depths(evaluator, mesh, topology, flat, max_depth);
+      const FaceTolerance kinds[3] = {geometry, color, flat};
+      LinearError* const errors[3] = {nullptr, &error, nullptr};
+      std::vector<std::vector<uint8_t>> all = face_depths(evaluator, mesh, topology, kinds, max_depth, errors);
+      depths = std::move(all[0]);
+      color_depths = std::move(all[1]);
+      const std::vector<uint8_t>& flat_depths = all[2];
       flat_faces.assign(faces, 0);
       for (int64_t f = 0; f < faces; ++f) {
         const int as_flat = std::max(depths[f], flat_depths[f]);

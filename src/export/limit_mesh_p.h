@@ -73,6 +73,11 @@ struct FaceTolerance {
 std::vector<uint8_t> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
                                  const MeshTopology& topology, const FaceTolerance& tolerance,
                                  int max_depth, LinearError* error = nullptr);
+// The same for several tolerances at once (one depth vector each, and errors[i] for tolerance i
+// where given): each face's grid is refined once, as deep as its most demanding tolerance needs.
+std::vector<std::vector<uint8_t>> face_depths(const LimitEvaluator& evaluator, const ControlMesh& mesh,
+                                              const MeshTopology& topology, std::span<const FaceTolerance> tolerances,
+                                              int max_depth, std::span<LinearError* const> errors = {});
 
 // The limit surface of `mesh` as a triangle mesh, face f refined to depths[f] on the regular grid
 // of its parameters, its limit positions and colors evaluated exactly (LimitEvaluator). An edge
