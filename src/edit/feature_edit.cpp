@@ -16,6 +16,7 @@
 
 #include "core/geometry_p.h"
 #include "core/messages_p.h"
+#include "edit/feature_edit_p.h"
 #include "subvec/core/error.h"
 #include "subvec/mesh/curves.h"
 #include "subvec/mesh/topology.h"
@@ -211,6 +212,32 @@ CurveFit fit_curve(std::span<const Vec2> polyline, double spacing, double tolera
   }
   return fit;
 }
+
+namespace edit_detail {
+
+void split_colors_at_tears(ControlMesh& mesh, const MeshTopology& topology) {
+  int count = 0;
+  const std::vector<Tri> fv = face_varying_indices(mesh, topology, count);
+  std::vector<Color> colors(count);
+  std::vector<double> sum(size_t(count) * 3, 0);
+  std::vector<int> seen(count, 0);
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Color& c = mesh.colors[mesh.triangle_colors[t][k]];
+      const int i = fv[t][k];
+      sum[3 * i] += c.r, sum[3 * i + 1] += c.g, sum[3 * i + 2] += c.b;
+      ++seen[i];
+    }
+  }
+  for (int i = 0; i < count; ++i)
+    colors[i] = {float(sum[3 * i] / seen[i]), float(sum[3 * i + 1] / seen[i]), float(sum[3 * i + 2] / seen[i])};
+  mesh.colors = std::move(colors);
+  mesh.triangle_colors = fv;
+}
+
+}  // namespace edit_detail
+
+using edit_detail::split_colors_at_tears;
 
 namespace {
 
@@ -668,28 +695,6 @@ std::vector<std::array<float, 3>> surface_at_pixels(const ControlMesh& mesh, con
     for (int k = 0; k < 3; ++k) out[p][k] = float(fit_detail::predict(loc, rc, values, k));
   }
   return out;
-}
-
-// Re-derives the face-varying color values from the tears: each new value takes the value its
-// corners had (they agree: a new tear only splits groups of corners).
-void split_colors_at_tears(ControlMesh& mesh, const MeshTopology& topology) {
-  int count = 0;
-  const std::vector<Tri> fv = face_varying_indices(mesh, topology, count);
-  std::vector<Color> colors(count);
-  std::vector<double> sum(size_t(count) * 3, 0);
-  std::vector<int> seen(count, 0);
-  for (int t = 0; t < mesh.num_triangles(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const Color& c = mesh.colors[mesh.triangle_colors[t][k]];
-      const int i = fv[t][k];
-      sum[3 * i] += c.r, sum[3 * i + 1] += c.g, sum[3 * i + 2] += c.b;
-      ++seen[i];
-    }
-  }
-  for (int i = 0; i < count; ++i)
-    colors[i] = {float(sum[3 * i] / seen[i]), float(sum[3 * i + 1] / seen[i]), float(sum[3 * i + 2] / seen[i])};
-  mesh.colors = std::move(colors);
-  mesh.triangle_colors = fv;
 }
 
 double mean_edge_near(const ControlMesh& mesh, std::span<const Vec2> points) {

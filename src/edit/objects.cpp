@@ -15,6 +15,7 @@
 
 #include "core/geometry_p.h"
 #include "core/messages_p.h"
+#include "edit/feature_edit_p.h"
 #include "mesh/collapse_engine_p.h"
 #include "mesh/coarsen_p.h"
 #include "subvec/core/error.h"
@@ -416,14 +417,7 @@ void tear_along(ControlMesh& mesh, int width, int height, const MeshTopology& to
     }
     if (!run.vertices.empty()) mesh.features.push_back(run);
   }
-  const MeshTopology t = MeshTopology::build(mesh, width, height);
-  int count = 0;
-  const std::vector<Tri> fv = face_varying_indices(mesh, t, count);
-  std::vector<Color> colors(count);
-  for (int f = 0; f < mesh.num_triangles(); ++f)
-    for (int k = 0; k < 3; ++k) colors[fv[f][k]] = mesh.colors[mesh.triangle_colors[f][k]];
-  mesh.colors = std::move(colors);
-  mesh.triangle_colors = fv;
+  edit_detail::split_colors_at_tears(mesh, MeshTopology::build(mesh, width, height));
 }
 
 Object& object_at(VectorImage& image, int object) {
