@@ -582,7 +582,8 @@ std::vector<uint8_t> grow(const MeshTopology& topology, std::vector<uint8_t> in,
 // is in `band_faces`) plus `membrane` times the Dirichlet energy of the free color values (their
 // squared differences with their neighbours on the triangles, cotangent-weighted), plus a light
 // pull to their current values. Returns the number of color values fitted.
-int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int height,
+// `system` is the fit's system of `mesh` (its positions and topology), its pixels located.
+int refit_colors(ControlMesh& mesh, const fit_detail::FitSystem& system, int width, int height,
                  const std::vector<uint8_t>& free_vertex, const std::vector<std::array<float, 3>>& targets,
                  const std::vector<uint8_t>& band, const std::vector<uint8_t>& band_faces, double membrane) {
   std::vector<int32_t> slot(mesh.num_colors(), -1);
@@ -593,8 +594,6 @@ int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int
   for (int c = 0; c < mesh.num_colors(); ++c)
     if (free_vertex[owner[c]]) slot[c] = n++;
   if (n == 0) return 0;
-  fit_detail::FitSystem system(mesh, topology, width, height, default_fit_depth(mesh));
-  fit_detail::locate_pixels(system);
   const SparseMatrix& s = system.s;
   using Triplet = Eigen::Triplet<double>;
   std::vector<Triplet> normal;
@@ -677,6 +676,14 @@ int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int
     mesh.colors[c] = {float(x(slot[c], 0)), float(x(slot[c], 1)), float(x(slot[c], 2))};
   }
   return n;
+}
+
+int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int height,
+                 const std::vector<uint8_t>& free_vertex, const std::vector<std::array<float, 3>>& targets,
+                 const std::vector<uint8_t>& band, const std::vector<uint8_t>& band_faces, double membrane) {
+  fit_detail::FitSystem system(mesh, topology, width, height, default_fit_depth(mesh));
+  fit_detail::locate_pixels(system);
+  return refit_colors(mesh, system, width, height, free_vertex, targets, band, band_faces, membrane);
 }
 
 // The surface of `mesh` at every pixel centre, on the fit's subdivision (float targets).
@@ -1036,15 +1043,13 @@ FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::
 
 namespace {
 
-// Which spans of `curve` (`per_span` samples each) the surface of `mesh` crosses by a step of
-// more than `max_step` levels (any channel, 8-bit): the two pixels on either side of each sample
-// segment's midpoint, both on `faces` and farther than 2 px from the tears and creases that stay
-// (their step is their own).
-std::vector<uint8_t> steep_spans(const ControlMesh& mesh, const MeshTopology& topology, int width, int height,
+// Which spans of `curve` (`per_span` samples each) the surface of `mesh` (`system`: its fit's
+// system, pixels located) crosses by a step of more than `max_step` levels (any channel, 8-bit):
+// the two pixels on either side of each sample segment's midpoint, both on `faces` and farther
+// than 2 px from the tears and creases that stay (their step is their own).
+std::vector<uint8_t> steep_spans(const ControlMesh& mesh, const fit_detail::FitSystem& system, int width, int height,
                                  std::span<const Vec2> curve, int per_span, const std::vector<uint8_t>& faces,
                                  int max_step) {
-  fit_detail::FitSystem system(mesh, topology, width, height, default_fit_depth(mesh));
-  fit_detail::locate_pixels(system);
   Eigen::MatrixX3d control(mesh.num_colors(), 3);
   for (int c = 0; c < mesh.num_colors(); ++c) control.row(c) << mesh.colors[c].r, mesh.colors[c].g, mesh.colors[c].b;
   const Eigen::MatrixX3d limit = system.s * control;
@@ -1169,6 +1174,9 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   const std::vector<std::array<float, 3>> targets =
       surface_at_pixels(mesh_in, before, width, height, default_fit_depth(mesh_in));
   const std::vector<Color> merged = mesh.colors;
+  // One system for every refit and check: the positions and the topology stay.
+  fit_detail::FitSystem system(mesh, topology, width, height, default_fit_depth(mesh));
+  fit_detail::locate_pixels(system);
   for (int attempt = 0;; ++attempt) {
     double widest = 0;
     for (size_t i = 0; i + 1 < curve.size(); ++i) {
@@ -1226,9 +1234,9 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
       }
     }
     mesh.colors = merged;
-    result.colors_refit = refit_colors(mesh, topology, width, height, free_vertex, targets, band, band_faces, kMembrane);
+    result.colors_refit = refit_colors(mesh, system, width, height, free_vertex, targets, band, band_faces, kMembrane);
     if (attempt == kWidenings) break;
-    const std::vector<uint8_t> steep = steep_spans(mesh, topology, width, height, curve, kPerSpan, band_faces, kMaxStep);
+    const std::vector<uint8_t> steep = steep_spans(mesh, system, width, height, curve, kPerSpan, band_faces, kMaxStep);
     if (std::find(steep.begin(), steep.end(), 1) == steep.end()) break;
     for (size_t span = 0; span < spans; ++span)
       if (steep[span]) widen[span] *= kWiden;
