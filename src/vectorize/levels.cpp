@@ -36,14 +36,15 @@ using coarsen_detail::Kind;
 constexpr double kMaxLoosening = 8;
 
 // The subdivision depth of a coarser level's color fit: its own default (default_fit_depth()), but
-// no deeper than gives it 1.5 times the refined triangles of level 0's fit (at depth `base_depth`
-// on `base_triangles`) at most. The default rule steps by whole levels, and a level of half the
+// no deeper than gives it half the refined triangles of level 0's fit (at depth `base_depth` on
+// `base_triangles`) at most. The default rule steps by whole levels, and a level of half the
 // faces often stepped one deeper: twice level 0's refined triangles, and at 4 MP 6 s of the fit
-// for 0.5% of its error (docs/vectorize.md, "Levels of abstraction"). A quarter of the faces, one
-// level deeper, is level 0's count again.
+// for 0.5% of its error (docs/vectorize.md, "Levels of abstraction"). A quarter of the faces one
+// level deeper, level 0's count again, was allowed until 2026-12-08: at 4 MP 1.2 s of the levels
+// for at most 0.6 % of level 2's error.
 int level_fit_depth(const ControlMesh& level, int base_depth, int base_triangles) {
   int depth = base_depth;
-  for (double faces = level.num_triangles(); 4 * faces <= 1.5 * base_triangles; faces *= 4) ++depth;
+  for (double faces = level.num_triangles(); 4 * faces <= 0.5 * base_triangles; faces *= 4) ++depth;
   return std::min(depth, default_fit_depth(level));
 }
 
