@@ -606,7 +606,7 @@ ColorFitStats fit_colors(ControlMesh& mesh, int width, int height, const Image8&
   for (int i = 0; i < system.c; ++i) {
     mesh.colors[i] = {static_cast<float>(x(i, 0)), static_cast<float>(x(i, 1)), static_cast<float>(x(i, 2))};
   }
-  if (pixels) measure_residual(system, image, x, stats);
+  if (pixels && options.measure) measure_residual(system, image, x, stats);
   return stats;
 }
 

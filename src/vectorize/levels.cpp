@@ -294,6 +294,7 @@ void build_levels(VectorImage& image, const Image8& photo, const LevelOptions& o
     ControlMesh coarse = c.result(parents, color_merged);
     ColorFitOptions fit = options.fit;
     if (!fit.cancel) fit.cancel = options.cancel;
+    fit.measure = false;
     if (fit.depth < 0) fit.depth = level_fit_depth(coarse, base_depth, base.num_triangles());
     fit_colors(coarse, image.width, image.height, photo, fit);
     coarse.parent_vertices = std::move(parents);

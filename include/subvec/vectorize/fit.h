@@ -31,6 +31,9 @@ struct ColorFitOptions {
   // (docs/vectorize.md, "Large images").
   int l1_iterations = 1;
   double l1_floor = 1.0;  // 0-255 scale
+  // Measure the residual (ColorFitStats::rms and mae: one more pass over the pixels); the coarser
+  // levels, whose stats nobody reads, skip it.
+  bool measure = true;
   // Damped Gauss-Newton steps that move the smooth control vertices (not those of features, creases,
   // the border or corners) to lower the squared pixel error, each kept only when the refit colors
   // lower it (pixel target only; 0: positions as given).
