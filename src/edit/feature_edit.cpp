@@ -686,14 +686,19 @@ int refit_colors(ControlMesh& mesh, const MeshTopology& topology, int width, int
   return refit_colors(mesh, system, width, height, free_vertex, targets, band, band_faces, membrane);
 }
 
+// The refined color values of `mesh` on its fit's `system`: the stencils times its colors.
+Eigen::MatrixX3d refined_colors(const ControlMesh& mesh, const fit_detail::FitSystem& system) {
+  Eigen::MatrixX3d control(mesh.num_colors(), 3);
+  for (int c = 0; c < mesh.num_colors(); ++c) control.row(c) << mesh.colors[c].r, mesh.colors[c].g, mesh.colors[c].b;
+  return system.s * control;
+}
+
 // The surface of `mesh` at every pixel centre, on the fit's subdivision (float targets).
 std::vector<std::array<float, 3>> surface_at_pixels(const ControlMesh& mesh, const MeshTopology& topology,
                                                     int width, int height, int depth) {
   fit_detail::FitSystem system(mesh, topology, width, height, depth);
   fit_detail::locate_pixels(system);
-  Eigen::MatrixX3d control(mesh.num_colors(), 3);
-  for (int c = 0; c < mesh.num_colors(); ++c) control.row(c) << mesh.colors[c].r, mesh.colors[c].g, mesh.colors[c].b;
-  const Eigen::MatrixX3d values = system.s * control;
+  const Eigen::MatrixX3d values = refined_colors(mesh, system);
   std::vector<std::array<float, 3>> out(size_t(width) * height, {0, 0, 0});
   for (size_t p = 0; p < out.size(); ++p) {
     const fit_detail::Location& loc = system.located[p];
@@ -1043,24 +1048,27 @@ FeatureEditResult add_feature(ControlMesh& mesh_in, int width, int height, std::
 
 namespace {
 
-// Which spans of `curve` (`per_span` samples each) the surface of `mesh` (`system`: its fit's
-// system, pixels located) crosses by a step of more than `max_step` levels (any channel, 8-bit):
-// the two pixels on either side of each sample segment's midpoint, both on `faces` and farther
-// than 2 px from the tears and creases that stay (their step is their own).
-std::vector<uint8_t> steep_spans(const ControlMesh& mesh, const fit_detail::FitSystem& system, int width, int height,
-                                 std::span<const Vec2> curve, int per_span, const std::vector<uint8_t>& faces,
-                                 int max_step) {
-  Eigen::MatrixX3d control(mesh.num_colors(), 3);
-  for (int c = 0; c < mesh.num_colors(); ++c) control.row(c) << mesh.colors[c].r, mesh.colors[c].g, mesh.colors[c].b;
-  const Eigen::MatrixX3d limit = system.s * control;
-  std::vector<uint8_t> by_sharp(size_t(width) * height, 0);
+// The pixels within 2 px of a tear or crease of `system`'s limit mesh.
+std::vector<uint8_t> near_sharp_pixels(const fit_detail::FitSystem& system, int width, int height) {
+  std::vector<uint8_t> near(size_t(width) * height, 0);
   for (const auto* edges : {&system.refined.tear_edges, &system.refined.crease_edges})
     for (const EdgeVerts& e : *edges) {
       const float* p = &system.limit[2 * size_t(e[0])];
       const float* q = &system.limit[2 * size_t(e[1])];
       detail::for_pixels_near_segment(p[0], p[1], q[0], q[1], 2.0, width, height,
-                                      [&](int x, int y) { by_sharp[size_t(y) * width + x] = 1; });
+                                      [&](int x, int y) { near[size_t(y) * width + x] = 1; });
     }
+  return near;
+}
+
+// Which spans of `curve` (`per_span` samples each) the surface of `mesh` (`system`: its fit's
+// system, pixels located) crosses by a step of more than `max_step` levels (any channel, 8-bit):
+// the two pixels on either side of each sample segment's midpoint, both on `faces` and not
+// `by_sharp` (near_sharp_pixels: a tear or crease that stays makes a step of its own).
+std::vector<uint8_t> steep_spans(const ControlMesh& mesh, const fit_detail::FitSystem& system, int width, int height,
+                                 std::span<const Vec2> curve, int per_span, const std::vector<uint8_t>& faces,
+                                 const std::vector<uint8_t>& by_sharp, int max_step) {
+  const Eigen::MatrixX3d limit = refined_colors(mesh, system);
   auto at = [&](int x, int y, std::array<double, 3>& out) {
     const fit_detail::Location& loc = system.located[size_t(y) * width + x];
     if (loc.triangle < 0 || by_sharp[size_t(y) * width + x] || !faces[system.refined.triangle_parent[loc.triangle]])
@@ -1177,6 +1185,9 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
   // One system for every refit and check: the positions and the topology stay.
   fit_detail::FitSystem system(mesh, topology, width, height, default_fit_depth(mesh));
   fit_detail::locate_pixels(system);
+  const std::vector<uint8_t> by_sharp = near_sharp_pixels(system, width, height);
+  std::vector<uint8_t> seeds(mesh.num_vertices(), 0);
+  for (const int v : gone.vertices) seeds[v] = 1;
   for (int attempt = 0;; ++attempt) {
     double widest = 0;
     for (size_t i = 0; i + 1 < curve.size(); ++i) {
@@ -1184,8 +1195,6 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
       widest = std::max(widest, band_for(std::max(jump[span % n], jump[(span + 1) % n]), widen[span]));
     }
     const int rings = std::min(16, 2 + static_cast<int>(std::ceil(widest / std::max(edge, 1.0))));
-    std::vector<uint8_t> seeds(mesh.num_vertices(), 0);
-    for (const int v : gone.vertices) seeds[v] = 1;
     const std::vector<uint8_t> free_vertex = grow(topology, seeds, rings);
     std::vector<uint8_t> band(size_t(width) * height, 0);
     for (size_t i = 0; i + 1 < curve.size(); ++i) {
@@ -1236,7 +1245,7 @@ FeatureEditResult delete_chain(ControlMesh& mesh_in, int width, int height, cons
     mesh.colors = merged;
     result.colors_refit = refit_colors(mesh, system, width, height, free_vertex, targets, band, band_faces, kMembrane);
     if (attempt == kWidenings) break;
-    const std::vector<uint8_t> steep = steep_spans(mesh, system, width, height, curve, kPerSpan, band_faces, kMaxStep);
+    const std::vector<uint8_t> steep = steep_spans(mesh, system, width, height, curve, kPerSpan, band_faces, by_sharp, kMaxStep);
     if (std::find(steep.begin(), steep.end(), 1) == steep.end()) break;
     for (size_t span = 0; span < spans; ++span)
       if (steep[span]) widen[span] *= kWiden;
